@@ -1,0 +1,60 @@
+# Finds every third-party dependency. A missing one stops configuration with the Debian package
+# that provides it, so `apt-get install <package>` is always the fix.
+
+# rtlab_require(<find_package args...> DEBIAN <package>)
+macro(rtlab_require name)
+    cmake_parse_arguments(_rq "" "DEBIAN" "" ${ARGN})
+    find_package(${name} ${_rq_UNPARSED_ARGUMENTS} QUIET)
+    if(NOT ${name}_FOUND)
+        message(FATAL_ERROR
+            "rtlab: dependency '${name}' was not found.\n"
+            "  Install the Debian package: apt-get install ${_rq_DEBIAN}\n"
+            "  (./rtlab.sh installs every package listed in scripts/debian-packages.txt)")
+    endif()
+endmacro()
+
+# rtlab_require_header(<var> <header> DEBIAN <package>) for header-only libraries without CMake files.
+function(rtlab_require_header var header)
+    cmake_parse_arguments(_rq "" "DEBIAN" "" ${ARGN})
+    find_path(${var} NAMES ${header})
+    if(NOT ${var})
+        message(FATAL_ERROR
+            "rtlab: header '${header}' was not found.\n"
+            "  Install the Debian package: apt-get install ${_rq_DEBIAN}")
+    endif()
+endfunction()
+
+# rtlab_require_library(<var> <libname> DEBIAN <package>)
+function(rtlab_require_library var lib)
+    cmake_parse_arguments(_rq "" "DEBIAN" "" ${ARGN})
+    find_library(${var} NAMES ${lib})
+    if(NOT ${var})
+        message(FATAL_ERROR
+            "rtlab: library '${lib}' was not found.\n"
+            "  Install the Debian package: apt-get install ${_rq_DEBIAN}")
+    endif()
+endfunction()
+
+find_package(PkgConfig QUIET)
+rtlab_require(Threads DEBIAN libc6-dev)
+rtlab_require(Vulkan DEBIAN libvulkan-dev)
+rtlab_require(glm DEBIAN libglm-dev)
+rtlab_require(TBB DEBIAN libtbb-dev)
+rtlab_require(yaml-cpp DEBIAN libyaml-cpp-dev)
+rtlab_require(CLI11 DEBIAN libcli11-dev)
+rtlab_require(fmt DEBIAN libfmt-dev)
+rtlab_require(GTest DEBIAN "libgtest-dev libgmock-dev")
+rtlab_require(benchmark DEBIAN libbenchmark-dev)
+
+rtlab_require(glslang CONFIG DEBIAN glslang-dev)
+rtlab_require(SPIRV-Tools CONFIG DEBIAN spirv-tools)
+rtlab_require(SPIRV-Tools-opt CONFIG DEBIAN spirv-tools)
+add_library(rtlab_glslang INTERFACE)
+target_link_libraries(rtlab_glslang INTERFACE
+    glslang::glslang glslang::SPIRV glslang::glslang-default-resource-limits)
+
+# Used from issue [2] on: ground truth, images, meshes, plots, baselines.
+rtlab_require(embree 3 CONFIG DEBIAN libembree-dev)
+rtlab_require(OpenImageIO CONFIG DEBIAN libopenimageio-dev)
+rtlab_require(tinyobjloader CONFIG DEBIAN libtinyobjloader-dev)
+rtlab_require(TinyGLTF CONFIG DEBIAN libtinygltf-dev)

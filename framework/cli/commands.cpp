@@ -1,0 +1,223 @@
+#include "cli/commands.h"
+
+#include "core/error.h"
+#include "core/json.h"
+#include "core/strings.h"
+#include "experiment/experiment.h"
+#include "experiment/runner.h"
+#include "plugin/technique.h"
+
+#include <fmt/core.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+namespace rtlab::cli {
+
+namespace fs = std::filesystem;
+
+std::string defaultSourceDirectory()
+{
+    if (const char* env = std::getenv("RTLAB_SOURCE_DIR"); env && *env)
+        return env;
+    return RTLAB_BUILT_FROM_SOURCE_DIR;
+}
+
+// ---------------------------------------------------------------------------------------- list
+
+static std::string specJson(const config::ParamSpec& s)
+{
+    JsonObject o;
+    o.add("name", s.name).add("type", config::toString(s.type));
+    o.addRaw("default", s.type == config::ParamType::String || s.type == config::ParamType::Enum
+                            ? jsonEscape(config::formatValue(s.defaultValue))
+                            : config::formatValue(s.defaultValue));
+    o.add("range", s.describeRange()).add("unit", s.unit).add("doc", s.doc);
+    return o.str();
+}
+
+int listTechniques(const ListOptions& options)
+{
+    const auto& registry = plugin::builtinRegistry();
+    std::vector<std::string> families = registry.familyNames();
+    if (!options.family.empty()) {
+        if (!registry.findFamily(options.family)) {
+            const auto close = closestNames(options.family, families);
+            fmt::print(stderr, "rtlab list: unknown family '{}'{}. Families: {}.\n", options.family,
+                       close.empty() ? "" : "; did you mean " + joinList(close, "or") + "?",
+                       joinList(families));
+            return kExitBadInput;
+        }
+        families = {options.family};
+    }
+    if (options.json) {
+        std::vector<std::string> familyJson;
+        for (const auto& f : families) {
+            const auto* info = registry.findFamily(f);
+            std::vector<std::string> techniques;
+            for (const auto* t : registry.techniques(f)) {
+                std::vector<std::string> params;
+                for (const auto& s : t->schema.specs())
+                    params.push_back(specJson(s));
+                techniques.push_back(JsonObject()
+                                         .add("name", t->info.name)
+                                         .add("summary", t->info.summary)
+                                         .add("reference", t->info.reference)
+                                         .add("seed", t->info.seed)
+                                         .addRaw("parameters", jsonArray(params))
+                                         .str());
+            }
+            familyJson.push_back(JsonObject()
+                                     .add("name", f)
+                                     .add("summary", info->summary)
+                                     .add("input", info->input)
+                                     .add("output", info->output)
+                                     .add("ground_truth", info->groundTruth)
+                                     .addRaw("techniques", jsonArray(techniques))
+                                     .str());
+        }
+        fmt::print("{}\n", JsonObject().addRaw("families", jsonArray(familyJson)).str());
+        return kExitOk;
+    }
+    for (const auto& f : families) {
+        const auto* info = registry.findFamily(f);
+        fmt::print("{}: {}\n", f, info->summary);
+        fmt::print("  input:        {}\n  output:       {}\n  ground truth: {}\n", info->input, info->output,
+                   info->groundTruth);
+        const auto techniques = registry.techniques(f);
+        if (techniques.empty())
+            fmt::print("  (no techniques yet: `rtlab new-technique {} <name>` adds one)\n", f);
+        for (const auto* t : techniques) {
+            fmt::print("\n  {}: {}\n", t->info.name, t->info.summary);
+            if (!t->info.reference.empty())
+                fmt::print("    after: {}\n", t->info.reference);
+            if (t->schema.empty()) {
+                fmt::print("    (no parameters)\n");
+                continue;
+            }
+            fmt::print("    {:<22} {:<6} {:<10} {:<22} {:<12} {}\n", "parameter", "type", "default", "range",
+                       "unit", "doc");
+            for (const auto& s : t->schema.specs())
+                fmt::print("    {:<22} {:<6} {:<10} {:<22} {:<12} {}\n", s.name, config::toString(s.type),
+                           config::formatValue(s.defaultValue), s.describeRange(), s.unit, s.doc);
+        }
+        fmt::print("\n");
+    }
+    return kExitOk;
+}
+
+// ----------------------------------------------------------------------------------------- run
+
+int runExperimentCommand(const RunOptions& options)
+{
+    const auto& registry = plugin::builtinRegistry();
+    experiment::Experiment e;
+    try {
+        e = experiment::loadExperiment(options.experimentPath, registry);
+    } catch (const InputError& error) {
+        fmt::print(stderr, "{}\n", error.what());
+        return kExitBadInput;
+    }
+    if (options.dryRun) {
+        fmt::print("{}: {} run(s){}\n", e.name, e.runs.size(),
+                   e.sweepKeys.empty() ? "" : " over " + joinList(e.sweepKeys));
+        for (std::size_t i = 0; i < e.runs.size(); ++i) {
+            const auto& r = e.runs[i];
+            std::string techniques;
+            for (const auto& [family, choice] : r.techniques)
+                techniques += fmt::format(" {}={}({})", family, choice.technique, choice.params.toString());
+            fmt::print("  {:>4}  {}  scene={} grid={}{}\n", i + 1, r.id(), r.scene, r.grid, techniques);
+        }
+        return kExitOk;
+    }
+    experiment::RunnerOptions runnerOptions;
+    runnerOptions.outputDirectory = options.outputDirectory;
+    const auto summary = experiment::runExperiment(e, registry, runnerOptions);
+    fmt::print("{}: {} run(s): {} computed, {} already done, {} failed\n", e.name, summary.total,
+               summary.succeeded, summary.alreadyDone, summary.failed);
+    fmt::print("results: {}/results.csv (and results.jsonl, manifest.json)\n", summary.outputDirectory);
+    if (summary.failed > 0) {
+        fmt::print(stderr, "{} run(s) failed; their errors are in the 'error' column of the results.\n",
+                   summary.failed);
+        return kExitFailed;
+    }
+    return kExitOk;
+}
+
+// ------------------------------------------------------------------------------- new-technique
+
+static std::string toPascalCase(const std::string& snake)
+{
+    std::string out;
+    bool upper = true;
+    for (char c : snake) {
+        if (c == '_') {
+            upper = true;
+            continue;
+        }
+        out += upper ? char(std::toupper(static_cast<unsigned char>(c))) : c;
+        upper = false;
+    }
+    return out;
+}
+
+int newTechnique(const NewTechniqueOptions& options)
+{
+    const auto& registry = plugin::builtinRegistry();
+    if (!registry.findFamily(options.family)) {
+        const auto close = closestNames(options.family, registry.familyNames());
+        fmt::print(stderr, "rtlab new-technique: unknown family '{}'{}. Families: {}.\n", options.family,
+                   close.empty() ? "" : "; did you mean " + joinList(close, "or") + "?",
+                   joinList(registry.familyNames()));
+        return kExitBadInput;
+    }
+    if (!std::regex_match(options.name, std::regex("[a-z][a-z0-9_]*")) || options.name.back() == '_') {
+        fmt::print(stderr,
+                   "rtlab new-technique: name '{}' must be snake_case: a lowercase letter, then lowercase "
+                   "letters, digits and single underscores (e.g. my_ao)\n",
+                   options.name);
+        return kExitBadInput;
+    }
+    const fs::path root = options.sourceDirectory.empty() ? defaultSourceDirectory() : options.sourceDirectory;
+    const fs::path templateDir = root / "techniques" / "_template" / options.family;
+    const fs::path target = root / "techniques" / options.family / options.name;
+    if (!fs::is_directory(templateDir)) {
+        fmt::print(stderr, "rtlab new-technique: no template for family '{}' at {}\n", options.family,
+                   templateDir.string());
+        return kExitEnvironment;
+    }
+    if (fs::exists(target)) {
+        fmt::print(stderr, "rtlab new-technique: {} already exists; choose another name\n", target.string());
+        return kExitBadInput;
+    }
+    const std::string className = toPascalCase(options.name);
+    fs::create_directories(target);
+    std::vector<std::string> written;
+    for (const auto& entry : fs::directory_iterator(templateDir)) {
+        if (!entry.is_regular_file())
+            continue;
+        std::string fileName = entry.path().filename().string();
+        if (fileName.ends_with(".in"))
+            fileName.resize(fileName.size() - 3);
+        for (auto pos = fileName.find("technique"); pos != std::string::npos; pos = fileName.find("technique"))
+            fileName.replace(pos, 9, options.name);
+        std::string text = readTextFile(entry.path().string());
+        const std::pair<std::string, std::string> substitutions[] = {
+            {"@NAME@", options.name}, {"@CLASS@", className}, {"@FAMILY@", options.family}};
+        for (const auto& [from, to] : substitutions)
+            for (auto pos = text.find(from); pos != std::string::npos; pos = text.find(from, pos + to.size()))
+                text.replace(pos, from.size(), to);
+        std::ofstream(target / fileName) << text;
+        written.push_back(fileName);
+    }
+    std::sort(written.begin(), written.end());
+    fmt::print("created {}/ ({})\n", target.string(), joinList(written));
+    fmt::print("next: rebuild (cmake --build build) and it appears in `rtlab list --family {}`;\n"
+               "      its unit test runs as ctest -R {}_{}\n",
+               options.family, options.family, options.name);
+    return kExitOk;
+}
+
+} // namespace rtlab::cli

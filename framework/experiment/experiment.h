@@ -1,0 +1,69 @@
+#pragma once
+// Experiment files: one YAML document describes a study. A `base` run plus a `sweep` that expands
+// to the cross product of its axes. Everything is validated against the registry's declarations
+// before anything runs; errors name file:line:column.
+//
+//   name: smoke
+//   description: marching cubes on analytic shapes
+//   base:
+//     scene: sphere                     # an analytic shape (scene::analyticShapes)
+//     grid: 48                          # SDF samples per axis
+//     timing: {warmup: 1, repeats: 5}
+//     techniques:
+//       isosurface: {technique: marching_cubes, params: {vertex_placement: linear}}
+//   sweep:                              # cross product, axes in file order
+//     scene: [sphere, torus]
+//     grid: [24, 48]
+//     isosurface.technique: [marching_cubes]
+//     isosurface.vertex_placement: [linear, midpoint]
+
+#include "config/param.h"
+#include "metrics/timing.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rtlab::plugin {
+class Registry;
+}
+
+namespace rtlab::experiment {
+
+//! The technique a run uses for one family, with its validated parameters (every declared key).
+struct TechniqueChoice {
+    std::string technique;
+    config::ParamSet params;
+};
+
+//! One fully expanded run.
+struct RunConfig {
+    std::string scene;
+    int grid = 64;                                     //!< samples per axis (isosurface)
+    metrics::TimingOptions timing;
+    std::map<std::string, TechniqueChoice> techniques;  //!< family -> choice
+
+    //! Short readable id, unique within an experiment: "sphere-g48-marching_cubes-3f2a91c0".
+    std::string id() const;
+    //! Canonical JSON of everything that determines the result (used for resume).
+    std::string toJson() const;
+    //! Hash of toJson(): a run whose hash is already in the results table is not recomputed.
+    std::string hash() const;
+};
+
+struct Experiment {
+    std::string path;
+    std::string name;
+    std::string description;
+    RunConfig base;
+    std::vector<std::string> sweepKeys;  //!< axes in file order
+    std::vector<RunConfig> runs;         //!< the expanded cross product (just `base` without sweep)
+};
+
+//! Loads, validates and expands an experiment file.
+Experiment loadExperiment(const std::string& path, const plugin::Registry& registry);
+//! Same for in-memory text; `label` stands for the path in messages.
+Experiment parseExperiment(const std::string& text, const std::string& label,
+                           const plugin::Registry& registry);
+
+} // namespace rtlab::experiment

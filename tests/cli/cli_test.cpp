@@ -1,0 +1,133 @@
+// The `rtlab` command as a user runs it: exit codes, messages, listings, the scaffold.
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Result {
+    int exitCode = -1;
+    std::string output;  // stdout and stderr together
+};
+
+Result runRtlab(const std::string& args)
+{
+    const std::string command = std::string(RTLAB_EXE) + " " + args + " 2>&1";
+    Result r;
+    std::FILE* pipe = ::popen(command.c_str(), "r");
+    if (!pipe)
+        return r;
+    std::array<char, 4096> buf;
+    while (std::size_t n = std::fread(buf.data(), 1, buf.size(), pipe))
+        r.output.append(buf.data(), n);
+    const int status = ::pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+fs::path freshDirectory(const std::string& name)
+{
+    const auto dir = fs::temp_directory_path() / ("rtlab_cli_test_" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+std::string readFile(const fs::path& p)
+{
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+} // namespace
+
+TEST(Cli, HelpOnEverySubcommand)
+{
+    for (const char* sub : {"", "list", "run", "new-technique", "gpu"}) {
+        const auto r = runRtlab(std::string(sub) + " --help");
+        EXPECT_EQ(r.exitCode, 0) << sub;
+        EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub << ": " << r.output;
+    }
+}
+
+TEST(Cli, NoSubcommandOrUnknownOptionIsAnError)
+{
+    EXPECT_EQ(runRtlab("").exitCode, 2);
+    EXPECT_EQ(runRtlab("list --bogus").exitCode, 2);
+    EXPECT_EQ(runRtlab("run").exitCode, 2);  // missing experiment file
+}
+
+TEST(Cli, ListShowsTheThreeFamiliesWithParameters)
+{
+    const auto r = runRtlab("list");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    for (const char* family : {"occlusion:", "isosurface:", "voxel_gi:"})
+        EXPECT_NE(r.output.find(family), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("parameter"), std::string::npos) << r.output;
+
+    const auto json = runRtlab("list --json");
+    ASSERT_EQ(json.exitCode, 0);
+    EXPECT_EQ(json.output.front(), '{');
+    EXPECT_NE(json.output.find("\"name\":\"voxel_gi\""), std::string::npos);
+
+    const auto bad = runRtlab("list --family isosurfac");
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("did you mean isosurface?"), std::string::npos) << bad.output;
+}
+
+TEST(Cli, RunReportsConfigErrorsWithLocationAndExitCode2)
+{
+    const auto dir = freshDirectory("bad_config");
+    const auto path = dir / "bad.yaml";
+    std::ofstream(path) << "base:\n  scene: sphere\n  techniques:\n    isosurface: {technique: marching_cube}\n";
+    const auto r = runRtlab("run " + path.string());
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find(path.string() + ":4:29: error: unknown technique"), std::string::npos) << r.output;
+}
+
+TEST(Cli, DryRunPrintsTheExpandedRuns)
+{
+    const auto r = runRtlab("run --dry-run " + std::string(RTLAB_SOURCE_DIR) + "/experiments/smoke.yaml");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("smoke: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("marching_cubes"), std::string::npos) << r.output;
+}
+
+TEST(Cli, NewTechniqueScaffoldsFromTheTemplate)
+{
+    const auto root = freshDirectory("scaffold");
+    fs::create_directories(root / "techniques");
+    fs::copy(fs::path(RTLAB_SOURCE_DIR) / "techniques" / "_template", root / "techniques" / "_template",
+             fs::copy_options::recursive);
+    const auto r = runRtlab("new-technique occlusion my_ao --source-dir " + root.string());
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    const auto folder = root / "techniques" / "occlusion" / "my_ao";
+    for (const char* f : {"CMakeLists.txt", "my_ao.cpp", "my_ao_test.cpp", "README.md"}) {
+        ASSERT_TRUE(fs::exists(folder / f)) << f;
+        EXPECT_EQ(readFile(folder / f).find('@'), std::string::npos) << f << " has an unreplaced placeholder";
+    }
+    EXPECT_NE(readFile(folder / "CMakeLists.txt").find("rtlab_add_technique(my_ao FAMILY occlusion"),
+              std::string::npos);
+    EXPECT_NE(readFile(folder / "my_ao.cpp").find("RTLAB_REGISTER_TECHNIQUE(occlusion, my_ao, MyAo)"),
+              std::string::npos);
+
+    // A second time: the folder exists, nothing is overwritten.
+    const auto again = runRtlab("new-technique occlusion my_ao --source-dir " + root.string());
+    EXPECT_EQ(again.exitCode, 2);
+    EXPECT_NE(again.output.find("already exists"), std::string::npos);
+    // Bad names and families.
+    EXPECT_EQ(runRtlab("new-technique occlusion MyAO --source-dir " + root.string()).exitCode, 2);
+    const auto fam = runRtlab("new-technique oclusion x --source-dir " + root.string());
+    EXPECT_EQ(fam.exitCode, 2);
+    EXPECT_NE(fam.output.find("did you mean occlusion?"), std::string::npos) << fam.output;
+}
