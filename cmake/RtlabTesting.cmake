@@ -8,7 +8,7 @@ function(rtlab_add_test name)
     target_link_libraries(${name} PRIVATE ${_t_LIBS} GTest::gtest GTest::gmock GTest::gtest_main
                                           rtlab_warnings)
     target_compile_definitions(${name} PRIVATE RTLAB_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
+    gtest_discover_tests(${name} DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60 TEST_PREFIX "${name}."
         PROPERTIES LABELS "${_t_LABELS}"
                    ENVIRONMENT "RTLAB_SOURCE_DIR=${PROJECT_SOURCE_DIR};RTLAB_CACHE_DIR=${PROJECT_BINARY_DIR}/cache")
 endfunction()

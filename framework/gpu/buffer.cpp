@@ -1,0 +1,172 @@
+// Storage buffers and their upload/download paths (mapped on unified memory, staged otherwise).
+
+#include "gpu/resources.h"
+
+#include <cstring>
+
+#include "core/error.h"
+#include "gpu/vulkan_internal.h"
+
+namespace rtlab::gpu {
+
+namespace detail {
+
+namespace {
+
+// A temporary host-visible buffer, freed on scope exit.
+class StagingBuffer {
+public:
+    StagingBuffer(DeviceState& device, VkDeviceSize size, VkBufferUsageFlags usage)
+        : mDevice(device),
+          mRaw(device.createRawBuffer(size, usage, DeviceState::MemoryKind::HostStaging, "staging"))
+    {
+    }
+    ~StagingBuffer() { mDevice.destroyRawBuffer(mRaw); }
+    StagingBuffer(const StagingBuffer&) = delete;
+    StagingBuffer& operator=(const StagingBuffer&) = delete;
+    const RawBuffer& getRaw() const { return mRaw; }
+
+private:
+    DeviceState& mDevice;
+    RawBuffer mRaw;
+};
+
+} // namespace
+
+BufferState::~BufferState()
+{
+    if (device)
+        device->destroyRawBuffer(raw);
+}
+
+void flushMapped(DeviceState& device, const RawBuffer& raw)
+{
+    if (raw.coherent)
+        return;
+    VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+    range.memory = raw.memory;
+    range.size = VK_WHOLE_SIZE;
+    checkResult(vkFlushMappedMemoryRanges(device.device, 1, &range), "vkFlushMappedMemoryRanges");
+}
+
+void invalidateMapped(DeviceState& device, const RawBuffer& raw)
+{
+    if (raw.coherent)
+        return;
+    VkMappedMemoryRange range{VK_STRUCTURE_TYPE_MAPPED_MEMORY_RANGE};
+    range.memory = raw.memory;
+    range.size = VK_WHOLE_SIZE;
+    checkResult(vkInvalidateMappedMemoryRanges(device.device, 1, &range),
+                "vkInvalidateMappedMemoryRanges");
+}
+
+void uploadThroughStaging(DeviceState& device, const void* data, std::size_t size,
+                          const std::function<void(VkCommandBuffer, VkBuffer)>& copy)
+{
+    StagingBuffer staging(device, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    std::memcpy(staging.getRaw().mapped, data, size);
+    flushMapped(device, staging.getRaw());
+    device.submitAndWait([&](VkCommandBuffer cmd) { copy(cmd, staging.getRaw().buffer); });
+}
+
+void downloadThroughStaging(DeviceState& device, void* data, std::size_t size,
+                            const std::function<void(VkCommandBuffer, VkBuffer)>& copy)
+{
+    StagingBuffer staging(device, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    device.submitAndWait([&](VkCommandBuffer cmd) { copy(cmd, staging.getRaw().buffer); });
+    invalidateMapped(device, staging.getRaw());
+    std::memcpy(data, staging.getRaw().mapped, size);
+}
+
+} // namespace detail
+
+Buffer::Buffer() = default;
+Buffer::~Buffer() = default;
+Buffer::Buffer(Buffer&&) noexcept = default;
+Buffer& Buffer::operator=(Buffer&&) noexcept = default;
+Buffer::Buffer(std::unique_ptr<detail::BufferState> state) : mState(std::move(state)) {}
+
+detail::BufferState& Buffer::getState() const
+{
+    if (!mState)
+        throw Error("use of an empty gpu::Buffer");
+    return *mState;
+}
+
+std::size_t Buffer::getSize() const
+{
+    return static_cast<std::size_t>(getState().raw.size);
+}
+
+const std::string& Buffer::getName() const
+{
+    return getState().name;
+}
+
+namespace {
+
+void checkRange(const detail::BufferState& state, std::size_t size, std::size_t offset,
+                const char* what)
+{
+    if (offset > state.raw.size || size > state.raw.size - offset)
+        throw Error(std::string(what) + " of " + std::to_string(size) + " bytes at offset " +
+                    std::to_string(offset) + " exceeds buffer '" + state.name + "' of " +
+                    std::to_string(state.raw.size) + " bytes");
+}
+
+} // namespace
+
+void Buffer::upload(const void* data, std::size_t size, std::size_t offset)
+{
+    detail::BufferState& state = getState();
+    checkRange(state, size, offset, "upload");
+    if (size == 0)
+        return;
+    detail::DeviceState& device = *state.device;
+    if (!device.stagingUploads && state.raw.mapped != nullptr) {
+        std::memcpy(static_cast<std::byte*>(state.raw.mapped) + offset, data, size);
+        detail::flushMapped(device, state.raw);
+        return;
+    }
+    detail::uploadThroughStaging(device, data, size, [&](VkCommandBuffer cmd, VkBuffer staging) {
+        VkBufferCopy region{0, offset, size};
+        vkCmdCopyBuffer(cmd, staging, state.raw.buffer, 1, &region);
+    });
+}
+
+void Buffer::download(void* data, std::size_t size, std::size_t offset) const
+{
+    detail::BufferState& state = getState();
+    checkRange(state, size, offset, "download");
+    if (size == 0)
+        return;
+    detail::DeviceState& device = *state.device;
+    if (!device.stagingUploads && state.raw.mapped != nullptr) {
+        detail::invalidateMapped(device, state.raw);
+        std::memcpy(data, static_cast<const std::byte*>(state.raw.mapped) + offset, size);
+        return;
+    }
+    detail::downloadThroughStaging(device, data, size, [&](VkCommandBuffer cmd, VkBuffer staging) {
+        VkBufferCopy region{offset, 0, size};
+        vkCmdCopyBuffer(cmd, state.raw.buffer, staging, 1, &region);
+    });
+}
+
+Buffer Context::createBuffer(const BufferDesc& desc)
+{
+    if (desc.size == 0)
+        throw Error("gpu buffer '" + desc.name + "' has size 0");
+    auto state = std::make_unique<detail::BufferState>();
+    state->device = mDevice;
+    state->name = desc.name.empty() ? std::string("buffer") : desc.name;
+    const auto kind = mDevice->stagingUploads ? detail::DeviceState::MemoryKind::DeviceLocal
+                                              : detail::DeviceState::MemoryKind::DeviceLocalMapped;
+    state->raw = mDevice->createRawBuffer(desc.size,
+                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                                          kind, state->name);
+    return Buffer(std::move(state));
+}
+
+} // namespace rtlab::gpu

@@ -1,0 +1,471 @@
+#include "extraction.h"
+
+#include "case_table.h"
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rtlab::isosurface::mc {
+namespace {
+
+constexpr std::size_t kNoNan = std::numeric_limits<std::size_t>::max();
+
+//! Read-only view of the field shared by both passes.
+class Grid {
+public:
+    Grid(const plugin::SampledField& field, double isoValue)
+        : mField(field), mIso(isoValue),
+          mSize(field.samples), mStride{1, std::size_t(field.samples.x),
+                                        std::size_t(field.samples.x) * field.samples.y}
+    {
+    }
+
+    int size(int axis) const { return mSize[axis]; }
+    std::size_t stride(int axis) const { return mStride[axis]; }
+    std::size_t index(int x, int y, int z) const { return mField.index(x, y, z); }
+    std::size_t layerSize() const { return mStride[2]; }
+    //! Value relative to the iso-value. Its sign is exact: a double difference is zero only when
+    //! the operands are equal, so f < iso exactly when relative(f) < 0.
+    double relative(std::size_t i) const { return double(mField.values[i]) - mIso; }
+    const plugin::SampledField& field() const { return mField; }
+
+private:
+    const plugin::SampledField& mField;
+    double mIso;
+    glm::ivec3 mSize;
+    std::size_t mStride[3];
+};
+
+//! Calls visit(x, y, axis) for every crossed grid edge starting in sample layer z, in the one
+//! order that both passes share: rows (y), then samples (x), then axes x, y, z. The edges of
+//! layer z are its x and y edges and the z edges from z to z + 1.
+template <class Visit>
+void visitCrossedEdges(const Grid& grid, const std::vector<std::uint8_t>& inside, int z,
+                       Visit&& visit)
+{
+    const int nx = grid.size(0);
+    const int ny = grid.size(1);
+    const bool hasUp = z + 1 < grid.size(2);
+    for (int y = 0; y < ny; ++y) {
+        const bool hasY = y + 1 < ny;
+        std::size_t i = grid.index(0, y, z);
+        for (int x = 0; x < nx; ++x, ++i) {
+            const std::uint8_t in = inside[i];
+            if (x + 1 < nx && in != inside[i + 1])
+                visit(x, y, 0);
+            if (hasY && in != inside[i + grid.stride(1)])
+                visit(x, y, 1);
+            if (hasUp && in != inside[i + grid.stride(2)])
+                visit(x, y, 2);
+        }
+    }
+}
+
+//! Vertex index of every crossed edge starting in one sample layer, per axis, indexed y * nx + x.
+//! Entries of edges that are not crossed are stale; the case table never asks for them.
+struct LayerVertices {
+    std::vector<std::uint32_t> edge[3];
+
+    explicit LayerVertices(std::size_t layerSize)
+    {
+        for (auto& e : edge)
+            e.resize(layerSize);
+    }
+};
+
+//! Field gradient at a sample, in field units per sample step: central differences inside the
+//! grid, one-sided on its boundary.
+glm::dvec3 computeGradient(const Grid& grid, int x, int y, int z)
+{
+    const int coord[3] = {x, y, z};
+    const std::size_t i = grid.index(x, y, z);
+    glm::dvec3 gradient(0.0);
+    for (int axis = 0; axis < 3; ++axis) {
+        const std::size_t step = grid.stride(axis);
+        const int c = coord[axis];
+        const int n = grid.size(axis);
+        if (c > 0 && c + 1 < n)
+            gradient[axis] = 0.5 * (grid.relative(i + step) - grid.relative(i - step));
+        else if (c == 0)
+            gradient[axis] = grid.relative(i + step) - grid.relative(i);
+        else
+            gradient[axis] = grid.relative(i) - grid.relative(i - step);
+    }
+    return gradient;
+}
+
+//! A vertex before it is stored: world position and unit normal, in double.
+struct Vertex {
+    glm::dvec3 position{0.0};
+    glm::dvec3 normal{0.0};
+};
+
+//! What one slab produces besides the edge vertices it writes in place.
+struct SlabOutput {
+    //! Three per triangle. Edge vertices carry their final index; interior vertices carry
+    //! kInteriorFlag | their index in `interior`, fixed up once every slab's count is known.
+    std::vector<std::uint32_t> triangles;
+    std::vector<Vertex> interior;
+};
+
+constexpr std::uint32_t kInteriorFlag = 0x80000000u;
+
+class Mesher {
+public:
+    Mesher(const Grid& grid, const ExtractionOptions& options,
+           const std::vector<std::uint8_t>& inside, const std::vector<std::uint64_t>& layerOffset,
+           TriangleMesh& mesh)
+        : mGrid(grid), mOptions(options), mInside(inside), mLayerOffset(layerOffset), mMesh(mesh),
+          mTable(CaseTable::getInstance())
+    {
+        for (int c = 0; c < kCornerCount; ++c)
+            mCornerOffset[c] =
+                grid.index(getCornerBit(c, 0), getCornerBit(c, 1), getCornerBit(c, 2));
+    }
+
+    //! Meshes cell layers [z0, z1): writes the edge vertices of the sample layers it owns and
+    //! appends its triangles, in cell scan order, to `out`.
+    void meshSlab(int z0, int z1, SlabOutput& out) const
+    {
+        const int lastLayer = mGrid.size(2) - 1;
+        LayerVertices lower(mGrid.layerSize());
+        LayerVertices upper(mGrid.layerSize());
+        // A slab owns the vertices of sample layers z0 .. z1 - 1 (and the top layer if it is the
+        // last slab). It numbers layer z1 too, for its top cells, but the next slab writes it.
+        numberLayer(z0, lower, true);
+        for (int z = z0; z < z1; ++z) {
+            numberLayer(z + 1, upper, z + 1 < z1 || z + 1 == lastLayer);
+            meshCellLayer(z, lower, upper, out);
+            std::swap(lower, upper);
+        }
+    }
+
+private:
+    void numberLayer(int z, LayerVertices& layer, bool writeVertices) const
+    {
+        std::uint64_t next = mLayerOffset[z];
+        const std::size_t nx = std::size_t(mGrid.size(0));
+        visitCrossedEdges(mGrid, mInside, z, [&](int x, int y, int axis) {
+            const auto index = static_cast<std::uint32_t>(next++);
+            layer.edge[axis][std::size_t(y) * nx + x] = index;
+            if (!writeVertices)
+                return;
+            const Vertex vertex = computeEdgeVertex(x, y, z, axis);
+            mMesh.positions[index] = glm::vec3(vertex.position);
+            if (mOptions.computeNormals)
+                mMesh.normals[index] = glm::vec3(vertex.normal);
+        });
+        assert(next == mLayerOffset[z + 1]);
+    }
+
+    //! The vertex on the crossed edge from sample (x, y, z) along `axis`. A pure function of the
+    //! samples, so a cell can recompute a vertex that another slab writes.
+    Vertex computeEdgeVertex(int x, int y, int z, int axis) const
+    {
+        const std::size_t a = mGrid.index(x, y, z);
+        const std::size_t b = a + mGrid.stride(axis);
+        const double valueA = mGrid.relative(a);
+        const double valueB = mGrid.relative(b);
+        const bool insideA = valueA < 0.0;
+
+        double s = 0.5; // parameter from sample a toward sample b
+        if (mOptions.placement == VertexPlacement::Linear) {
+            // [Lorensen & Cline 1987] the crossing of the linear interpolant along the edge.
+            // t runs from the inside end (< 0) to the outside end (>= 0); t = 1 exactly when the
+            // outside end is exactly on the iso-value, so the vertex lands on that sample.
+            const double in = insideA ? valueA : valueB;
+            const double out = insideA ? valueB : valueA;
+            double t;
+            if (std::isinf(in) && std::isinf(out))
+                t = 0.5;
+            else if (std::isinf(in))
+                t = 1.0; // the limit of in / (in - out) as in -> -inf
+            else if (std::isinf(out))
+                t = 0.0; // the limit as out -> +inf
+            else
+                t = std::clamp(in / (in - out), 0.0, 1.0);
+            s = insideA ? t : 1.0 - t;
+        }
+        // Grid coordinates are integers plus s, so a vertex at s = 0 or 1 is exactly the sample.
+        glm::dvec3 coord(x, y, z);
+        coord[axis] += s;
+        const plugin::SampledField& field = mGrid.field();
+        Vertex vertex;
+        vertex.position = field.origin + field.spacing * coord;
+        if (!mOptions.computeNormals)
+            return vertex;
+        const glm::dvec3 gradient =
+            (1.0 - s) * computeGradient(mGrid, x, y, z) +
+            s * computeGradient(mGrid, x + (axis == 0), y + (axis == 1), z + (axis == 2));
+        const double length = glm::length(gradient);
+        if (std::isfinite(length) && length > 0.0) {
+            vertex.normal = gradient / length;
+        } else {
+            // Flat or non-finite neighbourhood: the field increases from the inside end of the
+            // edge to the outside end, so that direction is outward.
+            vertex.normal[axis] = insideA ? 1.0 : -1.0;
+        }
+        return vertex;
+    }
+
+    //! The interior vertex of a loop in cell (x, y, z): the centroid of the loop's edge vertices,
+    //! with their mean normal (or, where that cancels, the normal of the loop's fan).
+    Vertex computeInteriorVertex(int x, int y, int z, const CellTriangulation& cell,
+                                 int extra) const
+    {
+        const auto& edges = getCellEdges();
+        Vertex loopVertices[kEdgeCount];
+        int count = 0;
+        Vertex vertex;
+        for (int e = 0; e < kEdgeCount; ++e) {
+            if (((cell.extraLoops[extra] >> e) & 1u) == 0)
+                continue;
+            const CellEdge& edge = edges[e];
+            loopVertices[e] =
+                computeEdgeVertex(x + getCornerBit(edge.start, 0), y + getCornerBit(edge.start, 1),
+                                  z + getCornerBit(edge.start, 2), edge.axis);
+            vertex.position += loopVertices[e].position;
+            vertex.normal += loopVertices[e].normal;
+            ++count;
+        }
+        vertex.position /= double(count);
+        if (!mOptions.computeNormals)
+            return vertex;
+        double length = glm::length(vertex.normal);
+        if (!(length > 1e-12)) {
+            vertex.normal = glm::dvec3(0.0);
+            for (int t = 0; t < cell.triangleCount; ++t) {
+                if (cell.vertices[3 * t] != kExtraVertex + extra)
+                    continue; // the fan's triangles start at the interior vertex
+                const glm::dvec3 b = loopVertices[cell.vertices[3 * t + 1]].position;
+                const glm::dvec3 c = loopVertices[cell.vertices[3 * t + 2]].position;
+                vertex.normal += glm::cross(b - vertex.position, c - vertex.position);
+            }
+            length = glm::length(vertex.normal);
+        }
+        if (length > 0.0 && std::isfinite(length)) {
+            vertex.normal /= length;
+        } else {
+            // Degenerate loop (all its vertices on one point): any loop vertex's normal is unit.
+            const int first = std::countr_zero(unsigned(cell.extraLoops[extra]));
+            vertex.normal = loopVertices[first].normal;
+        }
+        return vertex;
+    }
+
+    //! Compact decision bits for the ambiguous faces of a cell (see CaseTable::find).
+    unsigned decideFaces(unsigned cube, std::size_t base) const
+    {
+        const unsigned ambiguous = mTable.ambiguousFaces(cube);
+        if (ambiguous == 0 || mOptions.ambiguity == AmbiguityRule::SeparateInside)
+            return 0;
+        if (mOptions.ambiguity == AmbiguityRule::JoinInside)
+            return (1u << std::popcount(ambiguous)) - 1u;
+        unsigned decisions = 0;
+        int bit = 0;
+        for (int f = 0; f < kFaceCount; ++f) {
+            if (((ambiguous >> f) & 1u) == 0)
+                continue;
+            const auto& corners = getCellFaces()[f].corners;
+            double v[4];
+            for (int k = 0; k < 4; ++k)
+                v[k] = mGrid.relative(base + mCornerOffset[corners[k]]);
+            const bool firstInside = ((cube >> corners[0]) & 1u) != 0;
+            const double insideProduct = firstInside ? v[0] * v[2] : v[1] * v[3];
+            const double outsideProduct = firstInside ? v[1] * v[3] : v[0] * v[2];
+            // [Nielson & Hamann 1991] asymptotic decider: the bilinear interpolant on the face has
+            // its saddle value (ac - bd) / (a + c - b - d) (a, c diagonal). With a, c the inside
+            // pair the denominator is negative, so the saddle is inside, and the inside corners
+            // connected through it, exactly when ac > bd. A saddle exactly on the iso-value is
+            // outside, as samples on it are. Both cells sharing the face compute the same two
+            // products from the same four values, so they always agree: the mesh stays closed.
+            if (insideProduct > outsideProduct)
+                decisions |= 1u << bit;
+            ++bit;
+        }
+        return decisions;
+    }
+
+    void meshCellLayer(int z, const LayerVertices& lower, const LayerVertices& upper,
+                       SlabOutput& out) const
+    {
+        const int nx = mGrid.size(0);
+        const int ny = mGrid.size(1);
+        const auto& edges = getCellEdges();
+        for (int y = 0; y + 1 < ny; ++y) {
+            std::size_t base = mGrid.index(0, y, z);
+            for (int x = 0; x + 1 < nx; ++x, ++base) {
+                // [Lorensen & Cline 1987] the case index from the signs of the eight corners.
+                unsigned cube = 0;
+                for (int c = 0; c < kCornerCount; ++c)
+                    cube |= unsigned(mInside[base + mCornerOffset[c]]) << c;
+                if (cube == 0 || cube == 255)
+                    continue;
+                const CellTriangulation& cell = mTable.find(cube, decideFaces(cube, base));
+                std::uint32_t interior[kMaxCellExtras];
+                for (int j = 0; j < cell.extraCount; ++j) {
+                    interior[j] = kInteriorFlag | std::uint32_t(out.interior.size());
+                    out.interior.push_back(computeInteriorVertex(x, y, z, cell, j));
+                }
+                for (int k = 0; k < 3 * cell.triangleCount; ++k) {
+                    const int id = cell.vertices[k];
+                    if (id >= kExtraVertex) {
+                        out.triangles.push_back(interior[id - kExtraVertex]);
+                        continue;
+                    }
+                    const CellEdge& edge = edges[id];
+                    const LayerVertices& layer = getCornerBit(edge.start, 2) ? upper : lower;
+                    const std::size_t column = std::size_t(y + getCornerBit(edge.start, 1)) * nx +
+                                               std::size_t(x + getCornerBit(edge.start, 0));
+                    out.triangles.push_back(layer.edge[edge.axis][column]);
+                }
+            }
+        }
+    }
+
+    const Grid& mGrid;
+    const ExtractionOptions& mOptions;
+    const std::vector<std::uint8_t>& mInside;
+    const std::vector<std::uint64_t>& mLayerOffset;
+    TriangleMesh& mMesh;
+    const CaseTable& mTable;
+    std::size_t mCornerOffset[kCornerCount];
+};
+
+void validateField(const plugin::SampledField& field)
+{
+    if (!(std::isfinite(field.spacing) && field.spacing > 0.0))
+        throw std::invalid_argument(
+            "marching_cubes: the field spacing must be finite and > 0, got " +
+            std::to_string(field.spacing));
+    if (!(std::isfinite(field.origin.x) && std::isfinite(field.origin.y) &&
+          std::isfinite(field.origin.z)))
+        throw std::invalid_argument("marching_cubes: the field origin must be finite");
+    const std::size_t expected =
+        std::size_t(field.samples.x) * std::size_t(field.samples.y) * std::size_t(field.samples.z);
+    if (field.values.size() != expected)
+        throw std::invalid_argument(
+            "marching_cubes: the field has " + std::to_string(field.values.size()) +
+            " values for " + std::to_string(field.samples.x) + " x " +
+            std::to_string(field.samples.y) + " x " + std::to_string(field.samples.z) + " samples");
+}
+
+} // namespace
+
+void extractIsosurface(const plugin::SampledField& field, double isoValue,
+                       const ExtractionOptions& options, TriangleMesh& out)
+{
+    if (!std::isfinite(isoValue))
+        throw std::invalid_argument("marching_cubes: the iso-value must be finite, got " +
+                                    std::to_string(isoValue));
+    if (field.samples.x < 2 || field.samples.y < 2 || field.samples.z < 2) {
+        out.clear(); // no cell, no surface
+        return;
+    }
+    validateField(field);
+
+    const Grid grid(field, isoValue);
+    const int nz = grid.size(2);
+    const int grain = std::max(options.grain, 1);
+
+    // Pass 1, per sample layer: inside flags, NaN check, and the number of crossed edges whose
+    // vertex the layer owns. The prefix sum over layers numbers the vertices in scan order, so
+    // the numbering does not depend on how the work is split.
+    std::vector<std::uint8_t> inside(field.values.size());
+    std::vector<std::uint64_t> layerOffset(std::size_t(nz) + 1, 0);
+    std::vector<std::size_t> firstNan(std::size_t(nz), kNoNan);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
+        for (int z = range.begin(); z != range.end(); ++z) {
+            const std::size_t begin = std::size_t(z) * grid.layerSize();
+            for (std::size_t i = begin; i != begin + grid.layerSize(); ++i) {
+                const double value = grid.relative(i);
+                if (std::isnan(value) && firstNan[z] == kNoNan)
+                    firstNan[z] = i;
+                inside[i] = value < 0.0 ? 1 : 0;
+            }
+        }
+    });
+    for (const std::size_t i : firstNan) {
+        if (i == kNoNan)
+            continue;
+        const std::size_t nx = std::size_t(grid.size(0));
+        const std::size_t ny = std::size_t(grid.size(1));
+        throw std::invalid_argument("marching_cubes: NaN sample at (" + std::to_string(i % nx) +
+                                    ", " + std::to_string(i / nx % ny) + ", " +
+                                    std::to_string(i / (nx * ny)) +
+                                    "); the field must be NaN-free");
+    }
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
+        for (int z = range.begin(); z != range.end(); ++z) {
+            std::uint64_t count = 0;
+            visitCrossedEdges(grid, inside, z, [&](int, int, int) { ++count; });
+            layerOffset[std::size_t(z) + 1] = count;
+        }
+    });
+    for (int z = 0; z < nz; ++z)
+        layerOffset[std::size_t(z) + 1] += layerOffset[z];
+    const std::uint64_t edgeVertexCount = layerOffset.back();
+    if (edgeVertexCount >= kInteriorFlag)
+        throw std::length_error("marching_cubes: " + std::to_string(edgeVertexCount) +
+                                " edge vertices do not fit 31-bit indices");
+
+    // Pass 2, per slab of `grain` cell layers: edge vertices of the owned layers, written in
+    // place, and the slab's triangles and interior vertices, concatenated afterwards in slab
+    // order, i.e. in cell scan order whatever the grain or thread count.
+    TriangleMesh mesh;
+    mesh.positions.resize(edgeVertexCount);
+    if (options.computeNormals)
+        mesh.normals.resize(edgeVertexCount);
+    const int cellLayers = nz - 1;
+    const int slabCount = (cellLayers + grain - 1) / grain;
+    std::vector<SlabOutput> slabs(static_cast<std::size_t>(slabCount));
+    const Mesher mesher(grid, options, inside, layerOffset, mesh);
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, slabCount, 1),
+        [&](const tbb::blocked_range<int>& range) {
+            for (int s = range.begin(); s != range.end(); ++s) {
+                const int z0 = s * grain;
+                mesher.meshSlab(z0, std::min(z0 + grain, cellLayers), slabs[s]);
+            }
+        },
+        tbb::simple_partitioner());
+
+    // Interior vertices follow the edge vertices, in slab order.
+    std::uint64_t vertexCount = edgeVertexCount;
+    std::size_t indexCount = 0;
+    for (const SlabOutput& slab : slabs) {
+        vertexCount += slab.interior.size();
+        indexCount += slab.triangles.size();
+    }
+    if (vertexCount > std::numeric_limits<std::uint32_t>::max())
+        throw std::length_error("marching_cubes: " + std::to_string(vertexCount) +
+                                " vertices do not fit 32-bit indices");
+    mesh.indices.reserve(indexCount);
+    for (const SlabOutput& slab : slabs) {
+        const auto firstInterior = static_cast<std::uint32_t>(mesh.positions.size());
+        for (const std::uint32_t index : slab.triangles)
+            mesh.indices.push_back(
+                (index & kInteriorFlag) != 0 ? firstInterior + (index & ~kInteriorFlag) : index);
+        for (const Vertex& vertex : slab.interior) {
+            mesh.positions.push_back(glm::vec3(vertex.position));
+            if (options.computeNormals)
+                mesh.normals.push_back(glm::vec3(vertex.normal));
+        }
+    }
+    out = std::move(mesh);
+}
+
+} // namespace rtlab::isosurface::mc

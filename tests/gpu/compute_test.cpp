@@ -1,0 +1,322 @@
+// Compute shaders on the device with results checked on the CPU: saxpy (mapped and staged
+// buffers), push and specialisation constants, defines, transfer commands, chained dispatches,
+// and the errors that recording reports.
+
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "core/error.h"
+#include "gpu/context.h"
+#include "gpu_test_support.h"
+
+namespace rtlab::gpu::test {
+namespace {
+
+struct SaxpyParams {
+    float a;
+    std::uint32_t count;
+};
+
+// Deterministic inputs in [-10, 10) that are not small integers, so products round.
+float makeInput(std::uint32_t i, std::uint32_t salt)
+{
+    std::uint32_t v = i * 2654435761u + salt * 40503u;
+    v ^= v >> 13;
+    return static_cast<float>(v % 200000u) / 10000.0f - 10.0f;
+}
+
+// a * x rounded to float, then + y rounded to float: what `precise` requires of the shader.
+// Vulkan requires correctly rounded 32-bit OpFMul and OpFAdd, so the results match exactly.
+float referenceSaxpy(float a, float x, float y)
+{
+    const float product = a * x;
+    return product + y;
+}
+
+class ComputeTest : public GpuTest {
+protected:
+    ComputePipeline createSaxpy()
+    {
+        return createTestPipeline(
+            "saxpy.comp", {{0, BindingType::StorageBuffer}, {1, BindingType::StorageBuffer}},
+            sizeof(SaxpyParams));
+    }
+
+    void runSaxpyAndCheck()
+    {
+        constexpr std::uint32_t kCount = 100003; // not a multiple of the group size 64
+        constexpr float kA = 1.7f;
+        std::vector<float> x(kCount), y(kCount), expected(kCount);
+        for (std::uint32_t i = 0; i < kCount; ++i) {
+            x[i] = makeInput(i, 1);
+            y[i] = makeInput(i, 2);
+            expected[i] = referenceSaxpy(kA, x[i], y[i]);
+        }
+        const ComputePipeline saxpy = createSaxpy();
+        Buffer xBuffer = getContext().createBuffer({kCount * sizeof(float), "x"});
+        // One float of padding that the shader must not touch.
+        Buffer yBuffer = getContext().createBuffer({(kCount + 1) * sizeof(float), "y"});
+        xBuffer.uploadSpan<float>(x);
+        yBuffer.uploadSpan<float>(y);
+        const float sentinel = 12345.5f;
+        yBuffer.upload(&sentinel, sizeof sentinel, kCount * sizeof(float));
+
+        const SaxpyParams params{kA, kCount};
+        const RunResult run = getContext().run([&](CommandList& cmd) {
+            cmd.dispatch(saxpy,
+                         {Binding::storageBuffer(0, xBuffer), Binding::storageBuffer(1, yBuffer)},
+                         PushConstants(params), GroupCount{computeGroupCount(kCount, 64)});
+        });
+        ASSERT_EQ(run.commands.size(), 1u);
+        EXPECT_EQ(run.commands[0].label, "saxpy.comp");
+
+        const std::vector<float> result = yBuffer.downloadVector<float>(kCount);
+        std::uint32_t mismatches = 0;
+        for (std::uint32_t i = 0; i < kCount; ++i) {
+            if (result[i] != expected[i] && ++mismatches <= 5)
+                ADD_FAILURE() << "y[" << i << "] = " << result[i] << ", expected " << expected[i];
+        }
+        EXPECT_EQ(mismatches, 0u);
+        float tail = 0.0f;
+        yBuffer.download(&tail, sizeof tail, kCount * sizeof(float));
+        EXPECT_EQ(tail, sentinel);
+        // x is read-only in the shader and must be unchanged.
+        EXPECT_EQ(xBuffer.downloadVector<float>(), x);
+    }
+};
+
+class StagedComputeTest : public ComputeTest {
+protected:
+    ContextOptions makeContextOptions() const override
+    {
+        ContextOptions options = ComputeTest::makeContextOptions();
+        options.forceStagingUploads = true;
+        return options;
+    }
+};
+
+TEST_F(ComputeTest, SaxpyMatchesTheCpuExactly)
+{
+    if (getContext().getDeviceInfo().isCpu) {
+        EXPECT_FALSE(getContext().usesStagingUploads()); // unified memory: mapped buffers
+    }
+    runSaxpyAndCheck();
+}
+
+TEST_F(StagedComputeTest, SaxpyMatchesTheCpuExactlyThroughStagingBuffers)
+{
+    EXPECT_TRUE(getContext().usesStagingUploads());
+    runSaxpyAndCheck();
+}
+
+TEST_F(ComputeTest, ChainedDispatchesSeeEachOthersWrites)
+{
+    constexpr std::uint32_t kCount = 4096;
+    std::vector<float> x(kCount), y(kCount), expected(kCount);
+    const float a1 = 0.3f, a2 = -2.25f;
+    for (std::uint32_t i = 0; i < kCount; ++i) {
+        x[i] = makeInput(i, 3);
+        y[i] = makeInput(i, 4);
+        expected[i] = referenceSaxpy(a2, x[i], referenceSaxpy(a1, x[i], y[i]));
+    }
+    const ComputePipeline saxpy = createSaxpy();
+    Buffer xBuffer = getContext().createBuffer({kCount * sizeof(float), "x"});
+    Buffer yBuffer = getContext().createBuffer({kCount * sizeof(float), "y"});
+    Buffer copy = getContext().createBuffer({kCount * sizeof(float), "copy"});
+    xBuffer.uploadSpan<float>(x);
+    yBuffer.uploadSpan<float>(y);
+    const std::vector<Binding> bindings = {Binding::storageBuffer(0, xBuffer),
+                                           Binding::storageBuffer(1, yBuffer)};
+    const RunResult run = getContext().run([&](CommandList& cmd) {
+        cmd.dispatch(saxpy, bindings, PushConstants(SaxpyParams{a1, kCount}),
+                     GroupCount{kCount / 64}, "first");
+        cmd.dispatch(saxpy, bindings, PushConstants(SaxpyParams{a2, kCount}),
+                     GroupCount{kCount / 64}, "second");
+        cmd.copyBuffer(yBuffer, copy, "copy");
+    });
+    ASSERT_EQ(run.commands.size(), 3u);
+    EXPECT_EQ(run.commands[0].label, "first");
+    EXPECT_EQ(run.commands[1].label, "second");
+    EXPECT_EQ(run.commands[2].label, "copy");
+    EXPECT_EQ(yBuffer.downloadVector<float>(), expected);
+    EXPECT_EQ(copy.downloadVector<float>(), expected);
+}
+
+TEST_F(ComputeTest, PushAndSpecialisationConstantsTakeEffect)
+{
+    struct Params {
+        std::uint32_t base;
+        std::uint32_t count;
+        float scale;
+    };
+    struct Variant {
+        std::uint32_t groupSize;
+        std::uint32_t multiplier;
+        float offset;
+        bool negate;
+        Params params;
+    };
+    // Small integers times 0.5 or 0.25 plus a quarter: every value is exact in float.
+    const Variant variants[] = {
+        {32, 3, 0.25f, false, {10, 1000, 0.5f}},
+        {128, 5, -0.75f, true, {7, 777, 0.25f}},
+    };
+    for (const Variant& v : variants) {
+        SCOPED_TRACE("group size " + std::to_string(v.groupSize));
+        const ComputePipeline pipeline = createTestPipeline(
+            "spec_push.comp", {{0, BindingType::StorageBuffer}, {1, BindingType::StorageBuffer}},
+            sizeof(Params),
+            {SpecConstant::makeUint(0, v.groupSize), SpecConstant::makeUint(1, v.multiplier),
+             SpecConstant::makeFloat(2, v.offset), SpecConstant::makeBool(3, v.negate)});
+        Buffer values = getContext().createBuffer({1024 * sizeof(float), "values"});
+        Buffer info = getContext().createBuffer({2 * sizeof(std::uint32_t), "info"});
+        const std::uint32_t groups = computeGroupCount(v.params.count, v.groupSize);
+        getContext().run([&](CommandList& cmd) {
+            cmd.fillBuffer(values, 0u);
+            cmd.dispatch(pipeline,
+                         {Binding::storageBuffer(0, values), Binding::storageBuffer(1, info)},
+                         PushConstants(v.params), GroupCount{groups});
+        });
+        const std::vector<std::uint32_t> reported = info.downloadVector<std::uint32_t>();
+        EXPECT_EQ(reported[0], v.groupSize);
+        EXPECT_EQ(reported[1], groups);
+        const std::vector<float> got = values.downloadVector<float>();
+        for (std::uint32_t i = 0; i < 1024; ++i) {
+            float expected = 0.0f; // from fillBuffer, beyond count
+            if (i < v.params.count) {
+                expected = static_cast<float>((v.params.base + i) * v.multiplier) * v.params.scale +
+                           v.offset;
+                if (v.negate)
+                    expected = -expected;
+            }
+            ASSERT_EQ(got[i], expected) << "at " << i;
+        }
+    }
+}
+
+TEST_F(ComputeTest, DefinesReachTheShader)
+{
+    Buffer out = getContext().createBuffer({2 * sizeof(std::uint32_t), "out"});
+    const auto runWith = [&](const std::vector<ShaderDefine>& defines) {
+        const CompiledShader shader = compileTestShader("define_value.comp", defines);
+        ComputePipelineDesc desc;
+        desc.name = "define_value";
+        desc.spirv = shader.spirv;
+        desc.bindings = {{0, BindingType::StorageBuffer}};
+        const ComputePipeline pipeline = getContext().createPipeline(desc);
+        getContext().run([&](CommandList& cmd) {
+            cmd.dispatch(pipeline, {Binding::storageBuffer(0, out)}, GroupCount{});
+        });
+        return std::make_pair(shader.cacheHit, out.downloadVector<std::uint32_t>());
+    };
+    const auto [hit3, three] = runWith({{"VALUE", "3u"}});
+    EXPECT_FALSE(hit3);
+    EXPECT_EQ(three, (std::vector<std::uint32_t>{3, 0}));
+    const auto [hit7, seven] = runWith({{"VALUE", "7u"}, {"FLAG", ""}});
+    EXPECT_FALSE(hit7);
+    EXPECT_EQ(seven, (std::vector<std::uint32_t>{7, 1}));
+    const auto [hitAgain, again] = runWith({{"VALUE", "3u"}});
+    EXPECT_TRUE(hitAgain);
+    EXPECT_EQ(again, (std::vector<std::uint32_t>{3, 0}));
+}
+
+TEST_F(ComputeTest, FillAndCopyBuffers)
+{
+    Buffer a = getContext().createBuffer({1000 * sizeof(std::uint32_t), "a"});
+    Buffer b = getContext().createBuffer({600 * sizeof(std::uint32_t), "b"});
+    b.uploadSpan<std::uint32_t>(std::vector<std::uint32_t>(600, 1u));
+    getContext().run([&](CommandList& cmd) {
+        cmd.fillBuffer(a, 0xdeadbeefu);
+        cmd.copyBuffer(a, b); // copies min(size) = 600 words
+    });
+    EXPECT_EQ(a.downloadVector<std::uint32_t>(), std::vector<std::uint32_t>(1000, 0xdeadbeefu));
+    EXPECT_EQ(b.downloadVector<std::uint32_t>(), std::vector<std::uint32_t>(600, 0xdeadbeefu));
+}
+
+TEST_F(ComputeTest, PartialUploadsAndDownloadsRespectOffsets)
+{
+    Buffer buffer = getContext().createBuffer({64, "partial"});
+    std::vector<std::uint8_t> bytes(64);
+    for (int i = 0; i < 64; ++i)
+        bytes[i] = static_cast<std::uint8_t>(i);
+    buffer.uploadSpan<std::uint8_t>(bytes);
+    const std::uint8_t patch[3] = {200, 201, 202};
+    buffer.upload(patch, 3, 61);
+    bytes[61] = 200;
+    bytes[62] = 201;
+    bytes[63] = 202;
+    EXPECT_EQ(buffer.downloadVector<std::uint8_t>(), bytes);
+    EXPECT_EQ(buffer.downloadVector<std::uint8_t>(4, 60),
+              (std::vector<std::uint8_t>{60, 200, 201, 202}));
+    EXPECT_THROW(buffer.upload(patch, 3, 62), Error);
+    std::uint8_t sink[8];
+    EXPECT_THROW(buffer.download(sink, 8, 60), Error);
+    EXPECT_THROW(getContext().createBuffer({0, "empty"}), Error);
+}
+
+TEST_F(ComputeTest, RecordingRejectsMismatchedBindingsAndPushConstants)
+{
+    const ComputePipeline saxpy = createSaxpy();
+    Buffer x = getContext().createBuffer({256, "x"});
+    Buffer y = getContext().createBuffer({256, "y"});
+    Image image = getContext().createImage({ImageDimension::Image2D, Format::R32Float, 4, 4});
+    const SaxpyParams params{1.0f, 64};
+    auto expectError = [&](const std::function<void(CommandList&)>& record, const char* text) {
+        try {
+            getContext().run(record);
+            ADD_FAILURE() << "expected rtlab::Error containing '" << text << "'";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+        }
+    };
+    expectError(
+        [&](CommandList& cmd) {
+            cmd.dispatch(saxpy, {Binding::storageBuffer(0, x)}, PushConstants(params),
+                         GroupCount{1});
+        },
+        "binding 1 (storage buffer) is not bound");
+    expectError(
+        [&](CommandList& cmd) {
+            cmd.dispatch(saxpy, {Binding::storageBuffer(0, x), Binding::storageImage(1, image)},
+                         PushConstants(params), GroupCount{1});
+        },
+        "binding 1 expects a storage buffer, got a storage image");
+    expectError(
+        [&](CommandList& cmd) {
+            cmd.dispatch(saxpy,
+                         {Binding::storageBuffer(0, x), Binding::storageBuffer(1, y),
+                          Binding::storageBuffer(2, y)},
+                         PushConstants(params), GroupCount{1});
+        },
+        "binding 2 is not part of the pipeline layout");
+    expectError(
+        [&](CommandList& cmd) {
+            cmd.dispatch(saxpy, {Binding::storageBuffer(0, x), Binding::storageBuffer(1, y)},
+                         GroupCount{1});
+        },
+        "0 bytes of push constants given, the pipeline declares 8");
+    // After failed recordings the context still works.
+    const RunResult ok = getContext().run([&](CommandList& cmd) {
+        cmd.dispatch(saxpy, {Binding::storageBuffer(0, x), Binding::storageBuffer(1, y)},
+                     PushConstants(params), GroupCount{1});
+    });
+    EXPECT_EQ(ok.commands.size(), 1u);
+}
+
+TEST_F(ComputeTest, PipelineDescriptionsAreChecked)
+{
+    ComputePipelineDesc desc;
+    desc.name = "bad";
+    desc.spirv = {1, 2, 3};
+    EXPECT_THROW(getContext().createPipeline(desc), Error);
+    desc.spirv = compileTestShader("saxpy.comp").spirv;
+    desc.bindings = {{0, BindingType::StorageBuffer}, {0, BindingType::StorageBuffer}};
+    EXPECT_THROW(getContext().createPipeline(desc), Error);
+    desc.bindings = {{0, BindingType::StorageBuffer}, {1, BindingType::StorageBuffer}};
+    desc.pushConstantSize = 6;
+    EXPECT_THROW(getContext().createPipeline(desc), Error);
+}
+
+} // namespace
+} // namespace rtlab::gpu::test
