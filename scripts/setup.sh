@@ -26,6 +26,9 @@ fi
 # ccache keeps rebuilds on 2 cores short; keep its cache in the project's own folder when the
 # user has not chosen one, so that a fresh machine needs nothing outside the checkout.
 export CCACHE_DIR=${CCACHE_DIR:-$PWD/.cache/ccache}
+# Paths under the checkout are hashed relative to it, so copies of the tree (the scaffold test)
+# share the cache.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
 if [ ! -f build/build.ninja ]; then
     cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 fi

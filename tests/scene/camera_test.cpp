@@ -1,0 +1,78 @@
+// Cameras: projection conventions, jitter, and paths through keyframes.
+
+#include "scene/camera.h"
+
+#include <glm/geometric.hpp>
+#include <gtest/gtest.h>
+
+using namespace rtlab::scene;
+
+namespace {
+glm::vec3 project(const Camera& c, const glm::vec3& p, float aspect, glm::vec2 jitter = {},
+                  glm::ivec2 size = glm::ivec2(1))
+{
+    const glm::vec4 clip = c.projectionMatrix(aspect, jitter, size) * c.viewMatrix() * glm::vec4(p, 1.0f);
+    return glm::vec3(clip) / clip.w;
+}
+} // namespace
+
+TEST(Camera, VulkanClipConventions)
+{
+    Camera c;
+    c.position = {0, 0, 5};
+    c.target = {0, 0, 0};
+    c.nearPlane = 1.0f;
+    c.farPlane = 10.0f;
+    // Depth 0 at the near plane, 1 at the far plane.
+    EXPECT_NEAR(project(c, {0, 0, 4}, 1.0f).z, 0.0f, 1e-6f);
+    EXPECT_NEAR(project(c, {0, 0, -5}, 1.0f).z, 1.0f, 1e-6f);
+    // World up (+y) is NDC y < 0 (Vulkan's y points down), so row 0 is the top of the image.
+    EXPECT_LT(project(c, {0, 1, 0}, 1.0f).y, 0.0f);
+    EXPECT_GT(project(c, {1, 0, 0}, 1.0f).x, 0.0f);
+}
+
+TEST(Camera, JitterShiftsByTheRequestedPixels)
+{
+    Camera c;
+    const glm::ivec2 size(64, 32);
+    const glm::vec3 a = project(c, {0.3f, 0.2f, 0}, 2.0f, {}, size);
+    const glm::vec3 b = project(c, {0.3f, 0.2f, 0}, 2.0f, {0.5f, -0.25f}, size);
+    // NDC spans 2 over `size` pixels: half a pixel is 1/64 in x; -0.25 px is -0.5/32 in y.
+    EXPECT_NEAR(b.x - a.x, 2.0f * 0.5f / 64.0f, 1e-6f);
+    EXPECT_NEAR(b.y - a.y, 2.0f * -0.25f / 32.0f, 1e-6f);
+}
+
+TEST(CameraPath, PassesThroughKeyframesAndHoldsAtTheEnds)
+{
+    std::vector<CameraKeyframe> keys(4);
+    for (int i = 0; i < 4; ++i) {
+        keys[i].time = float(i);
+        keys[i].camera.position = {float(i), float(i * i), 3.0f};
+    }
+    const CameraPath path(keys);
+    EXPECT_TRUE(path.moves());
+    EXPECT_FLOAT_EQ(path.duration(), 3.0f);
+    for (int i = 0; i < 4; ++i) {
+        const glm::vec3 p = path.evaluate(float(i)).position;
+        EXPECT_NEAR(glm::length(p - keys[i].camera.position), 0.0f, 1e-5f) << i;
+    }
+    EXPECT_EQ(path.evaluate(-1.0f).position, keys.front().camera.position);
+    EXPECT_EQ(path.evaluate(9.0f).position, keys.back().camera.position);
+    // Between keys the path moves monotonically in x here.
+    float previous = -1.0f;
+    for (float t = 0.0f; t <= 3.0f; t += 0.125f) {
+        const float x = path.evaluate(t).position.x;
+        EXPECT_GT(x, previous) << t;
+        previous = x;
+    }
+}
+
+TEST(CameraPath, UnsortedKeysAndStillCamera)
+{
+    std::vector<CameraKeyframe> keys(2);
+    keys[0].time = 2.0f;
+    keys[1].time = 0.0f;
+    const CameraPath path(keys);
+    EXPECT_FLOAT_EQ(path.keyframes().front().time, 0.0f);
+    EXPECT_FALSE(path.moves());
+}
