@@ -110,30 +110,51 @@ WeightedMean computeWeightedMean(int width, int height, MaskView mask,
     return result;
 }
 
-Plane filterSeparable(const Plane& in, const std::vector<float>& kx, const std::vector<float>& ky)
+Plane filterRows(const Plane& in, const std::vector<float>& k)
 {
-    const int w = in.width, h = in.height;
-    const int rx = int(kx.size() - 1) / 2, ry = int(ky.size() - 1) / 2;
-    Plane tmp(w, h), out(w, h);
+    const int w = in.width, h = in.height, r = int(k.size() - 1) / 2;
+    Plane out(w, h);
     forEachRowBlock(h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) {
-                float sum = 0;
-                for (int i = -rx; i <= rx; ++i)
-                    sum += kx[std::size_t(i + rx)] * in.at(std::clamp(x + i, 0, w - 1), y);
-                tmp.at(x, y) = sum;
+        // Each row is padded with copies of its end pixels, then the taps are accumulated as
+        // whole-row multiply-adds (contiguous, so the compiler vectorises them).
+        std::vector<float> padded(std::size_t(w + 2 * r));
+        for (int y = y0; y < y1; ++y) {
+            const float* src = &in.values[std::size_t(y) * w];
+            for (int x = -r; x < w + r; ++x)
+                padded[std::size_t(x + r)] = src[std::clamp(x, 0, w - 1)];
+            float* dst = &out.values[std::size_t(y) * w];
+            for (int i = 0; i <= 2 * r; ++i) {
+                const float ki = k[std::size_t(i)];
+                const float* p = &padded[std::size_t(i)];
+                for (int x = 0; x < w; ++x)
+                    dst[x] += ki * p[x];
             }
-    });
-    forEachRowBlock(h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) {
-                float sum = 0;
-                for (int j = -ry; j <= ry; ++j)
-                    sum += ky[std::size_t(j + ry)] * tmp.at(x, std::clamp(y + j, 0, h - 1));
-                out.at(x, y) = sum;
-            }
+        }
     });
     return out;
+}
+
+Plane filterColumns(const Plane& in, const std::vector<float>& k)
+{
+    const int w = in.width, h = in.height, r = int(k.size() - 1) / 2;
+    Plane out(w, h);
+    forEachRowBlock(h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            float* dst = &out.values[std::size_t(y) * w];
+            for (int j = -r; j <= r; ++j) {
+                const float kj = k[std::size_t(j + r)];
+                const float* src = &in.values[std::size_t(std::clamp(y + j, 0, h - 1)) * w];
+                for (int x = 0; x < w; ++x)
+                    dst[x] += kj * src[x];
+            }
+        }
+    });
+    return out;
+}
+
+Plane filterSeparable(const Plane& in, const std::vector<float>& kx, const std::vector<float>& ky)
+{
+    return filterColumns(filterRows(in, kx), ky);
 }
 
 } // namespace detail
@@ -178,10 +199,22 @@ std::size_t countMaskPixels(MaskView mask, int width, int height)
 namespace {
 
 // Channel access shared by scalar and RGB images: per-pixel errors average the channels.
-inline int channelCount(float) { return 1; }
-inline int channelCount(const glm::vec3&) { return 3; }
-inline double channelOf(float v, int) { return v; }
-inline double channelOf(const glm::vec3& v, int c) { return v[c]; }
+inline int countChannels(float)
+{
+    return 1;
+}
+inline int countChannels(const glm::vec3&)
+{
+    return 3;
+}
+inline double getChannel(float v, int)
+{
+    return v;
+}
+inline double getChannel(const glm::vec3& v, int c)
+{
+    return v[c];
+}
 
 template <class T, class PerChannel>
 detail::WeightedMean averageOverPixels(const Image<T>& test, const Image<T>& reference,
@@ -193,36 +226,37 @@ detail::WeightedMean averageOverPixels(const Image<T>& test, const Image<T>& ref
     return detail::computeWeightedMean(test.width, test.height, mask, [&](std::size_t i) {
         const T& t = test.pixels[i];
         const T& r = reference.pixels[i];
-        const int channels = channelCount(t);
+        const int channels = countChannels(t);
         double sum = 0;
         for (int c = 0; c < channels; ++c)
-            sum += perChannel(channelOf(t, c), channelOf(r, c));
+            sum += perChannel(getChannel(t, c), getChannel(r, c));
         return sum / channels;
     });
 }
 
 template <class T>
-double mseOf(const Image<T>& test, const Image<T>& reference, MaskView mask, const char* what)
+double computeMseImpl(const Image<T>& test, const Image<T>& reference, MaskView mask,
+                      const char* what)
 {
-    return averageOverPixels(test, reference, mask, what, [](double t, double r) {
-               return (t - r) * (t - r);
-           }).mean;
+    return averageOverPixels(test, reference, mask, what,
+                             [](double t, double r) { return (t - r) * (t - r); })
+        .mean;
 }
 
 template <class T>
-double relMseOf(const Image<T>& test, const Image<T>& reference, MaskView mask, double epsilon)
+double computeRelMseImpl(const Image<T>& test, const Image<T>& reference, MaskView mask,
+                         double epsilon)
 {
     if (!(epsilon > 0))
         throw std::invalid_argument("computeRelativeMse: epsilon must be > 0, got " +
                                     std::to_string(epsilon));
-    return averageOverPixels(test, reference, mask, "computeRelativeMse",
-                             [epsilon](double t, double r) {
-                                 return (t - r) * (t - r) / (r * r + epsilon);
-                             })
+    return averageOverPixels(
+               test, reference, mask, "computeRelativeMse",
+               [epsilon](double t, double r) { return (t - r) * (t - r) / (r * r + epsilon); })
         .mean;
 }
 
-double psnrFromMse(double mse, double peak)
+double convertMseToPsnr(double mse, double peak)
 {
     if (!(peak > 0) || !std::isfinite(peak))
         throw std::invalid_argument("computePsnr: peak must be finite and > 0, got " +
@@ -235,7 +269,7 @@ double psnrFromMse(double mse, double peak)
 }
 
 template <class T>
-double meanSignedErrorOf(const Image<T>& test, const Image<T>& reference, MaskView mask)
+double computeMeanSignedErrorImpl(const Image<T>& test, const Image<T>& reference, MaskView mask)
 {
     return averageOverPixels(test, reference, mask, "computeMeanSignedError",
                              [](double t, double r) { return t - r; })
@@ -246,58 +280,58 @@ double meanSignedErrorOf(const Image<T>& test, const Image<T>& reference, MaskVi
 
 double computeMse(const Image<float>& test, const Image<float>& reference, MaskView mask)
 {
-    return mseOf(test, reference, mask, "computeMse");
+    return computeMseImpl(test, reference, mask, "computeMse");
 }
 
 double computeMse(const Image<glm::vec3>& test, const Image<glm::vec3>& reference, MaskView mask)
 {
-    return mseOf(test, reference, mask, "computeMse");
+    return computeMseImpl(test, reference, mask, "computeMse");
 }
 
 double computeRmse(const Image<float>& test, const Image<float>& reference, MaskView mask)
 {
-    return std::sqrt(mseOf(test, reference, mask, "computeRmse"));
+    return std::sqrt(computeMseImpl(test, reference, mask, "computeRmse"));
 }
 
 double computeRmse(const Image<glm::vec3>& test, const Image<glm::vec3>& reference, MaskView mask)
 {
-    return std::sqrt(mseOf(test, reference, mask, "computeRmse"));
+    return std::sqrt(computeMseImpl(test, reference, mask, "computeRmse"));
 }
 
 double computeRelativeMse(const Image<float>& test, const Image<float>& reference, MaskView mask,
                           double epsilon)
 {
-    return relMseOf(test, reference, mask, epsilon);
+    return computeRelMseImpl(test, reference, mask, epsilon);
 }
 
 double computeRelativeMse(const Image<glm::vec3>& test, const Image<glm::vec3>& reference,
                           MaskView mask, double epsilon)
 {
-    return relMseOf(test, reference, mask, epsilon);
+    return computeRelMseImpl(test, reference, mask, epsilon);
 }
 
 double computePsnr(const Image<float>& test, const Image<float>& reference, double peak,
                    MaskView mask)
 {
-    return psnrFromMse(mseOf(test, reference, mask, "computePsnr"), peak);
+    return convertMseToPsnr(computeMseImpl(test, reference, mask, "computePsnr"), peak);
 }
 
 double computePsnr(const Image<glm::vec3>& test, const Image<glm::vec3>& reference, double peak,
                    MaskView mask)
 {
-    return psnrFromMse(mseOf(test, reference, mask, "computePsnr"), peak);
+    return convertMseToPsnr(computeMseImpl(test, reference, mask, "computePsnr"), peak);
 }
 
 double computeMeanSignedError(const Image<float>& test, const Image<float>& reference,
                               MaskView mask)
 {
-    return meanSignedErrorOf(test, reference, mask);
+    return computeMeanSignedErrorImpl(test, reference, mask);
 }
 
 double computeMeanSignedError(const Image<glm::vec3>& test, const Image<glm::vec3>& reference,
                               MaskView mask)
 {
-    return meanSignedErrorOf(test, reference, mask);
+    return computeMeanSignedErrorImpl(test, reference, mask);
 }
 
 // ------------------------------------------------------------------------------------------------
@@ -307,32 +341,36 @@ namespace {
 
 // The worst value a valid image could hold at a pixel whose reference value is r: whichever of
 // 0 and peak is farther from r.
-inline float worstValue(float r, double peak)
+inline float pickWorstValue(float r, double peak)
 {
     return double(r) >= 0.5 * peak ? 0.0f : float(peak);
 }
 
-inline glm::vec3 toVec3(float v) { return glm::vec3(v); }
-inline glm::vec3 toVec3(const glm::vec3& v) { return v; }
+inline glm::vec3 convertToVec3(float v)
+{
+    return glm::vec3(v);
+}
+inline glm::vec3 convertToVec3(const glm::vec3& v)
+{
+    return v;
+}
 
-template <class T>
-Image<glm::vec3> toRgb(const Image<T>& image)
+template <class T> Image<glm::vec3> convertToRgb(const Image<T>& image)
 {
     Image<glm::vec3> rgb(image.width, image.height);
     for (std::size_t i = 0; i < image.pixels.size(); ++i)
-        rgb.pixels[i] = toVec3(image.pixels[i]);
+        rgb.pixels[i] = convertToVec3(image.pixels[i]);
     return rgb;
 }
 
-template <class T>
-double defaultPeak(const Image<T>& reference, DynamicRange range)
+template <class T> double findDefaultPeak(const Image<T>& reference, DynamicRange range)
 {
     if (range == DynamicRange::Ldr)
         return 1.0;
     double peak = 0;
     for (const T& p : reference.pixels)
-        for (int c = 0; c < channelCount(p); ++c)
-            peak = std::max(peak, channelOf(p, c));
+        for (int c = 0; c < countChannels(p); ++c)
+            peak = std::max(peak, getChannel(p, c));
     return peak > 0 ? peak : 1.0;
 }
 
@@ -346,7 +384,7 @@ ImageErrors computeImageErrorsImpl(const Image<T>& testIn, const Image<T>& refer
     detail::requireFiniteReference(reference, what);
 
     ImageErrors e;
-    e.peak = options.peak ? *options.peak : defaultPeak(reference, options.range);
+    e.peak = options.peak ? *options.peak : findDefaultPeak(reference, options.range);
     if (!(e.peak > 0) || !std::isfinite(e.peak))
         throw std::invalid_argument("computeImageErrors: peak must be finite and > 0, got " +
                                     std::to_string(e.peak));
@@ -362,22 +400,21 @@ ImageErrors computeImageErrorsImpl(const Image<T>& testIn, const Image<T>& refer
         if (mask.weight(i) > 0)
             ++e.nonFinitePixels;
         if constexpr (std::is_same_v<T, float>) {
-            p = worstValue(reference.pixels[i], e.peak);
+            p = pickWorstValue(reference.pixels[i], e.peak);
         } else {
             for (int c = 0; c < 3; ++c)
                 if (!std::isfinite(p[c]))
-                    p[c] = worstValue(reference.pixels[i][c], e.peak);
+                    p[c] = pickWorstValue(reference.pixels[i][c], e.peak);
         }
     }
 
-    const auto mse = averageOverPixels(test, reference, mask, what, [](double t, double r) {
-        return (t - r) * (t - r);
-    });
+    const auto mse = averageOverPixels(test, reference, mask, what,
+                                       [](double t, double r) { return (t - r) * (t - r); });
     e.pixels = mse.pixels;
     e.rmse = std::sqrt(mse.mean);
-    e.psnr = psnrFromMse(mse.mean, e.peak);
-    e.relMse = relMseOf(test, reference, mask, options.relMseEpsilon);
-    e.meanSignedError = meanSignedErrorOf(test, reference, mask);
+    e.psnr = convertMseToPsnr(mse.mean, e.peak);
+    e.relMse = computeRelMseImpl(test, reference, mask, options.relMseEpsilon);
+    e.meanSignedError = computeMeanSignedErrorImpl(test, reference, mask);
 
     const double nan = std::numeric_limits<double>::quiet_NaN();
     e.ssim = nan;
@@ -392,20 +429,19 @@ ImageErrors computeImageErrorsImpl(const Image<T>& testIn, const Image<T>& refer
     if (options.withFlip) {
         FlipResult flip;
         if (options.range == DynamicRange::Ldr) {
-            flip = computeFlip(toRgb(test), toRgb(reference), options.encoding, options.flip,
-                               mask);
+            flip = computeFlip(convertToRgb(test), convertToRgb(reference), options.encoding,
+                               options.flip, mask);
         } else {
-            flip = computeHdrFlip(toRgb(test), toRgb(reference), options.flip, mask);
+            flip = computeHdrFlip(convertToRgb(test), convertToRgb(reference), options.flip, mask);
         }
         if (nonFinite.empty()) {
             e.flip = flip.mean;
         } else {
             for (std::size_t i : nonFinite)
                 flip.map.pixels[i] = 1.0f;
-            e.flip = detail::computeWeightedMean(flip.map.width, flip.map.height, mask,
-                                                 [&](std::size_t i) {
-                                                     return double(flip.map.pixels[i]);
-                                                 })
+            e.flip = detail::computeWeightedMean(
+                         flip.map.width, flip.map.height, mask,
+                         [&](std::size_t i) { return double(flip.map.pixels[i]); })
                          .mean;
         }
     }

@@ -15,10 +15,11 @@
 //    see unmasked neighbours); the mask only selects which map values are averaged.
 //  - An empty selection (no pixel with a positive weight, or an empty image) gives NaN for every
 //    metric and `pixels == 0`; it never throws.
-//  - Non-finite values (NaN, +-inf) in `test` propagate into the individual metric functions
-//    (their result becomes NaN or inf). computeImageErrors instead counts them and replaces them
-//    by the worst valid value (see ImageErrors::nonFinitePixels). Non-finite values in
-//    `reference` are an error (std::invalid_argument) everywhere.
+//  - Non-finite values (NaN, +-inf) in `test` are not screened by the individual metric
+//    functions: they propagate into the result (NaN or inf), except that FLIP clamps its inputs
+//    (so +-inf becomes 1 or 0 there; NaN still propagates). computeImageErrors instead counts them
+//    and replaces them by the worst valid value (see ImageErrors::nonFinitePixels). Non-finite
+//    values in `reference` are an error (std::invalid_argument) everywhere.
 
 #include "core/image.h"
 
@@ -42,11 +43,12 @@ namespace rtlab::metrics {
 class MaskView {
 public:
     MaskView() = default;
-    MaskView(const Image<std::uint8_t>& mask) : mBinary(&mask) {}  // NOLINT: implicit on purpose
-    MaskView(const Image<float>& weights) : mWeights(&weights) {}  // NOLINT: implicit on purpose
+    MaskView(const Image<std::uint8_t>& mask) : mBinary(&mask) {} // NOLINT: implicit on purpose
+    MaskView(const Image<float>& weights) : mWeights(&weights) {} // NOLINT: implicit on purpose
 
     //! True when no mask was given.
     bool isAll() const { return mBinary == nullptr && mWeights == nullptr; }
+    //! Size of the viewed image in pixels (0 x 0 when isAll()).
     int width() const;
     int height() const;
     //! Weight of pixel `index` (row-major), >= 0; 1 when isAll().
@@ -92,7 +94,7 @@ Image<std::uint8_t> makeObjectMask(const Image<std::uint32_t>& objectIds,
 //! distance k of a set pixel is set. Use it to grow a given thin-object mask. k >= 0.
 Image<std::uint8_t> dilateMask(const Image<std::uint8_t>& mask, int k);
 
-//! Number of pixels with a positive weight.
+//! Number of pixels of a width x height image with a positive weight.
 std::size_t countMaskPixels(MaskView mask, int width, int height);
 
 // ------------------------------------------------------------------------------------------------
@@ -134,23 +136,23 @@ double computeMeanSignedError(const Image<glm::vec3>& test, const Image<glm::vec
 
 //! Which signal SSIM compares for RGB images.
 enum class SsimChannels {
-    Luminance,   //!< Y = 0.2126 R + 0.7152 G + 0.0722 B of the stored values (luma if encoded)
-    PerChannel,  //!< SSIM map of R, G and B separately, then averaged
+    Luminance,  //!< Y = 0.2126 R + 0.7152 G + 0.0722 B of the stored values (luma if encoded)
+    PerChannel, //!< SSIM map of R, G and B separately, then averaged
 };
 
 struct SsimOptions {
-    double dynamicRange = 1.0;  //!< L, the range of the pixel values (1 for LDR), > 0
-    double k1 = 0.01;           //!< C1 = (k1 L)^2
-    double k2 = 0.03;           //!< C2 = (k2 L)^2
-    double sigma = 1.5;         //!< Gaussian window standard deviation, pixels
-    int radius = 5;             //!< window half size: 11 x 11 for 5, pixels
-    SsimChannels channels = SsimChannels::Luminance;  //!< RGB inputs only
+    double dynamicRange = 1.0; //!< L, the range of the pixel values (1 for LDR), > 0
+    double k1 = 0.01;          //!< C1 = (k1 L)^2
+    double k2 = 0.03;          //!< C2 = (k2 L)^2
+    double sigma = 1.5;        //!< Gaussian window standard deviation, pixels
+    int radius = 5;            //!< window half size: 11 x 11 for 5, pixels
+    SsimChannels channels = SsimChannels::Luminance; //!< RGB inputs only
 };
 
 struct SsimResult {
-    double mean = 0;       //!< mean SSIM over the selected pixels, [-1, 1]; 1 for identical images
-    Image<float> map;      //!< per-pixel SSIM, [-1, 1], the size of the inputs
-    std::size_t pixels = 0;  //!< pixels with a positive mask weight
+    double mean = 0;        //!< mean SSIM over the selected pixels, [-1, 1]; 1 for identical images
+    Image<float> map;       //!< per-pixel SSIM, [-1, 1], the size of the inputs
+    std::size_t pixels = 0; //!< pixels with a positive mask weight
 };
 
 //! SSIM with the Gaussian window of Wang et al. (sigma 1.5, 11 x 11, K1 0.01, K2 0.03). The map
@@ -169,15 +171,15 @@ SsimResult computeSsim(const Image<glm::vec3>& test, const Image<glm::vec3>& ref
 
 //! How LDR values are encoded.
 enum class ColorEncoding {
-    Srgb,    //!< sRGB transfer function (what an 8-bit PNG holds), [0, 1]
-    Linear,  //!< linear RGB with sRGB/Rec.709 primaries, [0, 1]
+    Srgb,   //!< sRGB transfer function (what an 8-bit PNG holds), [0, 1]
+    Linear, //!< linear RGB with sRGB/Rec.709 primaries, [0, 1]
 };
 
-//! HDR-FLIP's tone mappers (HDR-FLIP, Sec. 3): applied per channel after exposure 2^c.
+//! HDR-FLIP's tone mappers, applied after the exposure 2^c; results are clamped to [0, 1].
 enum class ToneMapper {
-    Aces,      //!< Narkowicz's fit of the ACES filmic curve, with its 0.6 pre-scale (the default)
-    Hable,     //!< Hable's filmic curve, white point 11.2, exposure bias 2
-    Reinhard,  //!< x / (1 + Y(x)), Y the luminance of the exposed colour
+    Aces,     //!< per channel: Narkowicz's ACES fit with its 0.6 pre-scale (the default)
+    Hable,    //!< per channel: Hable's filmic curve, white point 11.2, exposure bias 2
+    Reinhard, //!< x / (1 + Y(x)), Y the luminance of the exposed colour
 };
 
 //! Pixels per degree of visual angle of an observer at `distanceMeters` from a monitor
@@ -185,40 +187,44 @@ enum class ToneMapper {
 double computePixelsPerDegree(double distanceMeters, double widthMeters, double widthPixels);
 
 //! FLIP's default viewing conditions: 0.7 m from a 0.7 m wide 3840-pixel monitor, ~67.02 ppd.
-inline constexpr double kDefaultPixelsPerDegree = 0.7 * (3840.0 / 0.7) * 3.14159265358979323846
-                                                  / 180.0;
+inline constexpr double kDefaultPixelsPerDegree =
+    0.7 * (3840.0 / 0.7) * 3.14159265358979323846 / 180.0;
 
 struct FlipOptions {
-    double pixelsPerDegree = kDefaultPixelsPerDegree;  //!< observer, > 0
-    // HDR-FLIP only:
+    //! Observer's pixels per degree of visual angle, > 0 (see computePixelsPerDegree).
+    double pixelsPerDegree = kDefaultPixelsPerDegree;
+    //! HDR-FLIP only: the tone mapper assumed for display.
     ToneMapper toneMapper = ToneMapper::Aces;
-    //! Exposure range in stops (log2 of the exposure factor). Unset: from the reference's
-    //! luminance (HDR-FLIP, Sec. 3): start = log2(T^-1(0.85) / Ymax), stop = log2(T^-1(0.85) /
-    //! Ymedian), T the tone mapper, Y = 0.2126 R + 0.7152 G + 0.0722 B.
+    //! HDR-FLIP only: first exposure in stops (log2 of the factor applied before tone mapping).
+    //! Unset: from the reference's luminance Y = 0.2126 R + 0.7152 G + 0.0722 B, as in HDR-FLIP:
+    //! start = log2(T^-1(0.85) / max Y), T the tone mapper.
     std::optional<double> startExposure;
+    //! HDR-FLIP only: last exposure in stops. Unset: stop = log2(T^-1(0.85) / median Y). When
+    //! more than half of the reference is black the median of the pixels with Y > 0 is used
+    //! (the plain median would give an infinite stop exposure). An all-black reference gives
+    //! start = stop = 0.
     std::optional<double> stopExposure;
-    //! Unset: max(2, ceil(stop - start)) exposures, or 1 when start == stop. >= 1.
+    //! HDR-FLIP only: exposures from start to stop, evenly spaced, >= 1. Unset: max(2,
+    //! ceil(stop - start)), or 1 when start == stop.
     std::optional<int> exposureCount;
 };
 
 struct FlipResult {
-    double mean = 0;         //!< mean FLIP over the selected pixels, [0, 1]; 0 for identical
-    Image<float> map;        //!< per-pixel FLIP error, [0, 1], the size of the inputs
-    std::size_t pixels = 0;  //!< pixels with a positive mask weight
+    double mean = 0;        //!< mean FLIP over the selected pixels, [0, 1]; 0 for identical
+    Image<float> map;       //!< per-pixel FLIP error, [0, 1], the size of the inputs
+    std::size_t pixels = 0; //!< pixels with a positive mask weight
     // HDR-FLIP only (0 for LDR-FLIP):
-    double startExposure = 0;  //!< stops, the exposure range actually used
-    double stopExposure = 0;   //!< stops
-    int exposureCount = 0;     //!< LDR-FLIP evaluations whose per-pixel maximum is the map
+    double startExposure = 0; //!< stops, the exposure range actually used
+    double stopExposure = 0;  //!< stops
+    int exposureCount = 0;    //!< LDR-FLIP evaluations whose per-pixel maximum is the map
 };
 
 //! LDR-FLIP. Values outside [0, 1] are clamped (LDR-FLIP is defined on [0, 1]). Scalar images are
 //! treated as grey (R = G = B).
 FlipResult computeFlip(const Image<glm::vec3>& test, const Image<glm::vec3>& reference,
-                       ColorEncoding encoding, const FlipOptions& options = {},
-                       MaskView mask = {});
+                       ColorEncoding encoding, const FlipOptions& options = {}, MaskView mask = {});
 FlipResult computeFlip(const Image<float>& test, const Image<float>& reference,
-                       ColorEncoding encoding, const FlipOptions& options = {},
-                       MaskView mask = {});
+                       ColorEncoding encoding, const FlipOptions& options = {}, MaskView mask = {});
 
 //! HDR-FLIP of linear radiance images: for each exposure c in the range, both images are scaled
 //! by 2^c, tone mapped and clamped to [0, 1], LDR-FLIP is evaluated, and the map is the per-pixel
@@ -233,32 +239,32 @@ glm::vec3 applyToneMapper(ToneMapper toneMapper, const glm::vec3& exposed);
 // Everything at once
 
 enum class DynamicRange {
-    Ldr,  //!< values in [0, 1], encoded per ImageErrorOptions::encoding; LDR-FLIP
-    Hdr,  //!< linear radiance >= 0; HDR-FLIP
+    Ldr, //!< values in [0, 1], encoded per ImageErrorOptions::encoding; LDR-FLIP
+    Hdr, //!< linear radiance >= 0; HDR-FLIP
 };
 
 struct ImageErrorOptions {
-    DynamicRange range = DynamicRange::Ldr;
-    ColorEncoding encoding = ColorEncoding::Srgb;  //!< LDR only; read by FLIP alone
+    DynamicRange range = DynamicRange::Ldr;       //!< LDR (LDR-FLIP) or HDR (HDR-FLIP) inputs
+    ColorEncoding encoding = ColorEncoding::Srgb; //!< LDR only; read by FLIP alone
     //! Full-scale value: PSNR's peak, SSIM's L and the bound used for non-finite pixels. Unset: 1
     //! for LDR, the reference's largest channel value for HDR (1 if that is <= 0).
     std::optional<double> peak;
-    double relMseEpsilon = kRelMseEpsilon;  //!< > 0
-    SsimChannels ssimChannels = SsimChannels::Luminance;
-    FlipOptions flip;
-    bool withSsim = true;  //!< false: ssim is NaN (saves time)
-    bool withFlip = true;  //!< false: flip is NaN (HDR-FLIP runs several LDR-FLIPs)
+    double relMseEpsilon = kRelMseEpsilon;               //!< > 0
+    SsimChannels ssimChannels = SsimChannels::Luminance; //!< RGB inputs only
+    FlipOptions flip;     //!< observer and, for HDR, tone mapper and exposures
+    bool withSsim = true; //!< false: ssim is NaN (saves time)
+    bool withFlip = true; //!< false: flip is NaN (HDR-FLIP runs several LDR-FLIPs)
 };
 
 struct ImageErrors {
-    double rmse = 0;             //!< pixel units, >= 0
-    double relMse = 0;           //!< dimensionless, >= 0
-    double psnr = 0;             //!< dB; +infinity when the images are identical
-    double ssim = 0;             //!< [-1, 1], 1 = identical
-    double flip = 0;             //!< [0, 1], 0 = identical (LDR- or HDR-FLIP per `range`)
-    double meanSignedError = 0;  //!< pixel units; > 0 when the test image is too bright
-    double peak = 0;             //!< the peak that was used (pixel units)
-    std::size_t pixels = 0;      //!< pixels with a positive mask weight (all when no mask)
+    double rmse = 0;            //!< pixel units, >= 0
+    double relMse = 0;          //!< dimensionless, >= 0
+    double psnr = 0;            //!< dB; +infinity when the images are identical
+    double ssim = 0;            //!< [-1, 1], 1 = identical
+    double flip = 0;            //!< [0, 1], 0 = identical (LDR- or HDR-FLIP per `range`)
+    double meanSignedError = 0; //!< pixel units; > 0 when the test image is too bright
+    double peak = 0;            //!< the peak that was used (pixel units)
+    std::size_t pixels = 0;     //!< pixels with a positive mask weight (all when no mask)
     //! Selected pixels of `test` with a NaN or infinite channel. Policy (applied to every pixel of
     //! the image, selected or not): each such channel is replaced by whichever of 0 and `peak` is
     //! farther from the reference value (the worst value a valid image could hold) before any

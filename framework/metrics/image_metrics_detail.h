@@ -11,8 +11,7 @@
 namespace rtlab::metrics::detail {
 
 //! Throws std::invalid_argument "<what>: test image is WxH but the reference is WxH".
-void requireSameSize(int testWidth, int testHeight, int refWidth, int refHeight,
-                     const char* what);
+void requireSameSize(int testWidth, int testHeight, int refWidth, int refHeight, const char* what);
 //! Throws std::invalid_argument when the mask's size differs or a weight is negative/non-finite.
 void requireValidMask(MaskView mask, int width, int height, const char* what);
 //! Throws std::invalid_argument when the reference holds a NaN or infinite value.
@@ -23,8 +22,8 @@ void requireFiniteReference(const Image<glm::vec3>& reference, const char* what)
 void forEachRowBlock(int height, const std::function<void(int y0, int y1)>& body);
 
 struct WeightedMean {
-    double mean = 0;         //!< NaN when no pixel has a positive weight
-    std::size_t pixels = 0;  //!< pixels with a positive weight
+    double mean = 0;        //!< NaN when no pixel has a positive weight
+    std::size_t pixels = 0; //!< pixels with a positive weight
 };
 
 //! Weighted mean of value(i) over the pixels i of a width x height image. Rows are summed in
@@ -33,7 +32,10 @@ struct WeightedMean {
 WeightedMean computeWeightedMean(int width, int height, MaskView mask,
                                  const std::function<double(std::size_t)>& value);
 
-inline bool isFinite(float v) { return std::isfinite(v); }
+inline bool isFinite(float v)
+{
+    return std::isfinite(v);
+}
 inline bool isFinite(const glm::vec3& v)
 {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
@@ -51,8 +53,12 @@ struct Plane {
     float at(int x, int y) const { return values[std::size_t(y) * width + x]; }
 };
 
-//! Separable correlation with clamp-to-edge borders: out(x, y) = sum_i sum_j kx[i] ky[j]
-//! in(clamp(x + i - rx), clamp(y + j - ry)), with rx = (kx.size() - 1) / 2 (odd sizes).
+//! Correlation along rows with clamp-to-edge borders: out(x, y) = sum_i k[i] in(clamp(x + i - r),
+//! y), r = (k.size() - 1) / 2 (odd sizes).
+Plane filterRows(const Plane& in, const std::vector<float>& k);
+//! The same along columns.
+Plane filterColumns(const Plane& in, const std::vector<float>& k);
+//! Separable correlation: filterColumns(filterRows(in, kx), ky).
 Plane filterSeparable(const Plane& in, const std::vector<float>& kx, const std::vector<float>& ky);
 
 } // namespace rtlab::metrics::detail
