@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/json.h"
 #include "core/strings.h"
+#include "experiment/analysis.h"
 #include "experiment/experiment.h"
 #include "experiment/runner.h"
 #include "plugin/technique.h"
@@ -134,8 +135,17 @@ int runExperimentCommand(const RunOptions& options)
     }
     experiment::RunnerOptions runnerOptions;
     runnerOptions.outputDirectory = options.outputDirectory;
+    if (!options.shard.empty()) {
+        try {
+            experiment::parseShard(options.shard, runnerOptions);
+        } catch (const InputError& error) {
+            fmt::print(stderr, "{}\n", error.what());
+            return kExitBadInput;
+        }
+    }
     const auto summary = experiment::runExperiment(e, registry, runnerOptions);
-    fmt::print("{}: {} run(s): {} computed, {} already done, {} failed\n", e.name, summary.total,
+    fmt::print("{}: {} run(s){}: {} computed, {} already done, {} failed\n", e.name, summary.total,
+               options.shard.empty() ? "" : " in shard " + options.shard,
                summary.succeeded, summary.alreadyDone, summary.failed);
     fmt::print("results: {}/results.csv (and results.jsonl, manifest.json)\n", summary.outputDirectory);
     if (summary.failed > 0) {
@@ -217,6 +227,72 @@ int newTechnique(const NewTechniqueOptions& options)
     fmt::print("next: rebuild (cmake --build build) and it appears in `rtlab list --family {}`;\n"
                "      its unit test runs as ctest -R {}_{}\n",
                options.family, options.family, options.name);
+    return kExitOk;
+}
+
+// -------------------------------------------------------------------------------- merge, best
+
+int mergeCommand(const MergeOptions& options)
+{
+    try {
+        const std::size_t rows = experiment::mergeShards(options.shardDirectories, options.outputDirectory);
+        fmt::print("merged {} shard(s): {} row(s) in {}/results.csv\n", options.shardDirectories.size(), rows,
+                   options.outputDirectory);
+        return kExitOk;
+    } catch (const Error& e) {
+        fmt::print(stderr, "rtlab merge: {}\n", e.what());
+        return kExitBadInput;
+    }
+}
+
+int bestCommand(const BestOptions& options)
+{
+    experiment::BestQuery query;
+    query.costColumn = options.timeColumn;
+    query.errorColumn = options.errorColumn;
+    if (!options.maxTime.empty()) {
+        try {
+            query.maxCost = experiment::parseDurationMs(options.maxTime);
+        } catch (const std::invalid_argument& e) {
+            fmt::print(stderr, "rtlab best: --max-time: {}\n", e.what());
+            return kExitBadInput;
+        }
+    } else {
+        query.maxError = options.maxError;
+    }
+    const auto rows = experiment::loadResults(options.resultsDirectory);
+    if (rows.empty()) {
+        fmt::print(stderr, "rtlab best: {}/results.jsonl has no rows\n", options.resultsDirectory);
+        return kExitBadInput;
+    }
+    for (const auto* column : {&query.costColumn, &query.errorColumn}) {
+        bool found = false;
+        std::vector<std::string> columns;
+        for (const auto& [k, v] : rows.front()) {
+            columns.push_back(k);
+            found = found || k == *column;
+        }
+        if (!found) {
+            const auto close = closestNames(*column, columns);
+            fmt::print(stderr, "rtlab best: no column '{}' in the results{}\n", *column,
+                       close.empty() ? "" : "; did you mean " + joinList(close, "or") + "?");
+            return kExitBadInput;
+        }
+    }
+    const long best = experiment::findBest(rows, query);
+    if (best < 0) {
+        fmt::print("no run satisfies {}\n", query.maxCost >= 0.0 ? options.timeColumn + " <= " + options.maxTime
+                                                                  : options.errorColumn + " <= " +
+                                                                        config::formatValue(options.maxError));
+        return kExitFailed;
+    }
+    const auto& row = rows[std::size_t(best)];
+    fmt::print("{}\n", row.at("run_id"));
+    fmt::print("  {:<22} {}\n", options.timeColumn, row.at(options.timeColumn));
+    fmt::print("  {:<22} {}\n", options.errorColumn, row.at(options.errorColumn));
+    for (const auto& [k, v] : row)
+        if (k == "scene" || k == "technique" || k == "grid" || k.rfind("param.", 0) == 0)
+            fmt::print("  {:<22} {}\n", k, v);
     return kExitOk;
 }
 

@@ -4,6 +4,7 @@
 // 3 the environment lacks something (no Vulkan device, ...).
 
 #include <string>
+#include <vector>
 
 namespace rtlab::cli {
 
@@ -22,6 +23,7 @@ struct RunOptions {
     std::string experimentPath;
     std::string outputDirectory;
     bool dryRun = false;
+    std::string shard;  //!< "i/N" or empty
 };
 int runExperimentCommand(const RunOptions& options);
 
@@ -37,6 +39,21 @@ struct GpuOptions {
     bool validation = false;
 };
 int gpuSmoke(const GpuOptions& options);
+
+struct MergeOptions {
+    std::string outputDirectory;
+    std::vector<std::string> shardDirectories;
+};
+int mergeCommand(const MergeOptions& options);
+
+struct BestOptions {
+    std::string resultsDirectory;
+    std::string maxTime;   //!< e.g. "5ms"
+    double maxError = -1.0;
+    std::string timeColumn = "extract.cpu_ms";
+    std::string errorColumn = "rms_deviation";
+};
+int bestCommand(const BestOptions& options);
 
 //! The repository root rtlab was built from ($RTLAB_SOURCE_DIR overrides).
 std::string defaultSourceDirectory();

@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+
 int main(int argc, char** argv)
 {
     using namespace rtlab::cli;
@@ -22,6 +24,28 @@ int main(int argc, char** argv)
     runCmd->add_option("-o,--output", run.outputDirectory,
                        "Output folder (default: results/<experiment name>)");
     runCmd->add_flag("--dry-run", run.dryRun, "Validate and print the expanded runs; run nothing");
+    runCmd->add_option("--shard", run.shard,
+                       "Run slice i of N of the sweep (runs k with k mod N = i-1), e.g. 2/4; "
+                       "default output results/<name>/shard-i-of-N");
+
+    MergeOptions merge;
+    auto* mergeCmd = app.add_subcommand("merge", "Join the results of shard folders into one folder");
+    mergeCmd->add_option("-o,--output", merge.outputDirectory, "Folder for the joined results")->required();
+    mergeCmd->add_option("shards", merge.shardDirectories, "Shard result folders")->required()->check(
+        CLI::ExistingDirectory);
+
+    BestOptions best;
+    auto* bestCmd = app.add_subcommand(
+        "best", "The lowest-error run within a time budget, or the fastest run within an error bound");
+    bestCmd->add_option("results", best.resultsDirectory, "A results folder (with results.jsonl)")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    auto* maxTime = bestCmd->add_option("--max-time", best.maxTime, "Time budget, e.g. 5ms, 0.5s, 250us");
+    auto* maxError = bestCmd->add_option("--max-error", best.maxError, "Error bound (in the error column's unit)");
+    maxTime->excludes(maxError);
+    bestCmd->add_option("--time-column", best.timeColumn, "Column holding the time in ms")
+        ->capture_default_str();
+    bestCmd->add_option("--error-column", best.errorColumn, "Column holding the error")->capture_default_str();
 
     NewTechniqueOptions scaffold;
     auto* newCmd = app.add_subcommand("new-technique",
@@ -51,5 +75,14 @@ int main(int argc, char** argv)
         return newTechnique(scaffold);
     if (*gpuCmd)
         return gpuSmoke(gpu);
+    if (*mergeCmd)
+        return mergeCommand(merge);
+    if (*bestCmd) {
+        if (best.maxTime.empty() && best.maxError < 0.0) {
+            std::fprintf(stderr, "rtlab best: give --max-time or --max-error\n");
+            return kExitBadInput;
+        }
+        return bestCommand(best);
+    }
     return kExitBadInput;
 }

@@ -71,7 +71,10 @@ void Progress::draw(const std::string& detail, bool final)
         return;
     }
     const double sinceLast = std::chrono::duration<double>(now - mLastPlain).count();
-    if (final || sinceLast >= mPlainInterval) {
+    // The final line is not repeated when the last advance already printed the finished state.
+    const bool due = final ? mLastPlainDone != mDone : sinceLast >= mPlainInterval;
+    if (due) {
+        mLastPlainDone = mDone;
         std::fprintf(mOut, "%s: %s\n", mLabel.c_str(),
                      formatBar(mDone, mTotal, elapsed, detail, 0).c_str());
         std::fflush(mOut);

@@ -42,6 +42,7 @@ private:
     std::chrono::steady_clock::time_point mStart;
     std::chrono::steady_clock::time_point mLastPlain;
     double mPlainInterval = 5.0;  //!< seconds between plain progress lines
+    std::size_t mLastPlainDone = 0;  //!< progress shown by the last plain line
 };
 
 } // namespace rtlab

@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace rtlab::experiment {
 
@@ -53,6 +54,63 @@ std::vector<std::size_t> findParetoFront(const std::vector<Row>& rows, const std
         }
     }
     return front;
+}
+
+} // namespace rtlab::experiment
+
+namespace rtlab::experiment {
+
+long findBest(const std::vector<Row>& rows, const BestQuery& query)
+{
+    long best = -1;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        const auto status = rows[i].find("status");
+        if (status == rows[i].end() || status->second != "ok")
+            continue;
+        const double cost = getNumber(rows[i], query.costColumn);
+        const double error = getNumber(rows[i], query.errorColumn);
+        if (!std::isfinite(cost) || !std::isfinite(error))
+            continue;
+        if (query.maxCost >= 0.0 && cost > query.maxCost)
+            continue;
+        if (query.maxError >= 0.0 && error > query.maxError)
+            continue;
+        if (best < 0) {
+            best = long(i);
+            continue;
+        }
+        const double bestCost = getNumber(rows[best], query.costColumn);
+        const double bestError = getNumber(rows[best], query.errorColumn);
+        const bool better = query.maxError >= 0.0
+                                ? (cost < bestCost || (cost == bestCost && error < bestError))
+                                : (error < bestError || (error == bestError && cost < bestCost));
+        if (better)
+            best = long(i);
+    }
+    return best;
+}
+
+double parseDurationMs(const std::string& text)
+{
+    std::string s;
+    for (char c : text)
+        if (c != ' ')
+            s += c;
+    double scale = 1.0;
+    for (const auto& [suffix, factor] : {std::pair<const char*, double>{"ms", 1.0}, {"us", 1e-3}, {"ns", 1e-6},
+                                         {"s", 1e3}}) {
+        const std::string suf = suffix;
+        if (s.size() > suf.size() && s.ends_with(suf)) {
+            s.resize(s.size() - suf.size());
+            scale = factor;
+            break;
+        }
+    }
+    double v = 0;
+    auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
+    if (s.empty() || ec != std::errc() || p != s.data() + s.size() || !(v >= 0.0) || !std::isfinite(v))
+        throw std::invalid_argument("expected a duration like 5ms, 0.5s or 250us, found '" + text + "'");
+    return v * scale;
 }
 
 } // namespace rtlab::experiment

@@ -24,3 +24,23 @@ std::vector<std::size_t> findParetoFront(const std::vector<Row>& rows, const std
                                          const std::string& errorColumn);
 
 } // namespace rtlab::experiment
+
+namespace rtlab::experiment {
+
+//! The answer to "which run is best under a constraint".
+struct BestQuery {
+    std::string costColumn = "extract.cpu_ms";  //!< minimised under --max-error
+    std::string errorColumn = "rms_deviation";  //!< minimised under --max-time
+    double maxCost = -1.0;   //!< >= 0: lowest error with cost <= maxCost
+    double maxError = -1.0;  //!< >= 0: lowest cost with error <= maxError
+};
+
+//! Index of the best ok row for the query, or -1 when no row satisfies the bound. Ties go to
+//! the other column (lower error among equal cost, and the reverse).
+long findBest(const std::vector<Row>& rows, const BestQuery& query);
+
+//! "5ms", "0.5 s", "250us", "2" (milliseconds when no unit) -> milliseconds; throws
+//! std::invalid_argument with the accepted forms otherwise.
+double parseDurationMs(const std::string& text);
+
+} // namespace rtlab::experiment

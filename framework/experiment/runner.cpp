@@ -3,6 +3,7 @@
 #include "core/error.h"
 #include "core/json.h"
 #include "core/progress.h"
+#include "experiment/manifest.h"
 #include "plugin/technique.h"
 
 #include <chrono>
@@ -10,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 #include <thread>
+
+#include "core/strings.h"
 
 namespace rtlab::experiment {
 
@@ -39,54 +42,37 @@ void addTimingColumns(ResultRow& row, const std::string& pass, const metrics::Ti
 
 namespace {
 
-std::string cpuModel()
-{
-    std::ifstream in("/proc/cpuinfo");
-    std::string line;
-    while (std::getline(in, line))
-        if (line.rfind("model name", 0) == 0) {
-            const auto colon = line.find(':');
-            return colon == std::string::npos ? line : line.substr(colon + 2);
-        }
-    return "unknown";
-}
-
-void writeManifest(const Experiment& experiment, const std::string& directory)
-{
-    std::vector<std::string> runs;
-    for (const auto& r : experiment.runs)
-        runs.push_back(JsonObject().add("id", r.id()).addRaw("config", r.toJson()).str());
-    const std::string json = JsonObject()
-                                 .add("experiment", experiment.name)
-                                 .add("file", experiment.path)
-                                 .add("description", experiment.description)
-                                 .add("cpu", cpuModel())
-                                 .add("hardware_threads", std::int64_t(std::thread::hardware_concurrency()))
-                                 .addRaw("runs", jsonArray(runs))
-                                 .str();
-    const std::string path = directory + "/manifest.json";
-    std::ofstream(path + ".tmp") << json << "\n";
-    std::filesystem::rename(path + ".tmp", path);
-}
-
 } // namespace
 
 RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry& registry,
                             const RunnerOptions& options)
 {
     RunnerSummary summary;
-    summary.outputDirectory =
-        options.outputDirectory.empty() ? "results/" + experiment.name : options.outputDirectory;
+    const bool sharded = options.shardCount > 1;
+    const std::string shard =
+        sharded ? std::to_string(options.shardIndex) + "/" + std::to_string(options.shardCount) : "";
+    summary.outputDirectory = !options.outputDirectory.empty() ? options.outputDirectory
+                              : sharded ? "results/" + experiment.name + "/shard-" +
+                                              std::to_string(options.shardIndex) + "-of-" +
+                                              std::to_string(options.shardCount)
+                                        : "results/" + experiment.name;
     ResultsStore store(summary.outputDirectory);
-    writeManifest(experiment, summary.outputDirectory);
+    writeManifest(experiment, collectBuildInfo(options.queryVulkanForManifest), summary.outputDirectory, shard);
     const auto done = store.completedHashes();
-    summary.total = experiment.runs.size();
+
+    std::vector<const RunConfig*> mine;
+    for (std::size_t k = 0; k < experiment.runs.size(); ++k)
+        if (int(k % std::size_t(options.shardCount)) == options.shardIndex - 1)
+            mine.push_back(&experiment.runs[k]);
+    summary.total = mine.size();
 
     std::unique_ptr<Progress> progress;
     if (!options.quiet)
-        progress = std::make_unique<Progress>("rtlab run " + experiment.name, experiment.runs.size());
+        progress = std::make_unique<Progress>("rtlab run " + experiment.name + (sharded ? " shard " + shard : ""),
+                                              mine.size());
 
-    for (const RunConfig& run : experiment.runs) {
+    for (const RunConfig* runPtr : mine) {
+        const RunConfig& run = *runPtr;
         const std::string hash = run.hash();
         if (done.count(hash)) {
             ++summary.alreadyDone;
@@ -96,6 +82,7 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
         }
         ResultRow row;
         row.set("experiment", experiment.name)
+            .set("shard", shard)
             .set("run_id", run.id())
             .set("config_hash", hash)
             .set("status", std::string("ok"))
@@ -125,6 +112,88 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
         progress->finish();
     store.writeCsv();
     return summary;
+}
+
+} // namespace rtlab::experiment
+
+namespace rtlab::experiment {
+
+void parseShard(const std::string& text, RunnerOptions& options)
+{
+    const auto slash = text.find('/');
+    int i = 0, n = 0;
+    bool ok = slash != std::string::npos;
+    if (ok) {
+        try {
+            std::size_t used = 0;
+            i = std::stoi(text.substr(0, slash), &used);
+            ok = used == slash;
+            n = std::stoi(text.substr(slash + 1), &used);
+            ok = ok && used == text.size() - slash - 1;
+        } catch (const std::exception&) {
+            ok = false;
+        }
+    }
+    if (!ok || n < 1 || i < 1 || i > n)
+        throw InputError({"--shard", 0, 0}, "expected i/N with 1 <= i <= N (e.g. 2/4), found '" + text + "'");
+    options.shardIndex = i;
+    options.shardCount = n;
+}
+
+std::size_t mergeShards(const std::vector<std::string>& shardDirectories, const std::string& outputDirectory)
+{
+    namespace fs = std::filesystem;
+    ResultsStore out(outputDirectory);
+    if (fs::exists(out.jsonlPath()))
+        fs::remove(out.jsonlPath());
+    // Rows keyed by config hash; an ok row replaces a failed one, never the other way round.
+    std::vector<std::string> order;
+    std::map<std::string, std::pair<bool, std::string>> rows;
+    std::vector<std::string> shardNames;
+    for (const auto& dir : shardDirectories) {
+        const fs::path jsonl = fs::path(dir) / "results.jsonl";
+        if (!fs::exists(jsonl))
+            throw Error(dir + ": not a results folder (no results.jsonl)");
+        std::ifstream in(jsonl);
+        for (std::string line; std::getline(in, line);) {
+            if (line.empty() || line.front() != '{' || line.back() != '}')
+                continue;  // a torn line from an interrupted shard
+            const auto hashAt = line.find("\"config_hash\":\"");
+            if (hashAt == std::string::npos)
+                continue;
+            const auto start = hashAt + 15;
+            const std::string hash = line.substr(start, line.find('"', start) - start);
+            const bool ok = line.find("\"status\":\"ok\"") != std::string::npos;
+            auto it = rows.find(hash);
+            if (it == rows.end()) {
+                order.push_back(hash);
+                rows[hash] = {ok, line};
+            } else if (ok && !it->second.first) {
+                it->second = {ok, line};
+            }
+        }
+        if (fs::exists(fs::path(dir) / "runs"))
+            fs::copy(fs::path(dir) / "runs", fs::path(outputDirectory) / "runs",
+                     fs::copy_options::recursive | fs::copy_options::overwrite_existing);
+        shardNames.push_back(dir);
+    }
+    {
+        std::ofstream merged(out.jsonlPath(), std::ios::trunc);
+        for (const auto& hash : order)
+            merged << rows[hash].second << "\n";
+    }
+    const fs::path firstManifest = fs::path(shardDirectories.front()) / "manifest.json";
+    if (fs::exists(firstManifest)) {
+        std::string manifest = readTextFile(firstManifest.string());
+        while (!manifest.empty() && (manifest.back() == '\n' || manifest.back() == '}'))
+            manifest.pop_back();
+        std::vector<std::string> quoted;
+        for (const auto& s : shardNames)
+            quoted.push_back(jsonEscape(s));
+        std::ofstream(fs::path(outputDirectory) / "manifest.json") << manifest << ",\"merged_from\":" << jsonArray(quoted)
+                                                                  << "}\n";
+    }
+    return out.writeCsv();
 }
 
 } // namespace rtlab::experiment

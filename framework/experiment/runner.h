@@ -18,10 +18,23 @@ namespace rtlab::experiment {
 struct RunnerOptions {
     std::string outputDirectory;  //!< results/<experiment name> when empty
     bool quiet = false;           //!< no progress output (tests)
+    int shardIndex = 1;           //!< run only runs k with k % shardCount == shardIndex - 1
+    int shardCount = 1;           //!< 1 = the whole sweep
+    bool queryVulkanForManifest = true;  //!< tests turn it off
 };
 
+//! Parses "i/N" (1 <= i <= N) into options.shardIndex and options.shardCount; throws
+//! rtlab::InputError naming the argument otherwise.
+void parseShard(const std::string& text, RunnerOptions& options);
+
+//! Joins the results of shard folders into `outputDirectory`: rows of every results.jsonl (a run
+//! that is "ok" in any shard wins over a failed attempt elsewhere, duplicates are dropped), the
+//! run folders, a CSV, and the first shard's manifest with the list of shards. Returns the row
+//! count. Throws rtlab::Error when a shard folder has no results.jsonl.
+std::size_t mergeShards(const std::vector<std::string>& shardDirectories, const std::string& outputDirectory);
+
 struct RunnerSummary {
-    std::size_t total = 0;
+    std::size_t total = 0;        //!< runs in this shard
     std::size_t alreadyDone = 0;  //!< found complete in the results table (resumed)
     std::size_t succeeded = 0;
     std::size_t failed = 0;

@@ -161,11 +161,12 @@ Buffer Context::createBuffer(const BufferDesc& desc)
     state->name = desc.name.empty() ? std::string("buffer") : desc.name;
     const auto kind = mDevice->stagingUploads ? detail::DeviceState::MemoryKind::DeviceLocal
                                               : detail::DeviceState::MemoryKind::DeviceLocalMapped;
-    state->raw = mDevice->createRawBuffer(desc.size,
-                                          VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                              VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                                          kind, state->name);
+    VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    if (desc.vertexIndexUsage)
+        usage |= VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
+    state->raw = mDevice->createRawBuffer(desc.size, usage, kind, state->name);
+    state->vertexIndexUsage = desc.vertexIndexUsage;
     return Buffer(std::move(state));
 }
 

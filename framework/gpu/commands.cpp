@@ -60,7 +60,7 @@ std::optional<double> RunResult::sumGpuMs(std::string_view label) const
 
 namespace {
 
-enum class CommandKind { Dispatch, Fill, Copy };
+enum class CommandKind { Dispatch, Fill, Copy, Encoded };
 
 struct RecordedCommand {
     CommandKind kind = CommandKind::Dispatch;
@@ -73,6 +73,7 @@ struct RecordedCommand {
     VkBuffer destination = VK_NULL_HANDLE;
     VkDeviceSize size = 0;
     std::uint32_t fillValue = 0;
+    std::function<void(VkCommandBuffer)> encode; // CommandKind::Encoded
 };
 
 } // namespace
@@ -81,6 +82,21 @@ struct CommandList::Impl {
     std::shared_ptr<detail::DeviceState> device;
     std::vector<RecordedCommand> commands;
 };
+
+void detail::appendEncodedCommand(CommandList& list, std::string label,
+                                  std::function<void(VkCommandBuffer)> encode)
+{
+    RecordedCommand cmd;
+    cmd.kind = CommandKind::Encoded;
+    cmd.label = std::move(label);
+    cmd.encode = std::move(encode);
+    list.getImpl().commands.push_back(std::move(cmd));
+}
+
+const std::shared_ptr<detail::DeviceState>& detail::getRecordingDevice(CommandList& list)
+{
+    return list.getImpl().device;
+}
 
 CommandList::CommandList(std::unique_ptr<Impl> impl) : mImpl(std::move(impl)) {}
 CommandList::~CommandList() = default;
@@ -366,6 +382,9 @@ void encodeCommand(VkCommandBuffer cb, const RecordedCommand& c, VkDescriptorSet
         vkCmdCopyBuffer(cb, c.source, c.destination, 1, &region);
         break;
     }
+    case CommandKind::Encoded:
+        c.encode(cb);
+        break;
     }
 }
 

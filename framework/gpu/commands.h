@@ -1,6 +1,6 @@
 #pragma once
-// Recording work for Context::run(): dispatches and small transfer commands, each timed on the
-// GPU with a pair of timestamps.
+// Recording work for Context::run(): dispatches, draws and small transfer commands, each timed
+// on the GPU with a pair of timestamps.
 //
 //   gpu::RunResult r = ctx.run([&](gpu::CommandList& cmd) {
 //       cmd.dispatch(blur, {gpu::Binding::storageImage(0, src), gpu::Binding::storageImage(1,
@@ -23,6 +23,10 @@
 #include "gpu/resources.h"
 
 namespace rtlab::gpu {
+
+class GraphicsPipeline;
+class RenderTarget;
+struct IndexedDraw;
 
 //! A resource bound to one binding of descriptor set 0 for a dispatch. The resource must live
 //! until Context::run() returns.
@@ -115,6 +119,12 @@ public:
     void fillBuffer(const Buffer& buffer, std::uint32_t value, std::string_view label = {});
     //! Copies min(source size, destination size) bytes.
     void copyBuffer(const Buffer& source, const Buffer& destination, std::string_view label = {});
+    //! Draws indexed triangles with `pipeline` into `target` in one render pass (see
+    //! gpu/graphics.h). Push-constant size must equal the pipeline's. An empty label uses the
+    //! pipeline name.
+    void drawIndexed(const GraphicsPipeline& pipeline, const RenderTarget& target,
+                     const IndexedDraw& draw, PushConstants pushConstants,
+                     std::string_view label = {});
 
     //! Number of commands recorded so far.
     std::size_t countCommands() const;

@@ -1,6 +1,7 @@
 #pragma once
-// The headless Vulkan context: instance, chosen physical device, one compute queue, optional
-// validation. Everything else (buffers, images, pipelines, timed submissions) is created from it.
+// The headless Vulkan context: instance, chosen physical device, one compute queue (which also
+// draws where its family supports graphics), optional validation. Everything else (buffers,
+// images, pipelines, render targets, timed submissions) is created from it.
 //
 // Environment variables read when a Context is created:
 //   RTLAB_VK_DEVICE=<substring>  pick the device whose name contains it (case-insensitive),
@@ -18,6 +19,7 @@
 
 #include "gpu/commands.h"
 #include "gpu/format.h"
+#include "gpu/graphics.h"
 #include "gpu/pipeline.h"
 #include "gpu/resources.h"
 
@@ -50,6 +52,7 @@ struct DeviceInfo {
     bool timestampsSupported = false;     //!< timestampValidBits > 0 and a positive period
 
     std::uint32_t subTexelPrecisionBits = 0; //!< fraction bits of filtering weights
+    std::uint32_t subPixelPrecisionBits = 0; //!< fraction bits of rasterised vertex positions
     std::uint32_t maxPushConstantsSize = 0;
     std::uint32_t maxComputeWorkGroupInvocations = 0;
     std::uint32_t maxComputeWorkGroupSize[3] = {0, 0, 0};
@@ -146,6 +149,11 @@ public:
     //! A compute pipeline. Throws rtlab::Error when the device rejects it or the description
     //! exceeds device limits.
     ComputePipeline createPipeline(const ComputePipelineDesc& desc);
+    //! A graphics pipeline (gpu/graphics.h). Throws rtlab::Error when the queue cannot draw, a
+    //! format cannot be rendered to, or the device rejects the pipeline.
+    GraphicsPipeline createGraphicsPipeline(const GraphicsPipelineDesc& desc);
+    //! Colour and depth attachments of one size that draws render into (gpu/graphics.h).
+    RenderTarget createRenderTarget(const RenderTargetDesc& desc);
 
     //! Records the commands that `record` issues into one command buffer, submits it, waits for
     //! completion and returns per-command GPU times and the CPU wall time of the submission.

@@ -282,6 +282,7 @@ void describeDevice(VkPhysicalDevice device, std::uint32_t queueTimestampBits, D
     info.timestampValidBits = queueTimestampBits;
     info.timestampsSupported = queueTimestampBits > 0 && limits.timestampPeriod > 0.0f;
     info.subTexelPrecisionBits = limits.subTexelPrecisionBits;
+    info.subPixelPrecisionBits = limits.subPixelPrecisionBits;
     info.maxPushConstantsSize = limits.maxPushConstantsSize;
     info.maxComputeWorkGroupInvocations = limits.maxComputeWorkGroupInvocations;
     for (int i = 0; i < 3; ++i) {

@@ -30,9 +30,12 @@ concept PlainData = std::is_trivially_copyable_v<T> && !std::is_pointer_v<T>;
 struct BufferDesc {
     std::size_t size = 0; //!< bytes, > 0
     std::string name;     //!< shown in errors and debug tools
+    //! Also usable as vertex and index buffer of draws (gpu/graphics.h).
+    bool vertexIndexUsage = false;
 };
 
-//! A storage buffer (also usable as transfer source and destination).
+//! A storage buffer (also usable as transfer source and destination, and as vertex and index
+//! buffer when created with BufferDesc::vertexIndexUsage).
 class Buffer {
 public:
     Buffer();

@@ -168,10 +168,12 @@ std::optional<std::string> readFileText(const fs::path& path)
 
 ShaderKey computeShaderKey(std::string_view source, const fs::path& sourcePath,
                            const std::vector<ShaderDefine>& defines,
-                           const std::vector<fs::path>& includeDirs)
+                           const std::vector<fs::path>& includeDirs, std::string_view stageTag)
 {
     KeyScanner scanner{includeDirs, Hasher(), {}, {}};
     scanner.hasher.add("rtlab-spirv-cache/1").add(getShaderCompilerVersion()).add(source);
+    if (!stageTag.empty())
+        scanner.hasher.add("stage").add(stageTag);
     scanner.hasher.addValue(static_cast<std::uint64_t>(defines.size()));
     for (const ShaderDefine& d : defines)
         scanner.hasher.add(d.name).add(d.value);

@@ -1,4 +1,4 @@
-// Compiling GLSL compute shaders with glslang, behind the SPIR-V cache.
+// Compiling GLSL shaders with glslang, behind the SPIR-V cache.
 
 #include "gpu/shader_compiler.h"
 
@@ -162,7 +162,21 @@ std::optional<LocatedError> parseLocatedError(const std::string& text)
     throw InputError(SourceLocation{errors.front().file, errors.front().line, 0}, message);
 }
 
+EShLanguage toGlslangStage(ShaderStage stage)
+{
+    switch (stage) {
+    case ShaderStage::Vertex:
+        return EShLangVertex;
+    case ShaderStage::Fragment:
+        return EShLangFragment;
+    case ShaderStage::Compute:
+        break;
+    }
+    return EShLangCompute;
+}
+
 std::vector<std::uint32_t> runGlslang(std::string_view source, const fs::path& sourcePath,
+                                      ShaderStage shaderStage,
                                       const std::vector<ShaderDefine>& defines,
                                       const std::vector<fs::path>& includeDirs,
                                       std::string& warnings)
@@ -174,10 +188,11 @@ std::vector<std::uint32_t> runGlslang(std::string_view source, const fs::path& s
     const int lengths[] = {static_cast<int>(source.size())};
     const char* names[] = {name.c_str()};
 
-    glslang::TShader shader(EShLangCompute);
+    const EShLanguage stage = toGlslangStage(shaderStage);
+    glslang::TShader shader(stage);
     shader.setStringsWithLengthsAndNames(strings, lengths, names, 1);
     shader.setPreamble(preamble.c_str());
-    shader.setEnvInput(glslang::EShSourceGlsl, EShLangCompute, glslang::EShClientVulkan, 100);
+    shader.setEnvInput(glslang::EShSourceGlsl, stage, glslang::EShClientVulkan, 100);
     shader.setEnvClient(glslang::EShClientVulkan, kClientVersion);
     shader.setEnvTarget(glslang::EShTargetSpv, kSpirvVersion);
     const auto messages = static_cast<EShMessages>(EShMsgSpvRules | EShMsgVulkanRules);
@@ -195,7 +210,7 @@ std::vector<std::uint32_t> runGlslang(std::string_view source, const fs::path& s
     glslang::SpvOptions options;
     options.disableOptimizer = false;
     options.validate = true;
-    glslang::GlslangToSpv(*program.getIntermediate(EShLangCompute), spirv, &logger, &options);
+    glslang::GlslangToSpv(*program.getIntermediate(stage), spirv, &logger, &options);
     warnings = trim(std::string(shader.getInfoLog()) + "\n" + logger.getAllMessages());
     if (spirv.empty())
         throw InputError(SourceLocation{name, 0, 0},
@@ -204,6 +219,29 @@ std::vector<std::uint32_t> runGlslang(std::string_view source, const fs::path& s
 }
 
 } // namespace
+
+ShaderStage getShaderStage(const fs::path& path)
+{
+    const fs::path extension = path.extension();
+    if (extension == ".vert")
+        return ShaderStage::Vertex;
+    if (extension == ".frag")
+        return ShaderStage::Fragment;
+    return ShaderStage::Compute;
+}
+
+const char* getShaderStageName(ShaderStage stage)
+{
+    switch (stage) {
+    case ShaderStage::Compute:
+        return "compute";
+    case ShaderStage::Vertex:
+        return "vertex";
+    case ShaderStage::Fragment:
+        return "fragment";
+    }
+    return "?";
+}
 
 std::string getShaderCompilerVersion()
 {
@@ -237,8 +275,13 @@ CompiledShader ShaderCompiler::compileSource(std::string_view source, const fs::
     const auto start = std::chrono::steady_clock::now();
     CompiledShader result;
     result.sourcePath = virtualPath;
+    result.stage = getShaderStage(virtualPath);
+    // Compute shaders carry no stage in their key, so their cache entries stay valid.
+    const std::string_view stageTag = result.stage == ShaderStage::Compute
+                                          ? std::string_view()
+                                          : getShaderStageName(result.stage);
     detail::ShaderKey key =
-        detail::computeShaderKey(source, virtualPath, defines, mOptions.includeDirs);
+        detail::computeShaderKey(source, virtualPath, defines, mOptions.includeDirs, stageTag);
     result.cacheKey = key.key;
     result.dependencies = std::move(key.dependencies);
 
@@ -249,8 +292,8 @@ CompiledShader ShaderCompiler::compileSource(std::string_view source, const fs::
         }
     }
     if (!result.cacheHit) {
-        result.spirv =
-            runGlslang(source, virtualPath, defines, mOptions.includeDirs, result.warnings);
+        result.spirv = runGlslang(source, virtualPath, result.stage, defines, mOptions.includeDirs,
+                                  result.warnings);
         if (mOptions.useCache) {
             const std::string problem =
                 detail::writeCachedSpirv(mCacheDir, result.cacheKey, result.spirv);

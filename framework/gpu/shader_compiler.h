@@ -1,5 +1,6 @@
 #pragma once
-// GLSL compute shaders compiled to SPIR-V (Vulkan 1.1, SPIR-V 1.3) with glslang at run time.
+// GLSL shaders compiled to SPIR-V (Vulkan 1.1, SPIR-V 1.3) with glslang at run time. The stage
+// follows the file extension: .vert vertex, .frag fragment, anything else compute.
 //
 // #include "file" is searched next to the including file, then in the include directories;
 // #include <file> only in the include directories. GL_GOOGLE_include_directive is enabled
@@ -17,6 +18,16 @@
 #include <vector>
 
 namespace rtlab::gpu {
+
+//! The pipeline stage a GLSL source is compiled for.
+enum class ShaderStage { Compute, Vertex, Fragment };
+
+//! The stage of a source file by its extension: ".vert" Vertex, ".frag" Fragment, anything else
+//! (".comp", ".glsl", none) Compute.
+ShaderStage getShaderStage(const std::filesystem::path& path);
+
+//! "compute", "vertex", "fragment".
+const char* getShaderStageName(ShaderStage stage);
 
 //! A preprocessor definition: #define name value (value may be empty).
 struct ShaderDefine {
@@ -36,6 +47,7 @@ struct ShaderCompilerOptions {
 struct CompiledShader {
     std::vector<std::uint32_t> spirv;
     std::filesystem::path sourcePath; //!< as given (or the virtual name of an in-memory source)
+    ShaderStage stage = ShaderStage::Compute;        //!< from the extension of sourcePath
     std::vector<std::filesystem::path> dependencies; //!< files reached by #include, resolved
     std::string cacheKey;                            //!< 32 hex digits
     bool cacheHit = false;  //!< SPIR-V came from the cache; glslang did not run
@@ -43,19 +55,20 @@ struct CompiledShader {
     std::string warnings;   //!< glslang's warnings, empty when there are none
 };
 
-//! Compiles compute shaders. Cheap to create; holds no glslang state between calls.
+//! Compiles shaders (stage by file extension, see getShaderStage()). Cheap to create; holds no
+//! glslang state between calls.
 class ShaderCompiler {
 public:
     explicit ShaderCompiler(ShaderCompilerOptions options = {});
 
-    //! Compiles a GLSL compute shader file. Throws rtlab::InputError naming the file and line
+    //! Compiles a GLSL shader file. Throws rtlab::InputError naming the file and line
     //! (of the included file, where the error is in one) with glslang's message when the shader
     //! does not compile, or naming the file when it cannot be read.
     CompiledShader compileFile(const std::filesystem::path& path,
                                const std::vector<ShaderDefine>& defines = {}) const;
 
-    //! Compiles GLSL held in memory. `virtualPath` names it in errors, and its directory is
-    //! where #include "..." looks first.
+    //! Compiles GLSL held in memory. `virtualPath` names it in errors, its extension selects
+    //! the stage, and its directory is where #include "..." looks first.
     CompiledShader compileSource(std::string_view source, const std::filesystem::path& virtualPath,
                                  const std::vector<ShaderDefine>& defines = {}) const;
 

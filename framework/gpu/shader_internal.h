@@ -31,10 +31,11 @@ struct ShaderKey {
 
 //! Hashes the source, the contents of all files its #include directives reach (directives are
 //! found by scanning lines, also in inactive #if branches), the defines and the compiler
-//! version.
+//! version. A non-empty `stageTag` (the stage of non-compute shaders) is hashed as well.
 ShaderKey computeShaderKey(std::string_view source, const std::filesystem::path& sourcePath,
                            const std::vector<ShaderDefine>& defines,
-                           const std::vector<std::filesystem::path>& includeDirs);
+                           const std::vector<std::filesystem::path>& includeDirs,
+                           std::string_view stageTag = {});
 
 //! The cached SPIR-V for `key`, or nullopt when absent or corrupt.
 std::optional<std::vector<std::uint32_t>> readCachedSpirv(const std::filesystem::path& dir,

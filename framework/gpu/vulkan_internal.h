@@ -128,6 +128,14 @@ void uploadThroughStaging(DeviceState& device, const void* data, std::size_t siz
 void downloadThroughStaging(DeviceState& device, void* data, std::size_t size,
                             const std::function<void(VkCommandBuffer, VkBuffer)>& copy);
 
+//! Appends a command to `list` that `encode` records into the command buffer of Context::run().
+//! Like every command it is timed and separated from its neighbours by full barriers. What
+//! `encode` uses must live until run() returns.
+void appendEncodedCommand(CommandList& list, std::string label,
+                          std::function<void(VkCommandBuffer)> encode);
+//! The device that `list` records commands for.
+const std::shared_ptr<DeviceState>& getRecordingDevice(CommandList& list);
+
 //! Records a barrier that orders all earlier memory writes before all later accesses.
 void recordFullBarrier(VkCommandBuffer commands);
 //! Records a barrier that makes all earlier device writes visible to host reads.
@@ -137,6 +145,7 @@ struct BufferState {
     std::shared_ptr<DeviceState> device;
     RawBuffer raw;
     std::string name;
+    bool vertexIndexUsage = false; //!< created with BufferDesc::vertexIndexUsage
     ~BufferState();
 };
 

@@ -13,15 +13,21 @@ glm::mat4 Camera::viewMatrix() const
     return glm::lookAtRH(position, target, up);
 }
 
+glm::mat4 Camera::projectionMatrix(float aspect) const
+{
+    return projectionMatrix(aspect, glm::vec2(0.0f), glm::ivec2(1));
+}
+
 glm::mat4 Camera::projectionMatrix(float aspect, glm::vec2 jitterPixels, glm::ivec2 size) const
 {
     // Right-handed view space, Vulkan clip space: depth in [0, 1], NDC y pointing down.
     glm::mat4 p = glm::perspectiveRH_ZO(glm::radians(verticalFovDegrees), aspect, nearPlane, farPlane);
     p[1][1] = -p[1][1];
-    // A sub-pixel shift is a translation in NDC by 2 * jitter / size, applied after the divide:
-    // add it to the third column scaled by -z (clip w = -z_view).
-    p[2][0] -= 2.0f * jitterPixels.x / float(size.x);
-    p[2][1] -= 2.0f * jitterPixels.y / float(size.y);
+    // The sample moves to pixel centre + jitter, so the image moves by -jitter: a translation in
+    // NDC by -2 * jitter / size after the divide, i.e. the third column gets +2 * jitter / size
+    // (clip w = -z_view).
+    p[2][0] += 2.0f * jitterPixels.x / float(size.x);
+    p[2][1] += 2.0f * jitterPixels.y / float(size.y);
     return p;
 }
 

@@ -20,10 +20,11 @@ struct Camera {
 
     //! World -> view (camera at origin looking down -z, y up).
     glm::mat4 viewMatrix() const;
-    //! View -> Vulkan clip space (depth 0 at near, 1 at far; y down in NDC) for `aspect` = w/h,
-    //! shifted by `jitterPixels` (sub-pixel offset in pixels, for temporal jitter) at `size`.
-    glm::mat4 projectionMatrix(float aspect, glm::vec2 jitterPixels = glm::vec2(0.0f),
-                               glm::ivec2 size = glm::ivec2(1)) const;
+    //! View -> Vulkan clip space (depth 0 at near, 1 at far; y down in NDC) for `aspect` = w/h.
+    glm::mat4 projectionMatrix(float aspect) const;
+    //! The same with the pixel samples of a `size` image moved to pixel centre + `jitterPixels`
+    //! (sub-pixel offset in pixels, for temporal jitter; the image content moves by -jitter).
+    glm::mat4 projectionMatrix(float aspect, glm::vec2 jitterPixels, glm::ivec2 size) const;
 };
 
 //! A camera at a time, for paths.

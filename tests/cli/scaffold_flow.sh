@@ -17,20 +17,21 @@ rm -rf "$work/tree/techniques/occlusion/flow_check_ao"
 
 "$rtlab" new-technique occlusion flow_check_ao --source-dir "$work/tree"
 
-# Share the project's compiler cache: with the base directory set, the copy's compilations hit
-# the entries of the main build, so this costs seconds, not a full build.
+# Share the project's compiler cache: the copy builds in tree/build as the project builds in
+# build/, so with the base directory set the relative paths match and its compilations hit the
+# entries of the main build: this costs seconds, not a full build.
 export CCACHE_BASEDIR="$work/tree"
 if [ -d "$src/.cache/ccache" ]; then
     export CCACHE_DIR="$src/.cache/ccache"
 fi
-cmake -S "$work/tree" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release >"$work/configure.log"
-cmake --build "$work/build" --target rtlab occlusion_flow_check_ao_test >"$work/build.log" 2>&1 \
+cmake -S "$work/tree" -B "$work/tree/build" -G Ninja -DCMAKE_BUILD_TYPE=Release >"$work/configure.log"
+cmake --build "$work/tree/build" --target rtlab occlusion_flow_check_ao_test >"$work/build.log" 2>&1 \
     || { tail -n 40 "$work/build.log"; exit 1; }
 
-listing=$("$work/build/rtlab" list --family occlusion)
+listing=$("$work/tree/build/rtlab" list --family occlusion)
 echo "$listing"
 grep -q "flow_check_ao: describe flow_check_ao in one line" <<<"$listing"
 grep -qE "radius +float +1 +\[0, inf\) +world units" <<<"$listing"
-"$work/build/techniques/occlusion/flow_check_ao/occlusion_flow_check_ao_test"
+"$work/tree/build/techniques/occlusion/flow_check_ao/occlusion_flow_check_ao_test"
 rm -rf "$work"
 echo "scaffold flow: ok"

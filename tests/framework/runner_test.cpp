@@ -45,7 +45,7 @@ TEST(Runner, WritesOneRowPerRunWithTimingAndMetrics)
     const auto registry = test::makeTestRegistry();
     const auto e = experiment::parseExperiment(kStudy, "runner.yaml", registry);
     const auto dir = freshDirectory("rows");
-    const auto s = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true});
+    const auto s = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     EXPECT_EQ(s.total, 4u);
     EXPECT_EQ(s.succeeded, 4u);
     EXPECT_EQ(s.failed, 0u);
@@ -70,7 +70,7 @@ TEST(Runner, ResumesAfterAnInterruptionWithoutRecomputing)
     const auto registry = test::makeTestRegistry();
     const auto e = experiment::parseExperiment(kStudy, "runner.yaml", registry);
     const auto dir = freshDirectory("resume");
-    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true});
+    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     auto lines = readLines(dir / "results.jsonl");
     ASSERT_EQ(lines.size(), 4u);
 
@@ -79,7 +79,7 @@ TEST(Runner, ResumesAfterAnInterruptionWithoutRecomputing)
         std::ofstream out(dir / "results.jsonl", std::ios::trunc);
         out << lines[0] << "\n" << lines[1] << "\n" << lines[2].substr(0, lines[2].size() / 2);
     }
-    const auto s = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true});
+    const auto s = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     EXPECT_EQ(s.alreadyDone, 2u);
     EXPECT_EQ(s.succeeded, 2u);
     // The two finished rows are untouched, byte for byte.
@@ -93,7 +93,7 @@ TEST(Runner, ResumesAfterAnInterruptionWithoutRecomputing)
     EXPECT_EQ(store.completedHashes().size(), 4u);
 
     // A third run computes nothing.
-    const auto again = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true});
+    const auto again = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     EXPECT_EQ(again.alreadyDone, 4u);
     EXPECT_EQ(again.succeeded, 0u);
 }
@@ -108,7 +108,7 @@ TEST(Runner, AFailingRunIsRecordedAndTheSweepGoesOn)
     auto broken = e;
     broken.runs[1].techniques["occlusion"] = {"no_such", {}};
     const auto dir = freshDirectory("failure");
-    const auto s = experiment::runExperiment(broken, registry, {.outputDirectory = dir.string(), .quiet = true});
+    const auto s = experiment::runExperiment(broken, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     EXPECT_EQ(s.failed, 1u);
     EXPECT_EQ(s.succeeded, 3u);
     experiment::ResultsStore store(dir.string());
@@ -118,7 +118,7 @@ TEST(Runner, AFailingRunIsRecordedAndTheSweepGoesOn)
     EXPECT_EQ(failed["status"], "failed");
     EXPECT_NE(failed["error"].find("occlusion"), std::string::npos) << failed["error"];
     // A failed run is retried next time; the others are not.
-    const auto again = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true});
+    const auto again = experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     EXPECT_EQ(again.alreadyDone, 3u);
     EXPECT_EQ(again.succeeded, 1u);
 }

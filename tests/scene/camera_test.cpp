@@ -9,7 +9,7 @@ using namespace rtlab::scene;
 
 namespace {
 glm::vec3 project(const Camera& c, const glm::vec3& p, float aspect, glm::vec2 jitter = {},
-                  glm::ivec2 size = glm::ivec2(1))
+                  glm::ivec2 size = glm::ivec2(64, 64))
 {
     const glm::vec4 clip = c.projectionMatrix(aspect, jitter, size) * c.viewMatrix() * glm::vec4(p, 1.0f);
     return glm::vec3(clip) / clip.w;
@@ -37,9 +37,10 @@ TEST(Camera, JitterShiftsByTheRequestedPixels)
     const glm::ivec2 size(64, 32);
     const glm::vec3 a = project(c, {0.3f, 0.2f, 0}, 2.0f, {}, size);
     const glm::vec3 b = project(c, {0.3f, 0.2f, 0}, 2.0f, {0.5f, -0.25f}, size);
-    // NDC spans 2 over `size` pixels: half a pixel is 1/64 in x; -0.25 px is -0.5/32 in y.
-    EXPECT_NEAR(b.x - a.x, 2.0f * 0.5f / 64.0f, 1e-6f);
-    EXPECT_NEAR(b.y - a.y, 2.0f * -0.25f / 32.0f, 1e-6f);
+    // The samples move by +jitter, so the image content moves by -jitter. NDC spans 2 over
+    // `size` pixels: half a pixel is 1/64 in x; -0.25 px is -0.5/32 in y.
+    EXPECT_NEAR(b.x - a.x, -2.0f * 0.5f / 64.0f, 1e-6f);
+    EXPECT_NEAR(b.y - a.y, -2.0f * -0.25f / 32.0f, 1e-6f);
 }
 
 TEST(CameraPath, PassesThroughKeyframesAndHoldsAtTheEnds)
