@@ -56,5 +56,22 @@ target_link_libraries(rtlab_glslang INTERFACE
 # Used from issue [2] on: ground truth, images, meshes, plots, baselines.
 rtlab_require(embree 3 CONFIG DEBIAN libembree-dev)
 rtlab_require(OpenImageIO CONFIG DEBIAN libopenimageio-dev)
-rtlab_require(tinyobjloader CONFIG DEBIAN libtinyobjloader-dev)
+# Debian 12's OpenImageIO package lists /usr/include/opencv4 among the include directories of
+# OpenImageIO::OpenImageIO without depending on libopencv-dev; keep only the ones that exist.
+foreach(_property INTERFACE_INCLUDE_DIRECTORIES INTERFACE_SYSTEM_INCLUDE_DIRECTORIES)
+    get_target_property(_dirs OpenImageIO::OpenImageIO ${_property})
+    if(_dirs)
+        set(_existing "")
+        foreach(_dir IN LISTS _dirs)
+            if(EXISTS "${_dir}")
+                list(APPEND _existing "${_dir}")
+            endif()
+        endforeach()
+        set_target_properties(OpenImageIO::OpenImageIO PROPERTIES ${_property} "${_existing}")
+    endif()
+endforeach()
+
 rtlab_require(TinyGLTF CONFIG DEBIAN libtinygltf-dev)
+rtlab_require(VTK 9.1 CONFIG COMPONENTS ChartsCore CommonColor CommonCore CommonDataModel
+    IOExportPDF IOImage RenderingContext2D RenderingContextOpenGL2 RenderingCore RenderingFreeType
+    RenderingOpenGL2 DEBIAN libvtk9-dev)

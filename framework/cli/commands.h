@@ -3,6 +3,7 @@
 // 0 success, 1 the work ran but something failed, 2 bad input (file, config or arguments),
 // 3 the environment lacks something (no Vulkan device, ...).
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -54,6 +55,27 @@ struct BestOptions {
     std::string errorColumn = "rms_deviation";
 };
 int bestCommand(const BestOptions& options);
+
+struct ReferenceOptions {
+    std::string scene;            //!< procedural scene name or scene file
+    std::string quantity = "ao";
+    std::string outputDirectory;
+    int width = 256;
+    int height = 256;
+    int frame = 0;
+    double radius = -1.0;         //!< world units; <= 0 = unbounded (ao, bent)
+    std::string falloff = "linear";
+    int bounces = 2;
+    double targetStdErr = 0.005;
+    double targetRelStdErr = 0.01;
+    int maxSamples = 4096;
+    std::uint64_t seed = 0;
+    int threads = 0;
+    bool noCache = false;
+    std::string gbuffer = "vulkan";  //!< "vulkan" (rasterised) or "embree" (ray cast)
+    int throughputSamples = 0;       //!< > 0: also measure Mrays/s against raw rtcIntersect1
+};
+int referenceCommand(const ReferenceOptions& options);
 
 //! The repository root rtlab was built from ($RTLAB_SOURCE_DIR overrides).
 std::string defaultSourceDirectory();

@@ -34,6 +34,42 @@ int main(int argc, char** argv)
     mergeCmd->add_option("shards", merge.shardDirectories, "Shard result folders")->required()->check(
         CLI::ExistingDirectory);
 
+    ReferenceOptions ref;
+    auto* refCmd = app.add_subcommand(
+        "reference", "Embree ground truth of one quantity for a scene, from its rasterised G-buffer");
+    refCmd->add_option("scene", ref.scene, "Procedural scene name (cornell_box, tomorrow_town, csg_gallery, "
+                                           "ao_testbed) or a scene .yaml file")
+        ->required();
+    refCmd->add_option("-q,--quantity", ref.quantity, "ao, ao_uniform, obscurance, bent, direct, indirect or full")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"ao", "ao_uniform", "obscurance", "bent", "direct", "indirect", "full"}));
+    refCmd->add_option("-o,--output", ref.outputDirectory, "Folder for <quantity>.exr and <quantity>_stderr.exr")
+        ->required();
+    refCmd->add_option("--width", ref.width, "Image width in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
+    refCmd->add_option("--height", ref.height, "Image height in pixels")->capture_default_str()->check(CLI::Range(1, 16384));
+    refCmd->add_option("--frame", ref.frame, "Frame of the scene's animation")->capture_default_str();
+    refCmd->add_option("--radius", ref.radius, "Occlusion radius in world units (default unbounded)");
+    refCmd->add_option("--falloff", ref.falloff, "Obscurance falloff: linear or smoothstep")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"linear", "smoothstep"}));
+    refCmd->add_option("--bounces", ref.bounces, "Indirect bounces (-1 = unlimited)")->capture_default_str()
+        ->check(CLI::Range(-1, 64));
+    refCmd->add_option("--target-stderr", ref.targetStdErr, "Absolute per-pixel standard error to reach")
+        ->capture_default_str()->check(CLI::PositiveNumber);
+    refCmd->add_option("--target-rel-stderr", ref.targetRelStdErr, "Relative per-pixel standard error to reach")
+        ->capture_default_str()->check(CLI::NonNegativeNumber);
+    refCmd->add_option("--max-samples", ref.maxSamples, "Sample cap per pixel")->capture_default_str()
+        ->check(CLI::Range(1, 1 << 24));
+    refCmd->add_option("--seed", ref.seed, "Seed of the sample sequences")->capture_default_str();
+    refCmd->add_option("--threads", ref.threads, "Worker threads (0 = all)")->capture_default_str()
+        ->check(CLI::Range(0, 1024));
+    refCmd->add_flag("--no-cache", ref.noCache, "Neither read nor write the on-disk reference cache");
+    refCmd->add_option("--gbuffer", ref.gbuffer, "vulkan (rasterised, default) or embree (ray cast)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"vulkan", "embree"}));
+    refCmd->add_option("--throughput", ref.throughputSamples,
+                       "Also trace N samples per pixel and compare Mrays/s with raw rtcIntersect1");
+
     BestOptions best;
     auto* bestCmd = app.add_subcommand(
         "best", "The lowest-error run within a time budget, or the fastest run within an error bound");
@@ -75,6 +111,8 @@ int main(int argc, char** argv)
         return newTechnique(scaffold);
     if (*gpuCmd)
         return gpuSmoke(gpu);
+    if (*refCmd)
+        return referenceCommand(ref);
     if (*mergeCmd)
         return mergeCommand(merge);
     if (*bestCmd) {

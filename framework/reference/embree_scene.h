@@ -1,0 +1,53 @@
+#pragma once
+// The RenderScene as one Embree 3 triangle geometry (internal to rtlab_reference: the only
+// header that includes Embree). Owns its device and scene (RAII, move-only).
+
+#include "scene/render_scene.h"
+
+#include <embree3/rtcore.h>
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <limits>
+
+namespace rtlab::reference {
+
+struct RayHit {
+    float t = 0.0f;
+    std::uint32_t triangle = 0;
+    float u = 0.0f;                  //!< barycentric of vertex 1
+    float v = 0.0f;                  //!< barycentric of vertex 2
+    glm::vec3 geometricNormal{0.0f}; //!< unnormalised, Embree's orientation
+};
+
+class EmbreeScene {
+public:
+    //! Throws rtlab::Error when the scene has no triangles or Embree reports an error.
+    explicit EmbreeScene(const scene::RenderScene& scene);
+    ~EmbreeScene();
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+    EmbreeScene(EmbreeScene&& other) noexcept;
+    EmbreeScene& operator=(EmbreeScene&& other) noexcept;
+
+    //! Closest hit along org + t dir, 0 <= t <= tFar (dir need not be unit; t is in its units).
+    bool intersect(const glm::vec3& org, const glm::vec3& dir, float tFar, RayHit& hit) const;
+    //! Whether anything lies along org + t dir, 0 <= t <= tFar.
+    bool occluded(const glm::vec3& org, const glm::vec3& dir, float tFar) const;
+
+    RTCScene getHandle() const { return mScene; }
+    //! Length of the diagonal of the triangles' bounding box.
+    double getSceneScale() const { return mSceneScale; }
+
+private:
+    void release();
+
+    RTCDevice mDevice = nullptr;
+    RTCScene mScene = nullptr;
+    double mSceneScale = 0.0;
+};
+
+//! The largest float tFar Embree accepts as "no limit".
+constexpr float kInfiniteDistance = std::numeric_limits<float>::infinity();
+
+} // namespace rtlab::reference

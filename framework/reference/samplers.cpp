@@ -1,0 +1,193 @@
+#include "reference/samplers.h"
+
+#include "core/error.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace rtlab::reference {
+
+Frame Frame::fromNormal(const glm::dvec3& n)
+{
+    // Branchless orthonormal basis [Duff et al. 2017, "Building an Orthonormal Basis, Revisited"].
+    const double sign = std::copysign(1.0, n.z);
+    const double a = -1.0 / (sign + n.z);
+    const double b = n.x * n.y * a;
+    Frame f;
+    f.tangent = glm::dvec3(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    f.bitangent = glm::dvec3(b, sign + n.y * n.y * a, -n.y);
+    f.normal = n;
+    return f;
+}
+
+double computeLuminance(const glm::dvec3& rgb)
+{
+    return 0.2126 * rgb.x + 0.7152 * rgb.y + 0.0722 * rgb.z;
+}
+
+glm::dvec3 sampleCosineHemisphere(const glm::dvec2& u)
+{
+    // Concentric map of the square onto the unit disk [Shirley & Chiu 1997] ...
+    const double a = 2.0 * u.x - 1.0;
+    const double b = 2.0 * u.y - 1.0;
+    double x = 0.0;
+    double y = 0.0;
+    if (a != 0.0 || b != 0.0) {
+        double r;
+        double phi;
+        if (std::abs(a) > std::abs(b)) {
+            r = a;
+            phi = (kPi / 4.0) * (b / a);
+        } else {
+            r = b;
+            phi = kPi / 2.0 - (kPi / 4.0) * (a / b);
+        }
+        x = r * std::cos(phi);
+        y = r * std::sin(phi);
+    }
+    // ... lifted onto the hemisphere: uniform on the disk = cosine-weighted (Malley's method).
+    return {x, y, std::sqrt(std::max(0.0, 1.0 - x * x - y * y))};
+}
+
+double pdfCosineHemisphere(double cosTheta)
+{
+    return cosTheta > 0.0 ? cosTheta / kPi : 0.0;
+}
+
+glm::dvec3 sampleUniformHemisphere(const glm::dvec2& u)
+{
+    const double z = u.x;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = 2.0 * kPi * u.y;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+double pdfUniformHemisphere()
+{
+    return 1.0 / (2.0 * kPi);
+}
+
+glm::dvec3 sampleUniformSphere(const glm::dvec2& u)
+{
+    const double z = 1.0 - 2.0 * u.x;
+    const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+    const double phi = 2.0 * kPi * u.y;
+    return {r * std::cos(phi), r * std::sin(phi), z};
+}
+
+double pdfUniformSphere()
+{
+    return 1.0 / (4.0 * kPi);
+}
+
+glm::dvec3 sampleSphericalGaussian(const glm::dvec2& u, double sharpness)
+{
+    // CDF in w = cos(theta): F(w) = (exp(k(w - 1)) - exp(-2k)) / (1 - exp(-2k)). Solving F(w) = 1 -
+    // u gives w = 1 + log(u + (1 - u) exp(-2k)) / k [Jakob 2012, "Numerically stable sampling of
+    // the von Mises Fisher distribution on S^2"]; log1p/expm1 keep it exact for small and large k.
+    const double k = sharpness;
+    const double oneMinusW = -std::log1p((1.0 - u.x) * std::expm1(-2.0 * k)) / k;
+    const double w = std::clamp(1.0 - oneMinusW, -1.0, 1.0);
+    const double sinTheta = std::sqrt(std::max(0.0, oneMinusW * (2.0 - oneMinusW)));
+    const double phi = 2.0 * kPi * u.y;
+    return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), w};
+}
+
+double pdfSphericalGaussian(double cosTheta, double sharpness)
+{
+    const double k = sharpness;
+    return k / (-2.0 * kPi * std::expm1(-2.0 * k)) * std::exp(k * (cosTheta - 1.0));
+}
+
+glm::dvec2 sampleTriangleBarycentrics(const glm::dvec2& u)
+{
+    // [Turk 1990]: b0 = 1 - sqrt(u1), b1 = (1 - u2) sqrt(u1), b2 = u2 sqrt(u1).
+    const double s = std::sqrt(u.x);
+    return {(1.0 - u.y) * s, u.y * s};
+}
+
+double pdfTriangleArea(double area)
+{
+    return area > 0.0 ? 1.0 / area : 0.0;
+}
+
+DiscreteDistribution::DiscreteDistribution(const std::vector<double>& weights)
+{
+    mPmf.resize(weights.size());
+    mCdf.assign(weights.size() + 1, 0.0);
+    for (std::size_t i = 0; i < weights.size(); ++i) {
+        if (!(weights[i] >= 0.0) || !std::isfinite(weights[i]))
+            throw Error("discrete distribution: weight " + std::to_string(i) +
+                        " is negative or not finite");
+        mTotal += weights[i];
+    }
+    if (mTotal <= 0.0)
+        return;
+    double sum = 0.0;
+    for (std::size_t i = 0; i < weights.size(); ++i) {
+        mPmf[i] = weights[i] / mTotal;
+        sum += weights[i];
+        mCdf[i + 1] = sum / mTotal;
+    }
+    // Exact end, and zero-width intervals at the end must not catch rounding: pin them to 1.
+    for (std::size_t i = weights.size(); i > 0 && (i == weights.size() || mPmf[i] == 0.0); --i)
+        mCdf[i] = 1.0;
+}
+
+std::size_t DiscreteDistribution::sample(double u, double* uRemapped) const
+{
+    // First interval [cdf[i], cdf[i+1]) containing u; zero-width intervals are never chosen.
+    const auto it = std::upper_bound(mCdf.begin() + 1, mCdf.end(), u);
+    std::size_t i = std::size_t(it - (mCdf.begin() + 1));
+    i = std::min(i, mPmf.size() - 1);
+    if (uRemapped)
+        *uRemapped = std::clamp((u - mCdf[i]) / mPmf[i], 0.0, 0x1.fffffffffffffp-1);
+    return i;
+}
+
+DiscreteDistribution buildPointLightDistribution(const std::vector<scene::PointLight>& lights)
+{
+    std::vector<double> power;
+    power.reserve(lights.size());
+    for (const auto& l : lights)
+        power.push_back(4.0 * kPi * std::max(0.0, computeLuminance(glm::dvec3(l.intensity))));
+    return DiscreteDistribution(power);
+}
+
+SkyLobeSampler::SkyLobeSampler(const scene::Sky& sky)
+{
+    if (sky.kind != scene::Sky::Kind::Srbf || !(sky.sharpness > 0.0f))
+        return;
+    mSharpness = sky.sharpness;
+    const double integral = scene::integrateSphericalGaussian(mSharpness);
+    std::vector<double> weights;
+    for (const auto& peak : sky.lobes)
+        weights.push_back(std::max(0.0, computeLuminance(glm::dvec3(peak))) * integral);
+    mLobes = DiscreteDistribution(weights);
+    for (const auto& axis : scene::getConeDirections())
+        mFrames.push_back(Frame::fromNormal(glm::normalize(axis)));
+    if (mLobes.empty())
+        mFrames.clear();
+}
+
+glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
+{
+    double ux = 0.0;
+    const std::size_t lobe = mLobes.sample(u.x, &ux);
+    return glm::normalize(mFrames[lobe].toWorld(sampleSphericalGaussian({ux, u.y}, mSharpness)));
+}
+
+double SkyLobeSampler::pdf(const glm::dvec3& direction) const
+{
+    double p = 0.0;
+    for (std::size_t i = 0; i < mFrames.size(); ++i)
+        if (mLobes.pmf(i) > 0.0)
+            p += mLobes.pmf(i) *
+                 pdfSphericalGaussian(glm::dot(direction, mFrames[i].normal), mSharpness);
+    return p;
+}
+
+} // namespace rtlab::reference

@@ -1,0 +1,115 @@
+// Ray throughput of the reference next to bare Embree calls on the same rays.
+#include "reference/reference.h"
+
+#include "reference/prepared.h"
+
+#include <embree3/rtcore.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+namespace rtlab::reference {
+
+namespace {
+
+double getSecondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+} // namespace
+
+RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,
+                                   const ReferenceSettings& settings, int samplesPerPixel)
+{
+    ReferenceSettings s = settings;
+    s.batchSize = std::max(1, samplesPerPixel);
+    s.maxSamples = s.batchSize;
+    s.targetStdErr = 0.0;
+    s.targetRelStdErr = 0.0;
+    s.useCache = false;
+
+    RayThroughput result;
+    tbb::task_arena arena(s.threadCount > 0 ? s.threadCount : int(tbb::task_arena::automatic));
+    result.threads = arena.max_concurrency();
+    arena.execute([&] {
+        const PreparedReference prepared(scene, gbuffer, s);
+        ProgressiveRule rule;
+        rule.channels = 1; // no early stop: the targets are 0
+        rule.batchSize = s.batchSize;
+        rule.maxSamples = s.maxSamples;
+
+        auto start = std::chrono::steady_clock::now();
+        const ProgressiveOutput out =
+            runProgressive(gbuffer.width, gbuffer.height, prepared.getActive(), rule,
+                           [&](std::size_t pixel, std::uint32_t index, SampleValue& value) {
+                               return prepared.evaluate(pixel, index, value);
+                           });
+        result.referenceSeconds = getSecondsSince(start);
+        result.referenceRays = out.rayCount;
+
+        // The same number of rays as AO would trace: cosine-distributed from the same origins.
+        std::vector<RTCRayHit> rays;
+        const double eps = prepared.getContext().rayEpsilon;
+        const float tFar = std::isinf(s.radius) ? kInfiniteDistance : float(s.radius);
+        for (std::size_t pixel = 0; pixel < prepared.getActive().size(); ++pixel) {
+            if (!prepared.getActive()[pixel])
+                continue;
+            const SurfacePoint& p = prepared.getPoint(pixel);
+            const Frame frame = Frame::fromNormal(p.normal);
+            const glm::vec3 o(p.position + eps * p.normal);
+            const PixelSequence sequence(s.seed, pixel);
+            for (std::uint32_t i = 0; i < std::uint32_t(s.maxSamples); ++i) {
+                const glm::vec3 d(frame.toWorld(sampleCosineHemisphere(sequence.get2D(i, 0))));
+                RTCRayHit rh{};
+                rh.ray.org_x = o.x;
+                rh.ray.org_y = o.y;
+                rh.ray.org_z = o.z;
+                rh.ray.dir_x = d.x;
+                rh.ray.dir_y = d.y;
+                rh.ray.dir_z = d.z;
+                rh.ray.tnear = 0.0f;
+                rh.ray.tfar = tFar;
+                rh.ray.mask = 0xffffffffu;
+                rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                rays.push_back(rh);
+            }
+        }
+        result.rawRays = rays.size();
+        const RTCScene handle = prepared.getEmbree().getHandle();
+        std::vector<RTCRayHit> work = rays;
+        start = std::chrono::steady_clock::now();
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              RTCIntersectContext context;
+                              rtcInitIntersectContext(&context);
+                              for (std::size_t i = r.begin(); i != r.end(); ++i)
+                                  rtcIntersect1(handle, &context, &work[i]);
+                          });
+        result.rawIntersectSeconds = getSecondsSince(start);
+
+        work = rays;
+        start = std::chrono::steady_clock::now();
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
+                          [&](const tbb::blocked_range<std::size_t>& r) {
+                              RTCIntersectContext context;
+                              rtcInitIntersectContext(&context);
+                              for (std::size_t i = r.begin(); i != r.end(); ++i)
+                                  rtcOccluded1(handle, &context, &work[i].ray);
+                          });
+        result.rawOccludedSeconds = getSecondsSince(start);
+    });
+    auto rate = [](std::uint64_t rays, double seconds) {
+        return seconds > 0.0 ? double(rays) / seconds * 1e-6 : 0.0;
+    };
+    result.referenceMraysPerSecond = rate(result.referenceRays, result.referenceSeconds);
+    result.rawIntersectMraysPerSecond = rate(result.rawRays, result.rawIntersectSeconds);
+    result.rawOccludedMraysPerSecond = rate(result.rawRays, result.rawOccludedSeconds);
+    return result;
+}
+
+} // namespace rtlab::reference

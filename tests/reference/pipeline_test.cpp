@@ -1,0 +1,282 @@
+// Determinism across thread counts, the progressive stopping rule, the on-disk cache, the EXR
+// round trip and bad input.
+#include "reference/reference.h"
+
+#include "core/error.h"
+#include "test_scenes.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+
+namespace rtlab::reference {
+namespace {
+
+using ::testing::HasSubstr;
+
+template <class T> bool isBitwiseEqual(const Image<T>& a, const Image<T>& b)
+{
+    return a.width == b.width && a.height == b.height && a.pixels.size() == b.pixels.size() &&
+           (a.pixels.empty() ||
+            std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(T)) == 0);
+}
+
+//! Every image of two results is byte for byte the same.
+void expectIdentical(const ReferenceResult& a, const ReferenceResult& b)
+{
+    EXPECT_TRUE(isBitwiseEqual(a.occlusion, b.occlusion));
+    EXPECT_TRUE(isBitwiseEqual(a.occlusionStdErr, b.occlusionStdErr));
+    EXPECT_TRUE(isBitwiseEqual(a.bentNormal, b.bentNormal));
+    EXPECT_TRUE(isBitwiseEqual(a.bentNormalStdErr, b.bentNormalStdErr));
+    EXPECT_TRUE(isBitwiseEqual(a.aperture, b.aperture));
+    EXPECT_TRUE(isBitwiseEqual(a.apertureStdErr, b.apertureStdErr));
+    EXPECT_TRUE(isBitwiseEqual(a.apertureUniform, b.apertureUniform));
+    EXPECT_TRUE(isBitwiseEqual(a.apertureUniformStdErr, b.apertureUniformStdErr));
+    EXPECT_TRUE(isBitwiseEqual(a.radiance, b.radiance));
+    EXPECT_TRUE(isBitwiseEqual(a.radianceStdErr, b.radianceStdErr));
+    EXPECT_TRUE(isBitwiseEqual(a.irradiance, b.irradiance));
+    EXPECT_TRUE(isBitwiseEqual(a.irradianceStdErr, b.irradianceStdErr));
+    EXPECT_TRUE(isBitwiseEqual(a.sampleCount, b.sampleCount));
+}
+
+struct Room {
+    scene::RenderScene scene = test::makeRoomScene();
+    scene::GBuffer gbuffer = test::makeRoomGBuffer(scene, 16, 16);
+};
+
+ReferenceSettings makeQuickSettings(Quantity q)
+{
+    ReferenceSettings s = test::makeSettings(q);
+    s.radius = q == Quantity::Obscurance ? 0.5 : 1.0;
+    s.batchSize = 32;
+    s.maxSamples = 256;
+    s.targetStdErr = 0.01;
+    s.targetRelStdErr = 0.05;
+    return s;
+}
+
+TEST(ReferencePipeline, ImagesAreBitwiseIdenticalForOneAndTwoThreads)
+{
+    const Room room;
+    for (Quantity q : {Quantity::Ao, Quantity::Bent, Quantity::Full}) {
+        ReferenceResult one, two;
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+            one = computeReference(room.scene, room.gbuffer, makeQuickSettings(q));
+        }
+        {
+            tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+            two = computeReference(room.scene, room.gbuffer, makeQuickSettings(q));
+        }
+        SCOPED_TRACE(getQuantityName(q));
+        EXPECT_GT(one.stats.rayCount, 0u);
+        EXPECT_EQ(one.stats.rayCount, two.stats.rayCount);
+        expectIdentical(one, two);
+        // The explicit thread-count setting as well.
+        ReferenceSettings s = makeQuickSettings(q);
+        s.threadCount = 2;
+        expectIdentical(one, computeReference(room.scene, room.gbuffer, s));
+    }
+}
+
+TEST(ReferencePipeline, ProgressiveStopsAtTheTargetOrTheCap)
+{
+    const Room room;
+    ReferenceSettings s = makeQuickSettings(Quantity::Ao);
+    s.targetStdErr = 0.02;
+    s.targetRelStdErr = 0.0;
+    const ReferenceResult r = computeReference(room.scene, room.gbuffer, s);
+    int atCap = 0, early = 0;
+    std::uint64_t samples = 0;
+    for (std::size_t i = 0; i < r.sampleCount.size(); ++i) {
+        const std::uint32_t n = r.sampleCount.pixels[i];
+        samples += n;
+        if (room.gbuffer.materialId.pixels[i] == scene::kNoMaterial) {
+            EXPECT_EQ(n, 0u);
+            EXPECT_EQ(r.occlusion.pixels[i], 1.0f);
+            EXPECT_EQ(r.occlusionStdErr.pixels[i], 0.0f);
+            continue;
+        }
+        EXPECT_EQ(n % 32, 0u);
+        EXPECT_GE(n, 32u);
+        EXPECT_LE(n, 256u);
+        if (n < 256) {
+            ++early;
+            EXPECT_LE(r.occlusionStdErr.pixels[i], 0.02f); // stopped because it met the target
+        } else if (r.occlusionStdErr.pixels[i] > 0.02f) {
+            ++atCap;
+        }
+    }
+    EXPECT_GT(early, 0);
+    EXPECT_EQ(atCap, r.stats.pixelsAtCap);
+    EXPECT_EQ(samples, r.stats.rayCount); // cosine AO: one ray per sample
+    EXPECT_LE(r.stats.maxStdErr, 0.2);
+    // A tighter target never takes fewer samples for any pixel (same sequence, later stop).
+    s.targetStdErr = 0.01;
+    const ReferenceResult tighter = computeReference(room.scene, room.gbuffer, s);
+    for (std::size_t i = 0; i < r.sampleCount.size(); ++i)
+        EXPECT_GE(tighter.sampleCount.pixels[i], r.sampleCount.pixels[i]);
+}
+
+TEST(ReferencePipeline, SecondCallIsACacheHitWithIdenticalPixels)
+{
+    const Room room;
+    const std::string dir = test::makeTemporaryFolder("cache");
+    ReferenceSettings s = makeQuickSettings(Quantity::Bent);
+    s.useCache = true;
+    s.cacheDirectory = dir;
+    const ReferenceResult first = computeReference(room.scene, room.gbuffer, s);
+    EXPECT_FALSE(first.stats.fromCache);
+    EXPECT_EQ(first.stats.cacheKey.size(), 32u);
+    EXPECT_TRUE(std::filesystem::exists(first.stats.cachePath + "/bent.exr"));
+    EXPECT_TRUE(std::filesystem::exists(first.stats.cachePath + "/bent_stderr.exr"));
+    EXPECT_TRUE(std::filesystem::exists(first.stats.cachePath + "/bent.json"));
+
+    const ReferenceResult second = computeReference(room.scene, room.gbuffer, s);
+    EXPECT_TRUE(second.stats.fromCache);
+    EXPECT_EQ(second.stats.cacheKey, first.stats.cacheKey);
+    EXPECT_EQ(second.stats.rayCount, first.stats.rayCount);
+    EXPECT_EQ(second.stats.seconds, first.stats.seconds);
+    expectIdentical(first, second);
+    std::printf("    cache: computed in %.3f s, hit %s\n", first.stats.seconds,
+                second.stats.cachePath.c_str());
+
+    // What changes the result changes the key; the thread count does not.
+    ReferenceSettings other = s;
+    other.seed = 1;
+    EXPECT_FALSE(computeReference(room.scene, room.gbuffer, other).stats.fromCache);
+    other = s;
+    other.threadCount = 1;
+    EXPECT_TRUE(computeReference(room.scene, room.gbuffer, other).stats.fromCache);
+    scene::GBuffer moved = room.gbuffer;
+    moved.position.pixels[17].x += 1e-3f;
+    EXPECT_NE(computeReferenceCacheKey(room.scene, moved, s), first.stats.cacheKey);
+    scene::RenderScene brighter = room.scene;
+    brighter.pointLights[0].intensity *= 2.0f;
+    EXPECT_NE(computeReferenceCacheKey(brighter, room.gbuffer, s), first.stats.cacheKey);
+    std::filesystem::remove_all(dir);
+}
+
+TEST(ReferencePipeline, CacheDirectoryFollowsTheEnvironment)
+{
+    ReferenceSettings s;
+    s.cacheDirectory = "/somewhere";
+    EXPECT_EQ(getReferenceCacheDirectory(s), "/somewhere");
+    s.cacheDirectory.clear();
+    const char* cache = std::getenv("RTLAB_CACHE_DIR");
+    const std::string savedCache = cache ? cache : "";
+    ::setenv("RTLAB_CACHE_DIR", "/tmp/rtlab-cache-test", 1);
+    EXPECT_EQ(getReferenceCacheDirectory(s), "/tmp/rtlab-cache-test/reference");
+    ::unsetenv("RTLAB_CACHE_DIR");
+    const char* home = std::getenv("HOME");
+    const std::string savedHome = home ? home : "";
+    ::setenv("HOME", "/home/someone", 1);
+    EXPECT_EQ(getReferenceCacheDirectory(s), "/home/someone/.cache/rtlab/reference");
+    if (home)
+        ::setenv("HOME", savedHome.c_str(), 1);
+    else
+        ::unsetenv("HOME");
+    if (!savedCache.empty())
+        ::setenv("RTLAB_CACHE_DIR", savedCache.c_str(), 1);
+}
+
+TEST(ReferencePipeline, ExrRoundTripIsExact)
+{
+    const Room room;
+    const std::string dir = test::makeTemporaryFolder("exr");
+    for (Quantity q : {Quantity::Ao, Quantity::Obscurance, Quantity::Bent, Quantity::Direct}) {
+        ReferenceSettings s = makeQuickSettings(q);
+        s.maxSamples = 64;
+        const ReferenceResult r = computeReference(room.scene, room.gbuffer, s);
+        writeReferenceExr(r, dir);
+        const std::string name = getQuantityName(q);
+        EXPECT_TRUE(std::filesystem::exists(dir + "/" + name + ".exr"));
+        EXPECT_TRUE(std::filesystem::exists(dir + "/" + name + "_stderr.exr"));
+        const ReferenceResult back = readReferenceExr(dir, q);
+        SCOPED_TRACE(name);
+        EXPECT_EQ(back.width, r.width);
+        EXPECT_EQ(back.height, r.height);
+        expectIdentical(r, back);
+        EXPECT_EQ(back.settings.radius, s.radius);
+        EXPECT_EQ(back.settings.falloff, s.falloff);
+        EXPECT_EQ(back.settings.maxSamples, s.maxSamples);
+        EXPECT_EQ(back.stats.rayCount, r.stats.rayCount);
+        EXPECT_EQ(back.stats.rayEpsilon, r.stats.rayEpsilon);
+    }
+    // An infinite radius reads back as infinity.
+    ReferenceSettings s = makeQuickSettings(Quantity::Ao);
+    s.radius = std::numeric_limits<double>::infinity();
+    s.maxSamples = 32;
+    writeReferenceExr(computeReference(room.scene, room.gbuffer, s), dir);
+    EXPECT_TRUE(std::isinf(readReferenceExr(dir, Quantity::Ao).settings.radius));
+    EXPECT_THROW(readReferenceExr(dir, Quantity::Full), Error); // never written
+    std::filesystem::remove_all(dir);
+}
+
+TEST(ReferencePipeline, BadInputIsAClearError)
+{
+    const Room room;
+    const ReferenceSettings s = makeQuickSettings(Quantity::Ao);
+    auto expectError = [&](const scene::RenderScene& sc, const scene::GBuffer& g,
+                           const ReferenceSettings& settings, const std::string& part) {
+        try {
+            computeReference(sc, g, settings);
+            ADD_FAILURE() << "no error; expected one mentioning '" << part << "'";
+        } catch (const Error& e) {
+            EXPECT_THAT(e.what(), HasSubstr(part));
+        }
+    };
+
+    scene::GBuffer g = room.gbuffer;
+    g.normal = Image<glm::vec3>(8, 16);
+    expectError(room.scene, g, s, "G-buffer image 'normal' is 8x16");
+    g = room.gbuffer;
+    g.materialId.pixels.pop_back();
+    expectError(room.scene, g, s, "'materialId'");
+    g = room.gbuffer;
+    g.width = 0;
+    expectError(room.scene, g, s, "G-buffer is empty");
+
+    expectError(scene::RenderScene{}, room.gbuffer, s, "no triangles");
+    scene::RenderScene broken = room.scene;
+    broken.triangleMaterial.pop_back();
+    expectError(broken, room.gbuffer, s, "triangle materials");
+    broken = room.scene;
+    broken.indices[4] = 100000;
+    expectError(broken, room.gbuffer, s, "index 4");
+
+    ReferenceSettings bad = s;
+    bad.quantity = Quantity::Obscurance;
+    bad.radius = std::numeric_limits<double>::infinity();
+    expectError(room.scene, room.gbuffer, bad, "finite radius");
+    bad = s;
+    bad.maxSamples = 8;
+    expectError(room.scene, room.gbuffer, bad, "maxSamples");
+    bad = s;
+    bad.radius = -1.0;
+    expectError(room.scene, room.gbuffer, bad, "radius");
+    EXPECT_THROW(parseQuantity("occlusion"), Error);
+    EXPECT_EQ(parseQuantity("ao_uniform"), Quantity::AoUniform);
+    for (Quantity q : getAllQuantities())
+        EXPECT_EQ(parseQuantity(getQuantityName(q)), q);
+}
+
+TEST(ReferencePipeline, ThroughputReportsBothRates)
+{
+    const Room room;
+    ReferenceSettings s = makeQuickSettings(Quantity::Ao);
+    const RayThroughput t = measureRayThroughput(room.scene, room.gbuffer, s, 16);
+    EXPECT_EQ(t.referenceRays, t.rawRays); // cosine AO: one ray per sample, same rays
+    EXPECT_GT(t.referenceMraysPerSecond, 0.0);
+    EXPECT_GT(t.rawIntersectMraysPerSecond, 0.0);
+    EXPECT_GT(t.rawOccludedMraysPerSecond, 0.0);
+}
+
+} // namespace
+} // namespace rtlab::reference
