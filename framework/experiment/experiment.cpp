@@ -7,6 +7,7 @@
 #include "plugin/technique.h"
 #include "scene/sdf_shapes.h"
 
+#include <algorithm>
 #include <filesystem>
 
 namespace rtlab::experiment {
@@ -172,30 +173,79 @@ struct Loader {
         if (!sweep.IsMap())
             file.fail(sweep, "sweep: expected a mapping from axis to a list of values, found " +
                                  config::describeNode(sweep));
-        // Technique axes first, so parameter axes meet the technique they belong to.
-        std::vector<std::pair<YAML::Node, YAML::Node>> axes;
-        for (const auto& kv : sweep)
-            if (kv.first.Scalar().ends_with(".technique"))
-                axes.emplace_back(kv.first, kv.second);
-        for (const auto& kv : sweep)
-            if (!kv.first.Scalar().ends_with(".technique"))
-                axes.emplace_back(kv.first, kv.second);
-        for (const auto& [keyNode, values] : axes) {
-            const std::string key = keyNode.Scalar();
-            keys.push_back(key);
+        // An axis of the cross product: one key, or a zip group of keys whose lists move
+        // together (value i of every key in the group goes into the same run).
+        struct Axis {
+            std::vector<std::pair<YAML::Node, YAML::Node>> keys;  // (key node, list of values)
+            std::size_t size = 0;
+            bool switchesTechnique = false;
+        };
+        auto checkList = [&](const YAML::Node& keyNode, const YAML::Node& values) {
             if (!values.IsSequence() || values.size() == 0)
-                file.fail(values, "sweep: axis '" + key + "' needs a non-empty list of values, found " +
+                file.fail(values, "sweep: axis '" + keyNode.Scalar() + "' needs a non-empty list of values, found " +
                                       config::describeNode(values));
+        };
+        std::vector<Axis> axes;
+        for (const auto& kv : sweep) {
+            const std::string key = kv.first.Scalar();
+            if (key != "zip") {
+                checkList(kv.first, kv.second);
+                axes.push_back({{{kv.first, kv.second}}, kv.second.size(), key.ends_with(".technique")});
+                continue;
+            }
+            if (!kv.second.IsSequence() || kv.second.size() == 0)
+                file.fail(kv.second, "sweep: zip: expected a list of groups, each a mapping from axis to "
+                                     "lists of equal length, found " + config::describeNode(kv.second));
+            for (const auto& group : kv.second) {
+                if (!group.IsMap() || group.size() < 2)
+                    file.fail(group, "sweep: zip: a group needs a mapping of at least two axes whose values "
+                                     "move together, found " + config::describeNode(group));
+                Axis axis;
+                for (const auto& member : group) {
+                    if (member.first.Scalar() == "zip")
+                        file.fail(member.first, "sweep: zip groups cannot be nested");
+                    checkList(member.first, member.second);
+                    if (axis.size != 0 && member.second.size() != axis.size)
+                        file.fail(member.second, "sweep: zip: '" + member.first.Scalar() + "' has " +
+                                                     std::to_string(member.second.size()) + " values but '" +
+                                                     axis.keys.front().first.Scalar() + "' has " +
+                                                     std::to_string(axis.size) + "; zipped lists need equal lengths");
+                    axis.size = member.second.size();
+                    axis.switchesTechnique = axis.switchesTechnique || member.first.Scalar().ends_with(".technique");
+                    axis.keys.emplace_back(member.first, member.second);
+                }
+                axes.push_back(std::move(axis));
+            }
+        }
+        // Axes that switch techniques first (and technique keys first within a zip group), so
+        // parameter axes meet the technique they belong to. Orders are kept as indices: assigning
+        // a YAML::Node overwrites the node it refers to, so nodes are never swapped.
+        auto techniquesFirst = [](std::size_t n, auto isTechnique) {
+            std::vector<std::size_t> order(n);
+            for (std::size_t i = 0; i < n; ++i)
+                order[i] = i;
+            std::stable_partition(order.begin(), order.end(), isTechnique);
+            return order;
+        };
+        for (std::size_t a : techniquesFirst(axes.size(), [&](std::size_t i) { return axes[i].switchesTechnique; })) {
+            const Axis& axis = axes[a];
+            const auto keyOrder = techniquesFirst(
+                axis.keys.size(), [&](std::size_t i) { return axis.keys[i].first.Scalar().ends_with(".technique"); });
+            std::string name;
+            for (const auto& [keyNode, values] : axis.keys)
+                name += (name.empty() ? "" : "+") + keyNode.Scalar();
+            keys.push_back(axis.keys.size() > 1 ? "zip(" + name + ")" : name);
             std::vector<RunConfig> next;
             for (const auto& run : runs)
-                for (const auto& value : values) {
+                for (std::size_t i = 0; i < axis.size; ++i) {
                     RunConfig r = run;
-                    applyAxis(key, keyNode, value, base, r);
+                    for (std::size_t k : keyOrder)
+                        applyAxis(axis.keys[k].first.Scalar(), axis.keys[k].first, axis.keys[k].second[i], base, r);
                     next.push_back(std::move(r));
                 }
             runs = std::move(next);
             if (runs.size() > 100000)
-                file.fail(keyNode, "sweep: the cross product exceeds 100000 runs");
+                file.fail(axis.keys.front().first, "sweep: the cross product exceeds 100000 runs");
         }
         std::map<std::string, std::size_t> seen;
         for (std::size_t i = 0; i < runs.size(); ++i)

@@ -114,3 +114,34 @@ sweep:
 )");
     EXPECT_NE(err.find("are identical"), std::string::npos) << err;
 }
+
+TEST(Sweep, ZipMovesAxesTogether)
+{
+    const auto registry = test::makeTestRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: sphere
+  techniques: {isosurface: {technique: fake_mesher}}
+sweep:
+  scene: [sphere, box]
+  zip:
+    - {grid: [8, 16, 32], isosurface.resolution: [2, 4, 8]}
+)",
+                                               "zip.yaml", registry);
+    ASSERT_EQ(e.runs.size(), 2u * 3u);  // not 2 x 3 x 3
+    for (const auto& r : e.runs)
+        EXPECT_EQ(r.techniques.at("isosurface").params.getInt("resolution") * 4, r.grid);
+    EXPECT_EQ(e.sweepKeys, (std::vector<std::string>{"scene", "zip(grid+isosurface.resolution)"}));
+}
+
+TEST(Sweep, ZipListsMustHaveEqualLengths)
+{
+    const std::string err = errorOf(R"(base:
+  scene: sphere
+  techniques: {isosurface: {technique: fake_mesher}}
+sweep:
+  zip:
+    - {grid: [8, 16, 32], isosurface.resolution: [2, 4]}
+)");
+    EXPECT_NE(err.find("sweep.yaml:6:50:"), std::string::npos) << err;
+    EXPECT_NE(err.find("has 2 values but 'grid' has 3"), std::string::npos) << err;
+}
