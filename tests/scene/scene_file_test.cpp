@@ -135,3 +135,18 @@ TEST(SceneFile, LoadsMeshesRelativeToTheSceneFile)
     EXPECT_EQ(s.meshes[0].triangleMaterial[0], 0u);
     EXPECT_EQ(loadScene("cornell_box").name, "cornell_box");
 }
+
+TEST(SceneFile, EveryShippedSceneFileLoadsAndBuilds)
+{
+    // The scene files under scenes/ are part of the product: each must load and build every frame.
+    int count = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(RTLAB_SOURCE_DIR) / "scenes")) {
+        if (entry.path().extension() != ".yaml")
+            continue;
+        const Scene s = loadScene(entry.path().string());
+        for (int frame = 0; frame < s.frameCount; ++frame)
+            EXPECT_GT(s.buildRenderScene(frame).triangleCount(), 0u) << entry.path() << " frame " << frame;
+        ++count;
+    }
+    EXPECT_GE(count, 1);
+}
