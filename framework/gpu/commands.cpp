@@ -459,7 +459,15 @@ RunResult Context::run(const std::function<void(CommandList&)>& record)
     if (count > 0)
         result.gpuTotalMs =
             convertTicksToMs(ticks[0], ticks[2 * count - 1], bits, info.timestampPeriodNs);
+    run.log.insert(run.log.end(), result.commands.begin(), result.commands.end());
     return result;
+}
+
+std::vector<CommandTime> Context::takeRunLog()
+{
+    std::vector<CommandTime> log;
+    log.swap(mRun->log);
+    return log;
 }
 
 } // namespace rtlab::gpu

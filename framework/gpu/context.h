@@ -160,6 +160,10 @@ public:
     //! Consecutive commands are separated by full memory barriers. Exceptions thrown while
     //! recording propagate and nothing is submitted.
     RunResult run(const std::function<void(CommandList&)>& record);
+    //! Every command timed by run() since the last call, oldest first, and clears the list.
+    //! The timing harness reads it around a technique's work, so techniques never report their
+    //! own GPU time.
+    std::vector<CommandTime> takeRunLog();
 
     //! Waits until the device is idle.
     void waitIdle();

@@ -190,6 +190,7 @@ struct RunState {
     std::uint32_t storageBufferCapacity = 0;
     std::uint32_t storageImageCapacity = 0;
     std::uint32_t sampledImageCapacity = 0;
+    std::vector<CommandTime> log;  //!< every command timed since the last takeRunLog()
 
     explicit RunState(std::shared_ptr<DeviceState> owner);
     RunState(const RunState&) = delete;

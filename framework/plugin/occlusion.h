@@ -12,6 +12,10 @@
 #include <array>
 #include <string>
 
+namespace rtlab::gpu {
+class Context;
+}
+
 namespace rtlab::plugin {
 
 //! Which integral a technique estimates; the ground truth integrates the same one.
@@ -21,24 +25,41 @@ enum class OcclusionQuantity {
     Obscurance,  //!< cosine-weighted, occluders at distance d weighted by falloff(d / radius)
 };
 
+//! Obscurance falloff rho(x), x = distance / radius: 1 (unoccluded) for x >= 1 and for no hit.
+enum class OcclusionFalloff {
+    Linear,      //!< rho(x) = x
+    Smoothstep,  //!< rho(x) = 3x^2 - 2x^3
+};
+
 struct OcclusionDefinition {
     OcclusionQuantity quantity = OcclusionQuantity::CosineAo;
     double radius = 1.0;  //!< world units; occluders farther than this do not count
+    OcclusionFalloff falloff = OcclusionFalloff::Linear;  //!< Obscurance only
 };
 
-//! A view of the G-buffer. View space: camera at the origin looking down -z.
+//! A view of the G-buffer. View space: camera at the origin looking down -z, y up, x right; row 0
+//! of the images is the top of the screen.
 struct OcclusionInput {
     const Image<float>* linearDepth = nullptr;  //!< view-space distance along -z, world units; inf = sky
-    const Image<glm::vec3>* normal = nullptr;   //!< view-space unit normals (zero where no surface)
-    glm::mat4 projection{1.0f};                 //!< view -> clip
+    const Image<glm::vec3>* normal = nullptr;   //!< view-space unit normals facing the camera (zero where no surface)
+    glm::mat4 projection{1.0f};                 //!< view -> Vulkan clip space (gbuffer.h), jitter included
+    glm::mat4 view{1.0f};                       //!< world -> view (to bring world directions, e.g. the 16 cones, to view space)
     int frameIndex = 0;                          //!< for techniques that rotate samples over frames
+    //! The Vulkan device to run on. Null: run the plain C++ version (parity tests, CPU studies).
+    //! GPU work goes through gpu::Context::run with labelled dispatches; the harness reads their
+    //! timestamps from the context's run log, so a technique never reports its own time.
+    gpu::Context* gpu = nullptr;
 };
 
 struct OcclusionOutput {
-    Image<float> ambient;            //!< AO or obscurance in [0, 1], 1 = unoccluded
-    Image<glm::vec3> bentNormal;     //!< view space, unit length
-    Image<float> coneAperture;       //!< half-angle in radians, [0, pi/2]
-    std::vector<Image<float>> coneVisibility;  //!< optional: per fixed cone direction, in [0, 1]
+    Image<float> ambient;            //!< AO or obscurance in [0, 1], 1 = unoccluded; 1 where no surface
+    Image<glm::vec3> bentNormal;     //!< view space, unit length; zero where no surface
+    //! Half-angle in radians, [0, pi/2], in the cosine convention of the ground truth:
+    //! sin^2(aperture) = cosine-weighted visible fraction (reference.h, "bent").
+    Image<float> coneAperture;
+    //! Optional: visibility in [0, 1] of each of the 16 fixed cone directions (scene/sky.h,
+    //! world space), in that order; empty when the technique does not produce it.
+    std::vector<Image<float>> coneVisibility;
 };
 
 class OcclusionTechnique : public Technique {

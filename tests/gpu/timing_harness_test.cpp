@@ -18,11 +18,12 @@ struct SaxpyParams {
     std::uint32_t count;
 };
 
-// Per-label GPU time of one submission, in the harness's form.
-metrics::GpuPassTimes collectPassTimes(const RunResult& run)
+// Per-label GPU time of everything the context ran since the last call, in the harness's form:
+// the harness reads the context's log, the work itself reports nothing.
+metrics::GpuPassTimes collectPassTimes(Context& context)
 {
     metrics::GpuPassTimes times;
-    for (const auto& c : run.commands)
+    for (const auto& c : context.takeRunLog())
         if (c.gpuMs)
             times[c.label] += *c.gpuMs;
     return times;
@@ -45,13 +46,13 @@ TEST_F(TimingHarnessTest, SeparatesCompilationFirstUseAndRepeats)
         [&] {
             ++submissions;
             const SaxpyParams params{2.0f, kCount};
-            const RunResult run = getContext().run([&](CommandList& cmd) {
+            getContext().run([&](CommandList& cmd) {
                 cmd.dispatch(*saxpy, {Binding::storageBuffer(0, x), Binding::storageBuffer(1, y)},
                              PushConstants(params), GroupCount{computeGroupCount(kCount, 64)}, "saxpy");
                 cmd.dispatch(*saxpy, {Binding::storageBuffer(0, x), Binding::storageBuffer(1, y)},
                              PushConstants(params), GroupCount{computeGroupCount(kCount, 64)}, "saxpy_again");
             });
-            return collectPassTimes(run);
+            return collectPassTimes(getContext());
         },
         // Setup: compiling the shader and creating the pipeline, timed apart from the work.
         [&] {
@@ -77,6 +78,7 @@ TEST_F(TimingHarnessTest, SeparatesCompilationFirstUseAndRepeats)
     EXPECT_LE(report.gpuTotalMedianMs(), report.cpuMs.max) << "GPU time must fit in the CPU wall time";
     // 9 submissions of y += 2 * x twice, on x = 1.
     EXPECT_EQ(y.downloadVector<float>(1)[0], 36.0f);
+    EXPECT_TRUE(getContext().takeRunLog().empty());  // the log was emptied by every read
 }
 
 } // namespace
