@@ -5,9 +5,11 @@
 #include "core/json.h"
 #include "core/strings.h"
 #include "plugin/technique.h"
+#include "scene/procedural.h"
 #include "scene/sdf_shapes.h"
 
 #include <algorithm>
+#include <climits>
 #include <filesystem>
 
 namespace rtlab::experiment {
@@ -25,6 +27,15 @@ std::string RunConfig::toJson() const
     return JsonObject()
         .add("scene", scene)
         .add("grid", grid)
+        .add("width", width)
+        .add("height", height)
+        .add("frames", frames)
+        .addRaw("reference", JsonObject()
+                                 .add("target_stderr", reference.targetStdErr)
+                                 .add("target_rel_stderr", reference.targetRelStdErr)
+                                 .add("max_samples", reference.maxSamples)
+                                 .add("seed", std::int64_t(reference.seed))
+                                 .str())
         .addRaw("timing", JsonObject().add("warmup", timing.warmup).add("repeats", timing.repeats).str())
         .addRaw("techniques", techniquesJson.str())
         .str();
@@ -37,7 +48,10 @@ std::string RunConfig::hash() const
 
 std::string RunConfig::id() const
 {
-    std::string s = scene + "-g" + std::to_string(grid);
+    const bool screenSpace = !techniques.count("isosurface");
+    std::string s = std::filesystem::path(scene).stem().string() +
+                    (screenSpace ? "-" + std::to_string(width) + "x" + std::to_string(height)
+                                 : "-g" + std::to_string(grid));
     for (const auto& [family, choice] : techniques)
         s += "-" + choice.technique;
     return s + "-" + hash().substr(0, 8);
@@ -63,7 +77,46 @@ struct Loader {
     void readScene(const YAML::Node& node, RunConfig& run) const
     {
         run.scene = config::readString(file, node, "scene");
-        config::checkName(file, node, run.scene, scene::analyticShapeNames(), "scene");
+        if (run.scene.ends_with(".yaml") || run.scene.ends_with(".yml")) {
+            // Scene files resolve against the experiment file's folder, then the working folder.
+            const auto beside = std::filesystem::path(file.path()).parent_path() / run.scene;
+            if (std::filesystem::exists(beside))
+                run.scene = beside.lexically_normal().string();
+            else if (!std::filesystem::exists(run.scene))
+                file.fail(node, "scene file '" + run.scene + "' does not exist (looked beside " + file.path() +
+                                    " and in the working folder)");
+            return;
+        }
+        std::vector<std::string> names = scene::analyticShapeNames();
+        for (const auto& n : scene::getProceduralSceneNames())
+            names.push_back(n);
+        config::checkName(file, node, run.scene, names, "scene");
+    }
+
+    void readResolution(const YAML::Node& node, RunConfig& run) const
+    {
+        if (!node.IsSequence() || node.size() != 2)
+            file.fail(node, "resolution: expected [width, height] in pixels, found " + config::describeNode(node));
+        run.width = int(config::readInt(file, node[0], "resolution width", 1, 8192));
+        run.height = int(config::readInt(file, node[1], "resolution height", 1, 8192));
+    }
+
+    void readReference(const YAML::Node& node, RunConfig& run) const
+    {
+        config::checkKeys(file, node, {"target_stderr", "target_rel_stderr", "max_samples", "seed"}, {}, "reference");
+        auto positive = [&](const char* key, double& out) {
+            if (!node[key])
+                return;
+            out = config::readFloat(file, node[key], std::string("reference.") + key);
+            if (!(out >= 0.0))
+                file.fail(node[key], std::string("reference.") + key + ": expected a number >= 0");
+        };
+        positive("target_stderr", run.reference.targetStdErr);
+        positive("target_rel_stderr", run.reference.targetRelStdErr);
+        if (node["max_samples"])
+            run.reference.maxSamples = int(config::readInt(file, node["max_samples"], "reference.max_samples", 1, 1 << 24));
+        if (node["seed"])
+            run.reference.seed = std::uint64_t(config::readInt(file, node["seed"], "reference.seed", 0, INT64_MAX));
     }
 
     void readGrid(const YAML::Node& node, RunConfig& run) const
@@ -104,12 +157,18 @@ struct Loader {
 
     RunConfig readBase(const YAML::Node& node) const
     {
-        config::checkKeys(file, node, {"scene", "grid", "timing", "techniques"}, {"scene", "techniques"},
-                          "base");
+        config::checkKeys(file, node, {"scene", "grid", "resolution", "frames", "timing", "reference", "techniques"},
+                          {"scene", "techniques"}, "base");
         RunConfig run;
         readScene(node["scene"], run);
         if (node["grid"])
             readGrid(node["grid"], run);
+        if (node["resolution"])
+            readResolution(node["resolution"], run);
+        if (node["frames"])
+            run.frames = int(config::readInt(file, node["frames"], "frames", 1, 100000));
+        if (node["reference"])
+            readReference(node["reference"], run);
         if (node["timing"])
             readTiming(node["timing"], run);
         readTechniques(node["techniques"], run);
@@ -126,10 +185,16 @@ struct Loader {
             return readScene(value, run);
         if (key == "grid")
             return readGrid(value, run);
+        if (key == "resolution")
+            return readResolution(value, run);
+        if (key == "frames") {
+            run.frames = int(config::readInt(file, value, "frames", 1, 100000));
+            return;
+        }
         const auto dot = key.find('.');
         if (dot == std::string::npos)
-            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, "
-                               "<family>.technique, <family>.<parameter>");
+            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, resolution, frames, "
+                               "<family>.technique, <family>.<parameter>, zip");
         const std::string family = key.substr(0, dot);
         const std::string field = key.substr(dot + 1);
         config::checkName(file, keyNode, family, registry.familyNames(), "technique family");

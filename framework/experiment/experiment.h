@@ -6,8 +6,12 @@
 //   name: smoke
 //   description: marching cubes on analytic shapes
 //   base:
-//     scene: sphere                     # an analytic shape (scene::analyticShapes)
-//     grid: 48                          # SDF samples per axis
+//     scene: sphere                     # an analytic shape (isosurface), a procedural scene
+//                                       # (cornell_box, ...) or a scene file (.yaml)
+//     grid: 48                          # SDF samples per axis (isosurface)
+//     resolution: [320, 180]            # image size (screen-space families)
+//     frames: 1                         # frames of the scene's animation, from frame 0
+//     reference: {target_stderr: 0.01, target_rel_stderr: 0.02, max_samples: 1024, seed: 0}
 //     timing: {warmup: 1, repeats: 5}
 //     techniques:
 //       isosurface: {technique: marching_cubes, params: {vertex_placement: linear}}
@@ -20,6 +24,7 @@
 #include "config/param.h"
 #include "metrics/timing.h"
 
+#include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
@@ -36,11 +41,23 @@ struct TechniqueChoice {
     config::ParamSet params;
 };
 
+//! How the ground truth of screen-space families is computed (reference/reference.h).
+struct ReferenceOptions {
+    double targetStdErr = 0.01;     //!< absolute per-pixel standard error to reach
+    double targetRelStdErr = 0.02;  //!< relative part of the stopping rule
+    int maxSamples = 1024;          //!< per pixel
+    std::uint64_t seed = 0;
+};
+
 //! One fully expanded run.
 struct RunConfig {
-    std::string scene;
-    int grid = 64;                                     //!< samples per axis (isosurface)
+    std::string scene;             //!< analytic shape, procedural scene, or scene file path
+    int grid = 64;                 //!< SDF samples per axis (isosurface)
+    int width = 320;               //!< image size in pixels (screen-space families)
+    int height = 180;
+    int frames = 1;                //!< frames 0..frames-1 of the scene's animation
     metrics::TimingOptions timing;
+    ReferenceOptions reference;
     std::map<std::string, TechniqueChoice> techniques;  //!< family -> choice
 
     //! Short readable id, unique within an experiment: "sphere-g48-marching_cubes-3f2a91c0".

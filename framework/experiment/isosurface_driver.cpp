@@ -39,9 +39,12 @@ plugin::SampledField sampleShape(const scene::AnalyticShape& shape, int grid)
 
 } // namespace
 
-void runIsosurfaceFamily(const RunConfig& run, const std::string& family, const plugin::Registry& registry,
-                         const std::string& runDirectory, ResultRow& row)
+std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::string& family,
+                                           DriverContext& context, const ResultRow& common)
 {
+    const plugin::Registry& registry = context.registry();
+    const std::string& runDirectory = context.runDirectory();
+    ResultRow row = common;
     const scene::AnalyticShape* shape = scene::findAnalyticShape(run.scene);
     if (!shape)
         throw Error("scene '" + run.scene + "' is not an analytic shape the isosurface family can use");
@@ -98,6 +101,7 @@ void runIsosurfaceFamily(const RunConfig& run, const std::string& family, const 
     const std::string meshPath = runDirectory + "/mesh.obj";
     writeObj(mesh, meshPath);
     row.set("mesh_file", meshPath);
+    return {row};
 }
 
 } // namespace rtlab::experiment

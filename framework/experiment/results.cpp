@@ -129,7 +129,14 @@ std::set<std::string> ResultsStore::completedHashes() const
 
 void ResultsStore::append(const ResultRow& row)
 {
-    std::string line = row.toJson() + "\n";
+    append(std::vector<ResultRow>{row});
+}
+
+void ResultsStore::append(const std::vector<ResultRow>& rows)
+{
+    std::string line;
+    for (const auto& row : rows)
+        line += row.toJson() + "\n";
     const int fd = ::open(jsonlPath().c_str(), O_RDWR | O_APPEND | O_CREAT | O_CLOEXEC, 0644);
     if (fd < 0)
         throw Error(jsonlPath() + ": cannot open for appending");

@@ -38,6 +38,9 @@ public:
     std::set<std::string> completedHashes() const;
     //! Appends one row as a single line and flushes it to disk before returning.
     void append(const ResultRow& row);
+    //! Appends rows (e.g. every frame of a run) in one write, so a crash keeps all or none of
+    //! them (up to a torn last line, which readers skip).
+    void append(const std::vector<ResultRow>& rows);
     //! Rewrites results.csv from results.jsonl (union of columns in first-seen order), through a
     //! temporary file and a rename so that a reader never sees half a table. Returns row count.
     std::size_t writeCsv() const;

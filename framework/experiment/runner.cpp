@@ -4,6 +4,7 @@
 #include "core/json.h"
 #include "core/progress.h"
 #include "experiment/manifest.h"
+#include "gpu/context.h"
 #include "plugin/technique.h"
 
 #include <chrono>
@@ -20,8 +21,23 @@ const std::map<std::string, FamilyDriver>& familyDrivers()
 {
     static const std::map<std::string, FamilyDriver> drivers = {
         {"isosurface", &runIsosurfaceFamily},
+        {"occlusion", &runOcclusionFamily},
     };
     return drivers;
+}
+
+DriverContext::DriverContext(const plugin::Registry& registry, std::string runDirectory)
+    : mRegistry(registry), mRunDirectory(std::move(runDirectory))
+{
+}
+
+DriverContext::~DriverContext() = default;
+
+gpu::Context& DriverContext::getGpu()
+{
+    if (!mGpu)
+        mGpu = std::make_unique<gpu::Context>();
+    return *mGpu;
 }
 
 void addTimingColumns(ResultRow& row, const std::string& pass, const metrics::TimingReport& report)
@@ -71,6 +87,7 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
         progress = std::make_unique<Progress>("rtlab run " + experiment.name + (sharded ? " shard " + shard : ""),
                                               mine.size());
 
+    DriverContext context(registry, summary.outputDirectory);
     for (const RunConfig* runPtr : mine) {
         const RunConfig& run = *runPtr;
         const std::string hash = run.hash();
@@ -80,31 +97,36 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
                 progress->advance(1, run.id() + " (done before)");
             continue;
         }
-        ResultRow row;
-        row.set("experiment", experiment.name)
+        ResultRow common;
+        common.set("experiment", experiment.name)
             .set("shard", shard)
             .set("run_id", run.id())
             .set("config_hash", hash)
             .set("status", std::string("ok"))
             .set("error", std::string())
             .set("scene", run.scene)
-            .set("grid", std::int64_t(run.grid));
-        const std::string runDirectory = summary.outputDirectory + "/runs/" + run.id();
+            .set("grid", std::int64_t(run.grid))
+            .set("width", std::int64_t(run.width))
+            .set("height", std::int64_t(run.height));
+        context.setRunDirectory(summary.outputDirectory + "/runs/" + run.id());
+        std::vector<ResultRow> rows;
         try {
-            std::filesystem::create_directories(runDirectory);
+            std::filesystem::create_directories(context.runDirectory());
             for (const auto& [family, choice] : run.techniques) {
-                row.set("family", family).set("technique", choice.technique);
+                common.set("family", family).set("technique", choice.technique);
                 auto driver = familyDrivers().find(family);
                 if (driver == familyDrivers().end())
                     throw Error("family '" + family + "' cannot run in experiments yet (no driver)");
-                driver->second(run, family, registry, runDirectory, row);
+                for (auto& row : driver->second(run, family, context, common))
+                    rows.push_back(std::move(row));
             }
             ++summary.succeeded;
         } catch (const std::exception& e) {
-            row.set("status", std::string("failed")).set("error", std::string(e.what()));
+            rows.assign(1, common);
+            rows[0].set("status", std::string("failed")).set("error", std::string(e.what()));
             ++summary.failed;
         }
-        store.append(row);
+        store.append(rows);
         if (progress)
             progress->advance(1, run.id());
     }

@@ -7,10 +7,14 @@
 
 #include <functional>
 #include <map>
+#include <memory>
 #include <string>
 
 namespace rtlab::plugin {
 class Registry;
+}
+namespace rtlab::gpu {
+class Context;
 }
 
 namespace rtlab::experiment {
@@ -41,11 +45,27 @@ struct RunnerSummary {
     std::string outputDirectory;
 };
 
-//! Runs one family's part of a run and fills metric and timing columns of `row`.
-//! `runDirectory` receives the run's output files.
-using FamilyDriver = std::function<void(const RunConfig& run, const std::string& family,
-                                        const plugin::Registry& registry, const std::string& runDirectory,
-                                        ResultRow& row)>;
+//! What a family driver gets besides the run: the registry, the run's output folder, and the
+//! Vulkan device (opened on first use and shared by every run of the sweep).
+class DriverContext {
+public:
+    DriverContext(const plugin::Registry& registry, std::string runDirectory);
+    ~DriverContext();
+    const plugin::Registry& registry() const { return mRegistry; }
+    const std::string& runDirectory() const { return mRunDirectory; }
+    void setRunDirectory(std::string directory) { mRunDirectory = std::move(directory); }
+    gpu::Context& getGpu();
+
+private:
+    const plugin::Registry& mRegistry;
+    std::string mRunDirectory;
+    std::unique_ptr<gpu::Context> mGpu;
+};
+
+//! Runs one family's part of a run and returns its rows (one per frame), each a copy of
+//! `common` (ids, scene, config) with the family's metric and timing columns added.
+using FamilyDriver = std::function<std::vector<ResultRow>(const RunConfig& run, const std::string& family,
+                                                          DriverContext& context, const ResultRow& common)>;
 
 //! The drivers of the families that can run in experiments, by family name.
 const std::map<std::string, FamilyDriver>& familyDrivers();
@@ -55,8 +75,12 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
                             const RunnerOptions& options);
 
 //! The isosurface family's driver: samples the analytic shape, extracts, measures.
-void runIsosurfaceFamily(const RunConfig& run, const std::string& family, const plugin::Registry& registry,
-                         const std::string& runDirectory, ResultRow& row);
+std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::string& family,
+                                           DriverContext& context, const ResultRow& common);
+//! The occlusion family's driver: G-buffer on Vulkan, the technique, the Embree ground truth of
+//! the quantity it declares, image metrics, per-frame rows and images.
+std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::string& family,
+                                          DriverContext& context, const ResultRow& common);
 
 //! Adds the timing columns of one pass: <pass>.cpu_ms (median), <pass>.cpu_ms_iqr,
 //! <pass>.first_use_ms, <pass>.setup_ms, and <pass>.gpu_ms when it ran GPU work.

@@ -1,0 +1,20 @@
+#pragma once
+// Per-run images for looking (PNG, 8-bit, tone-mapped by the report) and for numbers (EXR,
+// float32, exactly the values the metrics saw).
+
+#include "core/image.h"
+
+#include <glm/vec3.hpp>
+
+#include <string>
+
+namespace rtlab::experiment {
+
+//! Writes a one-channel float32 EXR. Throws rtlab::Error naming the path on failure.
+void writeExr(const Image<float>& image, const std::string& path);
+//! Writes an RGB float32 EXR.
+void writeExr(const Image<glm::vec3>& image, const std::string& path);
+//! Reads a one-channel EXR (the first channel).
+Image<float> readExrScalar(const std::string& path);
+
+} // namespace rtlab::experiment

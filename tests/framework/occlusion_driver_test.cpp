@@ -1,0 +1,106 @@
+// The occlusion family's experiment driver end to end on lavapipe: G-buffer, technique, Embree
+// ground truth of the declared quantity, metrics and images. The technique is a test double that
+// reports "no occlusion" (ambient 1), so its error against the ground truth is known: the mean
+// signed error is the mean occlusion of the reference, 1 - mean(reference AO).
+
+#include "experiment/analysis.h"
+#include "experiment/runner.h"
+#include "plugin/occlusion.h"
+#include "test_registry.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+using namespace rtlab;
+
+namespace {
+
+class Unoccluded final : public plugin::OcclusionTechnique {
+public:
+    static plugin::TechniqueInfo describe() { return {.summary = "test double: no occlusion anywhere"}; }
+    static config::ParamSchema declareParams()
+    {
+        config::ParamSchema s;
+        s.addFloat("radius", 0.5, 0.0, 100.0, "world units", "radius the ground truth uses");
+        return s;
+    }
+    explicit Unoccluded(const config::ParamSet& p) : mRadius(p.getFloat("radius")) {}
+    config::ParamSet effectiveParams() const override
+    {
+        config::ParamSet p;
+        p.set("radius", mRadius);
+        return p;
+    }
+    plugin::OcclusionDefinition definition() const override
+    {
+        return {plugin::OcclusionQuantity::CosineAo, mRadius};
+    }
+    void compute(const plugin::OcclusionInput& in, plugin::OcclusionOutput& out) override
+    {
+        out.ambient = Image<float>(in.normal->width, in.normal->height, 1.0f);
+        out.bentNormal = *in.normal;
+        out.coneAperture = Image<float>(in.normal->width, in.normal->height, 1.5707964f);
+    }
+
+private:
+    double mRadius;
+};
+
+} // namespace
+
+TEST(OcclusionDriver, RunsTheFramePipelineAgainstTheGroundTruth)
+{
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<Unoccluded>(registry, "occlusion", "unoccluded");
+    const auto e = experiment::parseExperiment(R"(name: occlusion_driver_test
+base:
+  scene: ao_testbed
+  resolution: [48, 32]
+  frames: 1
+  timing: {warmup: 0, repeats: 2}
+  reference: {target_stderr: 0.02, max_samples: 64}
+  techniques: {occlusion: {technique: unoccluded, params: {radius: 0.5}}}
+)",
+                                               "occlusion.yaml", registry);
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_test";
+    std::filesystem::remove_all(dir);
+    const auto s = experiment::runExperiment(
+        e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
+    const auto rows = experiment::loadResults(dir.string());
+    ASSERT_EQ(rows.size(), 1u);
+    const auto& row = rows[0];
+    ASSERT_EQ(s.failed, 0u) << row.at("error");
+    EXPECT_EQ(row.at("quantity"), "cosine_ao");
+    EXPECT_EQ(row.at("frame"), "0");
+    // Ambient 1 everywhere: the signed error is the reference's mean occlusion, positive, and the
+    // RMSE is at least its absolute value.
+    const double mse = experiment::getNumber(row, "ao.mean_signed_error");
+    const double rmse = experiment::getNumber(row, "ao.rmse");
+    EXPECT_GT(mse, 0.0);
+    EXPECT_GE(rmse, mse - 1e-12);
+    EXPECT_GT(experiment::getNumber(row, "ao.pixels"), 48 * 32 / 4);
+    EXPECT_GT(experiment::getNumber(row, "gbuffer.cpu_ms"), 0.0);
+    EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "bent.angle_error_deg")));
+    EXPECT_TRUE(std::filesystem::exists(row.at("image.error")));
+    EXPECT_TRUE(std::filesystem::exists(row.at("image.reference")));
+    // The G-buffer draw's GPU time came from the timestamps, through the context's run log.
+    EXPECT_GT(experiment::getNumber(row, "gbuffer.gpu_ms"), 0.0);
+}
+
+TEST(OcclusionDriver, AnAnalyticShapeIsARecordedFailure)
+{
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<Unoccluded>(registry, "occlusion", "unoccluded");
+    const auto e = experiment::parseExperiment(
+        "base: {scene: sphere, techniques: {occlusion: {technique: unoccluded}}}\n", "bad.yaml", registry);
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_bad";
+    std::filesystem::remove_all(dir);
+    const auto s = experiment::runExperiment(
+        e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
+    EXPECT_EQ(s.failed, 1u);
+    const auto rows = experiment::loadResults(dir.string());
+    ASSERT_EQ(rows.size(), 1u);
+    EXPECT_NE(rows[0].at("error").find("analytic shape"), std::string::npos) << rows[0].at("error");
+}
