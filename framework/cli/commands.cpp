@@ -7,6 +7,7 @@
 #include "experiment/experiment.h"
 #include "experiment/runner.h"
 #include "plugin/technique.h"
+#include "report/report.h"
 
 #include <fmt/core.h>
 
@@ -148,6 +149,8 @@ int runExperimentCommand(const RunOptions& options)
                options.shard.empty() ? "" : " in shard " + options.shard,
                summary.succeeded, summary.alreadyDone, summary.failed);
     fmt::print("results: {}/results.csv (and results.jsonl, manifest.json)\n", summary.outputDirectory);
+    if (options.report && summary.succeeded + summary.alreadyDone > 0 && reportCommand(summary.outputDirectory) != kExitOk)
+        return kExitFailed;
     if (summary.failed > 0) {
         fmt::print(stderr, "{} run(s) failed; their errors are in the 'error' column of the results.\n",
                    summary.failed);
@@ -228,6 +231,20 @@ int newTechnique(const NewTechniqueOptions& options)
                "      its unit test runs as ctest -R {}_{}\n",
                options.family, options.family, options.name);
     return kExitOk;
+}
+
+// ------------------------------------------------------------------------------------- report
+
+int reportCommand(const std::string& resultsDirectory)
+{
+    try {
+        const report::ReportSummary s = report::writeStudyReport(resultsDirectory);
+        fmt::print("report: {} ({} plots in {}/plots, each .png and .pdf)\n", s.html, s.plots.size(), resultsDirectory);
+        return kExitOk;
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "rtlab report: {}\n", e.what());
+        return kExitFailed;
+    }
 }
 
 // -------------------------------------------------------------------------------- merge, best

@@ -25,7 +25,11 @@ struct RunOptions {
     std::string outputDirectory;
     bool dryRun = false;
     std::string shard;  //!< "i/N" or empty
+    bool report = true; //!< write plots and report.html after the runs
 };
+
+//! Writes the plots and report.html of a results folder.
+int reportCommand(const std::string& resultsDirectory);
 int runExperimentCommand(const RunOptions& options);
 
 struct NewTechniqueOptions {

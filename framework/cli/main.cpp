@@ -28,6 +28,14 @@ int main(int argc, char** argv)
                        "Run slice i of N of the sweep (runs k with k mod N = i-1), e.g. 2/4; "
                        "default output results/<name>/shard-i-of-N");
 
+    runCmd->add_flag("!--no-report", run.report, "Do not write plots and report.html after the runs");
+
+    std::string reportDirectory;
+    auto* reportCmd = app.add_subcommand("report", "Write the plots and report.html of a results folder");
+    reportCmd->add_option("results", reportDirectory, "A results folder (with results.jsonl)")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+
     MergeOptions merge;
     auto* mergeCmd = app.add_subcommand("merge", "Join the results of shard folders into one folder");
     mergeCmd->add_option("-o,--output", merge.outputDirectory, "Folder for the joined results")->required();
@@ -111,6 +119,8 @@ int main(int argc, char** argv)
         return newTechnique(scaffold);
     if (*gpuCmd)
         return gpuSmoke(gpu);
+    if (*reportCmd)
+        return reportCommand(reportDirectory);
     if (*refCmd)
         return referenceCommand(ref);
     if (*mergeCmd)

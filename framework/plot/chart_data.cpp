@@ -1,0 +1,94 @@
+// The data side of the charts: Pareto fronts, colours, axis scales. No VTK here.
+
+#include "plot/charts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace rtlab::plot {
+
+std::vector<std::size_t> findParetoFront(const std::vector<double>& x, const std::vector<double>& y)
+{
+    std::vector<std::size_t> candidates;
+    for (std::size_t i = 0; i < std::min(x.size(), y.size()); ++i)
+        if (std::isfinite(x[i]) && std::isfinite(y[i]))
+            candidates.push_back(i);
+    std::sort(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) {
+        return x[a] != x[b] ? x[a] < x[b] : y[a] < y[b];
+    });
+    std::vector<std::size_t> front;
+    double bestY = std::numeric_limits<double>::infinity();
+    for (std::size_t i : candidates) {
+        if (y[i] < bestY) {
+            front.push_back(i);
+            bestY = y[i];
+        }
+    }
+    return front;
+}
+
+std::vector<Color> getSeriesColors(const std::vector<Series>& series, const ColorTable& colors)
+{
+    ColorTable table = colors;
+    std::vector<Color> result;
+    for (const auto& s : series)
+        result.push_back(table.getColor(s.label));
+    return result;
+}
+
+bool isLogAxis(AxisScale scale, const std::vector<double>& values)
+{
+    if (scale != AxisScale::Automatic)
+        return scale == AxisScale::Log;
+    double lo = std::numeric_limits<double>::infinity();
+    double hi = -lo;
+    for (double v : values) {
+        if (!std::isfinite(v))
+            continue;
+        if (v <= 0)
+            return false;
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+    }
+    return lo <= hi && hi / lo >= kAutoLogRatio;
+}
+
+std::vector<ParetoFrontLine> computeParetoFronts(const ScatterSpec& spec)
+{
+    std::vector<double> allX, allY;
+    for (const auto& s : spec.series) {
+        allX.insert(allX.end(), s.x.begin(), s.x.end());
+        allY.insert(allY.end(), s.y.begin(), s.y.end());
+    }
+    const bool logX = isLogAxis(spec.xScale, allX);
+    const bool logY = isLogAxis(spec.yScale, allY);
+    const auto colors = getSeriesColors(spec.series, spec.colors);
+
+    std::vector<ParetoFrontLine> fronts;
+    for (std::size_t s = 0; s < spec.series.size(); ++s) {
+        const Series& series = spec.series[s];
+        // What the axes cannot show does not take part.
+        std::vector<double> x = series.x, y = series.y;
+        y.resize(x.size(), std::numeric_limits<double>::quiet_NaN());
+        for (std::size_t i = 0; i < x.size(); ++i)
+            if ((logX && !(x[i] > 0)) || (logY && !(y[i] > 0)))
+                x[i] = std::numeric_limits<double>::quiet_NaN();
+        ParetoFrontLine line{s, series.label, colors[s], findParetoFront(x, y), {}, {}};
+        if (line.pointIndices.empty())
+            continue;
+        for (std::size_t k = 0; k < line.pointIndices.size(); ++k) {
+            const std::size_t i = line.pointIndices[k];
+            if (k > 0) { // horizontal to the next point's cost, then down to its error
+                line.stepX.push_back(x[i]);
+                line.stepY.push_back(line.stepY.back());
+            }
+            line.stepX.push_back(x[i]);
+            line.stepY.push_back(y[i]);
+        }
+        fronts.push_back(std::move(line));
+    }
+    return fronts;
+}
+
+} // namespace rtlab::plot

@@ -1,0 +1,18 @@
+#pragma once
+// Internal: building VTK tables for chart plots. VTK classes are only forward-declared here.
+
+#include <string>
+#include <vector>
+
+class vtkTable;
+
+namespace rtlab::plot::detail {
+
+//! A new table with double columns "x" and "y" (the caller owns the reference).
+vtkTable* makeXyTable(const std::vector<double>& x, const std::vector<double>& y);
+
+//! Throws rtlab::Error when a series' x, y and pointLabels lengths disagree.
+void checkSeriesLengths(const std::string& what, const std::string& label, std::size_t x,
+                        std::size_t y, std::size_t labels);
+
+} // namespace rtlab::plot::detail

@@ -1,0 +1,111 @@
+// report.html: one self-contained page (relative links only) that opens from disk.
+
+#include "report/report_detail.h"
+
+#include "core/error.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace rtlab::report::detail {
+
+namespace {
+
+std::string escapeHtml(const std::string& s)
+{
+    std::string out;
+    for (char c : s) {
+        switch (c) {
+        case '&': out += "&amp;"; break;
+        case '<': out += "&lt;"; break;
+        case '>': out += "&gt;"; break;
+        case '"': out += "&quot;"; break;
+        default: out += c;
+        }
+    }
+    return out;
+}
+
+std::string formatNumber(double v)
+{
+    if (!std::isfinite(v))
+        return "";
+    std::ostringstream s;
+    s.precision(4);
+    s << v;
+    return s.str();
+}
+
+std::string relativeTo(const std::string& path, const std::string& directory)
+{
+    return std::filesystem::relative(path, directory).generic_string();
+}
+
+} // namespace
+
+void writeHtml(const std::string& directory, const std::vector<Group>& groups, const std::vector<Figures>& figures,
+               const std::string& manifestJson)
+{
+    std::ostringstream h;
+    std::string title = std::filesystem::path(directory).filename().string();
+    h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escapeHtml(title)
+      << " - rtlab study</title>\n<style>\n"
+         "body{font-family:sans-serif;margin:2em auto;max-width:1200px;color:#222}\n"
+         "img{max-width:100%;border:1px solid #ddd}\nfigure{margin:1.5em 0}\n"
+         "figcaption{color:#555;font-size:0.9em}\n"
+         "table{border-collapse:collapse;font-size:0.85em}td,th{border:1px solid #ccc;padding:2px 6px;"
+         "text-align:right}th{background:#f3f3f3}\n.scroll{overflow-x:auto;max-height:30em}\n"
+         "pre{background:#f7f7f7;padding:1em;overflow-x:auto;font-size:0.8em}\n</style></head><body>\n";
+    h << "<h1>Study " << escapeHtml(title) << "</h1>\n";
+    h << "<p>Results table: <a href=\"results.csv\">results.csv</a> (and <a href=\"results.jsonl\">results.jsonl</a>); "
+         "what produced it: <a href=\"manifest.json\">manifest.json</a>. Every figure is also a vector PDF beside its "
+         "PNG.</p>\n";
+    h << "<ul>\n";
+    for (const auto& g : groups)
+        h << "<li><a href=\"#" << escapeHtml(g.key) << "\">" << escapeHtml(g.title) << "</a> (" << g.runs.size()
+          << " runs)</li>\n";
+    h << "</ul>\n";
+
+    for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+        const Group& g = groups[gi];
+        const FamilyColumns columns = getFamilyColumns(g.family);
+        h << "<h2 id=\"" << escapeHtml(g.key) << "\">" << escapeHtml(g.title) << "</h2>\n";
+        for (std::size_t i = 0; i < figures[gi].plots.size(); ++i) {
+            const std::string rel = relativeTo(figures[gi].plots[i], directory);
+            h << "<figure><img src=\"" << escapeHtml(rel) << ".png\" alt=\"" << escapeHtml(figures[gi].captions[i])
+              << "\"><figcaption>" << escapeHtml(figures[gi].captions[i]) << " <a href=\"" << escapeHtml(rel)
+              << ".pdf\">PDF</a></figcaption></figure>\n";
+        }
+        // The runs, sorted by error, with the columns a reader compares.
+        std::vector<const RunSummary*> runs;
+        for (const auto& r : g.runs)
+            runs.push_back(&r);
+        std::sort(runs.begin(), runs.end(), [&](const RunSummary* a, const RunSummary* b) {
+            return a->get(columns.error) < b->get(columns.error);
+        });
+        h << "<h3>Runs, most accurate first</h3>\n<div class=\"scroll\"><table><tr><th>run</th><th>technique</th>"
+             "<th>parameters</th><th>"
+          << escapeHtml(columns.cost) << "</th><th>" << escapeHtml(columns.error) << "</th><th>frames</th></tr>\n";
+        for (const RunSummary* r : runs)
+            h << "<tr><td>" << escapeHtml(r->runId) << "</td><td>" << escapeHtml(r->technique) << "</td><td>"
+              << escapeHtml(describeRun(*r, g.varyingParams)) << "</td><td>" << formatNumber(r->get(columns.cost))
+              << "</td><td>" << formatNumber(r->get(columns.error)) << "</td><td>" << r->frames.size()
+              << "</td></tr>\n";
+        h << "</table></div>\n";
+    }
+    h << "<h2>Manifest</h2>\n<pre>" << escapeHtml(manifestJson.substr(0, 20000)) << "</pre>\n</body></html>\n";
+
+    const std::string path = directory + "/report.html";
+    std::ofstream out(path + ".tmp", std::ios::trunc);
+    out << h.str();
+    out.close();
+    if (!out)
+        throw Error(path + ": cannot write");
+    std::filesystem::rename(path + ".tmp", path);
+}
+
+} // namespace rtlab::report::detail

@@ -1,0 +1,151 @@
+#include "report/report.h"
+
+#include "core/error.h"
+#include "core/strings.h"
+#include "report/report_detail.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <set>
+
+namespace rtlab::report {
+
+FamilyColumns getFamilyColumns(const std::string& family)
+{
+    if (family == "occlusion")
+        return {"occlusion.gpu_ms", "GPU time of the technique (ms, median)", "ao.rmse",
+                "RMSE against ground truth (AO / obscurance, unitless)", {"gbuffer.gpu_ms", "occlusion.gpu_ms"}};
+    if (family == "isosurface")
+        return {"extract.cpu_ms", "CPU time of the extraction (ms, median)", "rms_deviation",
+                "RMS distance to the true surface (world units)", {"sample_field.cpu_ms", "extract.cpu_ms"}};
+    throw Error("no report columns for family '" + family + "'");
+}
+
+namespace detail {
+
+double RunSummary::get(const std::string& column) const
+{
+    auto it = number.find(column);
+    return it == number.end() ? std::nan("") : it->second;
+}
+
+std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows)
+{
+    // Runs by id, frames together.
+    std::map<std::string, RunSummary> runs;
+    std::vector<std::string> order;
+    for (const auto& row : rows) {
+        auto status = row.find("status");
+        if (status == row.end() || status->second != "ok")
+            continue;
+        const std::string id = row.at("run_id");
+        auto [it, inserted] = runs.try_emplace(id);
+        if (inserted) {
+            it->second.runId = id;
+            it->second.technique = row.count("technique") ? row.at("technique") : "?";
+            order.push_back(id);
+        }
+        it->second.frames.push_back(row);
+    }
+    std::map<std::string, Group> groups;
+    std::vector<std::string> groupOrder;
+    for (const auto& id : order) {
+        RunSummary& run = runs[id];
+        std::map<std::string, std::pair<double, int>> sums;
+        for (const auto& frame : run.frames)
+            for (const auto& [k, v] : frame) {
+                const double x = experiment::getNumber(frame, k);
+                if (std::isfinite(x)) {
+                    sums[k].first += x;
+                    sums[k].second += 1;
+                } else if (!run.text.count(k)) {
+                    run.text[k] = v;
+                }
+            }
+        for (const auto& [k, s] : sums)
+            run.number[k] = s.first / s.second;
+        const std::string family = run.text.count("family") ? run.text["family"] : "?";
+        std::string scene = std::filesystem::path(run.text.count("scene") ? run.text["scene"] : "?").stem().string();
+        std::string key = scene, title = scene;
+        if (family != "isosurface") {
+            const std::string size = (run.text.count("width") ? run.text["width"]
+                                                               : std::to_string(int(run.get("width")))) +
+                                     "x" + std::to_string(int(run.get("height")));
+            key += "_" + size;
+            title += ", " + size;
+        }
+        key = family + "_" + key;
+        auto [git, added] = groups.try_emplace(key);
+        if (added) {
+            git->second.key = key;
+            git->second.title = family + ": " + title;
+            git->second.family = family;
+            groupOrder.push_back(key);
+        }
+        git->second.runs.push_back(run);
+    }
+    std::vector<Group> out;
+    for (const auto& key : groupOrder) {
+        Group g = groups[key];
+        std::map<std::string, std::set<std::string>> values;
+        for (const auto& run : g.runs)
+            for (const auto& frame : run.frames)
+                for (const auto& [k, v] : frame)
+                    if (k.rfind("param.", 0) == 0 || k == "grid")
+                        values[k].insert(v);
+        if (g.runs.size() > 1)
+            for (const auto& [k, vs] : values)
+                if (vs.size() > 1)
+                    g.varyingParams.push_back(k);
+        out.push_back(std::move(g));
+    }
+    return out;
+}
+
+std::string describeRun(const RunSummary& run, const std::vector<std::string>& varyingParams)
+{
+    std::string s;
+    const auto& first = run.frames.front();
+    for (const auto& p : varyingParams) {
+        auto it = first.find(p);
+        if (it == first.end())
+            continue;
+        s += (s.empty() ? "" : " ") + (p.rfind("param.", 0) == 0 ? p.substr(6) : p) + "=" + it->second;
+    }
+    return s;
+}
+
+} // namespace detail
+
+ReportSummary writeStudyReport(const std::string& directory)
+{
+    const auto rows = experiment::loadResults(directory);
+    if (rows.empty())
+        throw Error(directory + ": no results (results.jsonl is missing or empty)");
+    const auto groups = detail::groupRuns(rows);
+    std::set<std::string> techniqueSet;
+    for (const auto& g : groups)
+        for (const auto& r : g.runs)
+            techniqueSet.insert(r.technique);
+    const std::vector<std::string> techniques(techniqueSet.begin(), techniqueSet.end());
+
+    ReportSummary summary;
+    std::vector<detail::Figures> figures;
+    for (const auto& g : groups) {
+        figures.push_back(detail::writeGroupFigures(g, directory, techniques));
+        for (const auto& p : figures.back().plots)
+            summary.plots.push_back(p + ".png");
+    }
+    std::string manifest;
+    try {
+        manifest = readTextFile(directory + "/manifest.json");
+    } catch (const std::exception&) {
+        manifest = "{}";
+    }
+    detail::writeHtml(directory, groups, figures, manifest);
+    summary.html = directory + "/report.html";
+    return summary;
+}
+
+} // namespace rtlab::report

@@ -1,0 +1,49 @@
+#pragma once
+// Internal to the report module: the study's rows grouped the way the figures need them.
+
+#include "report/report.h"
+
+#include "experiment/analysis.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace rtlab::report::detail {
+
+//! One run: its rows (one per frame) averaged column by column where numeric.
+struct RunSummary {
+    std::string runId;
+    std::string technique;
+    std::map<std::string, std::string> text;  //!< non-numeric columns of the first frame
+    std::map<std::string, double> number;     //!< numeric columns, mean over frames
+    std::vector<experiment::Row> frames;
+    double get(const std::string& column) const;
+};
+
+//! Runs of one family on one scene (and image size): one figure each.
+struct Group {
+    std::string key;    //!< file-name friendly: "ao_testbed_320x180"
+    std::string title;  //!< "ao_testbed, 320x180"
+    std::string family;
+    std::vector<RunSummary> runs;
+    std::vector<std::string> varyingParams;  //!< param.* columns and "grid" with more than one value
+};
+
+std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows);
+//! "directions=36 steps=4" from the varying parameters of a run.
+std::string describeRun(const RunSummary& run, const std::vector<std::string>& varyingParams);
+
+struct Figures {
+    std::vector<std::string> plots;     //!< paths without extension
+    std::vector<std::string> captions;  //!< one per plot
+};
+
+//! Writes every figure of `group` under directory/plots; returns them with captions.
+Figures writeGroupFigures(const Group& group, const std::string& directory, const std::vector<std::string>& techniques);
+
+//! The HTML page.
+void writeHtml(const std::string& directory, const std::vector<Group>& groups,
+               const std::vector<Figures>& figures, const std::string& manifestJson);
+
+} // namespace rtlab::report::detail

@@ -1,0 +1,74 @@
+#include "plot/headless_display.h"
+
+#include <gtest/gtest.h>
+
+#include <cerrno>
+#include <cstdlib>
+
+#include <signal.h>
+
+using namespace rtlab::plot;
+
+TEST(HeadlessTest, XvfbServerRunsForTheLifetimeOfTheObject)
+{
+    int pid = -1;
+    std::string name;
+    {
+        XvfbServer server(640, 480);
+        pid = server.getProcessId();
+        name = server.getDisplayName();
+        EXPECT_GE(server.getDisplayNumber(), 0);
+        EXPECT_EQ(name, ":" + std::to_string(server.getDisplayNumber()));
+        EXPECT_TRUE(isLocalDisplayReachable(name));
+        EXPECT_EQ(::kill(pid, 0), 0);
+    }
+    errno = 0;
+    EXPECT_EQ(::kill(pid, 0), -1);
+    EXPECT_EQ(errno, ESRCH); // gone and reaped
+    EXPECT_FALSE(isLocalDisplayReachable(name));
+}
+
+TEST(HeadlessTest, TwoServersGetDifferentDisplays)
+{
+    XvfbServer a(320, 240), b(320, 240);
+    EXPECT_NE(a.getDisplayNumber(), b.getDisplayNumber());
+}
+
+TEST(HeadlessTest, EnsureDisplayStartsXvfbWhenDisplayIsUnset)
+{
+    ::unsetenv("DISPLAY");
+    const std::string display = ensureDisplay();
+    ASSERT_GE(getOwnXvfbDisplay(), 0);
+    EXPECT_EQ(display, ":" + std::to_string(getOwnXvfbDisplay()));
+    ASSERT_NE(std::getenv("DISPLAY"), nullptr);
+    EXPECT_EQ(std::string(std::getenv("DISPLAY")), display);
+    EXPECT_TRUE(isLocalDisplayReachable(display));
+    // Later calls reuse it.
+    EXPECT_EQ(ensureDisplay(), display);
+}
+
+TEST(HeadlessTest, EnsureDisplayReplacesADisplayNobodyServes)
+{
+    ::setenv("DISPLAY", ":9999", 1);
+    ASSERT_FALSE(isLocalDisplayReachable(":9999"));
+    const std::string display = ensureDisplay();
+    EXPECT_NE(display, ":9999");
+    EXPECT_TRUE(isLocalDisplayReachable(display));
+    EXPECT_EQ(std::string(std::getenv("DISPLAY")), display);
+}
+
+TEST(HeadlessTest, EnsureDisplayKeepsADisplayThatIsServed)
+{
+    XvfbServer other(320, 240);
+    ::setenv("DISPLAY", (other.getDisplayName() + ".0").c_str(), 1);
+    EXPECT_EQ(ensureDisplay(), other.getDisplayName() + ".0");
+    EXPECT_EQ(std::string(std::getenv("DISPLAY")), other.getDisplayName() + ".0");
+    ::unsetenv("DISPLAY");
+}
+
+TEST(HeadlessTest, ParsesOnlyLocalDisplays)
+{
+    EXPECT_FALSE(isLocalDisplayReachable("remote.example:0"));
+    EXPECT_FALSE(isLocalDisplayReachable(":"));
+    EXPECT_FALSE(isLocalDisplayReachable("garbage"));
+}
