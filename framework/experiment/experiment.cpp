@@ -229,10 +229,25 @@ struct Loader {
                                                         "technique '" + it->second.technique + "'"));
     }
 
+    // Expands `sweep` on top of `runs`: the cross product of its axes (and zip groups), with
+    // `variants` (a list of sub-sweeps, each expanded on its own and the results concatenated,
+    // e.g. one per technique with its own parameters) applied last.
     std::vector<RunConfig> expand(const YAML::Node& sweep, const RunConfig& base,
                                   std::vector<std::string>& keys) const
     {
-        std::vector<RunConfig> runs = {base};
+        std::vector<RunConfig> runs = expandAxes(sweep, {base}, base, keys, true);
+        std::map<std::string, std::size_t> seen;
+        for (std::size_t i = 0; i < runs.size(); ++i)
+            if (!seen.emplace(runs[i].hash(), i).second)
+                file.fail(sweep, "sweep: runs " + std::to_string(seen[runs[i].hash()] + 1) + " and " +
+                                     std::to_string(i + 1) + " of the expansion are identical (" +
+                                     runs[i].id() + "); does an axis repeat a value?");
+        return runs;
+    }
+
+    std::vector<RunConfig> expandAxes(const YAML::Node& sweep, std::vector<RunConfig> runs, const RunConfig& base,
+                                      std::vector<std::string>& keys, bool topLevel) const
+    {
         if (!sweep)
             return runs;
         if (!sweep.IsMap())
@@ -253,6 +268,11 @@ struct Loader {
         std::vector<Axis> axes;
         for (const auto& kv : sweep) {
             const std::string key = kv.first.Scalar();
+            if (key == "variants") {
+                if (!topLevel)
+                    file.fail(kv.first, "sweep: variants cannot be nested");
+                continue;
+            }
             if (key != "zip") {
                 checkList(kv.first, kv.second);
                 axes.push_back({{{kv.first, kv.second}}, kv.second.size(), key.ends_with(".technique")});
@@ -312,12 +332,22 @@ struct Loader {
             if (runs.size() > 100000)
                 file.fail(axis.keys.front().first, "sweep: the cross product exceeds 100000 runs");
         }
-        std::map<std::string, std::size_t> seen;
-        for (std::size_t i = 0; i < runs.size(); ++i)
-            if (!seen.emplace(runs[i].hash(), i).second)
-                file.fail(sweep, "sweep: runs " + std::to_string(seen[runs[i].hash()] + 1) + " and " +
-                                     std::to_string(i + 1) + " of the expansion are identical (" +
-                                     runs[i].id() + "); does an axis repeat a value?");
+        const YAML::Node variants = sweep["variants"];
+        if (topLevel && variants) {
+            if (!variants.IsSequence() || variants.size() == 0)
+                file.fail(variants, "sweep: variants: expected a list of sub-sweeps (mappings of axes), found " +
+                                        config::describeNode(variants));
+            std::vector<RunConfig> all;
+            for (const auto& variant : variants) {
+                std::vector<std::string> variantKeys;
+                for (auto& r : expandAxes(variant, runs, base, variantKeys, false))
+                    all.push_back(std::move(r));
+                for (const auto& k : variantKeys)
+                    if (std::find(keys.begin(), keys.end(), k) == keys.end())
+                        keys.push_back(k);
+            }
+            runs = std::move(all);
+        }
         return runs;
     }
 };

@@ -130,6 +130,9 @@ ReportSummary writeStudyReport(const std::string& directory)
             techniqueSet.insert(r.technique);
     const std::vector<std::string> techniques(techniqueSet.begin(), techniqueSet.end());
 
+    // Per-run PNGs: |error| of 0.25 (a quarter of the AO range) saturates the heat map.
+    detail::writeRunImages(rows, 0.25f);
+
     ReportSummary summary;
     std::vector<detail::Figures> figures;
     for (const auto& g : groups) {

@@ -7,6 +7,7 @@
 //   <dir>/plots/pass_times_<scene>.png|pdf      stacked per-pass time of the front runs
 //   <dir>/plots/images_<scene>.png|pdf          reference | each technique's best run | error maps,
 //                                               with zoomed crops (screen-space families)
+//   <dir>/runs/<id>/frame<k>/*.png               each run's output, reference and error heat map
 //   <dir>/report.html                           one page: plots, image grids, tables, manifest
 
 #include <string>

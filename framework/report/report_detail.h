@@ -42,6 +42,10 @@ struct Figures {
 //! Writes every figure of `group` under directory/plots; returns them with captions.
 Figures writeGroupFigures(const Group& group, const std::string& directory, const std::vector<std::string>& techniques);
 
+//! technique.png, reference.png and error.png (|error| through viridis over [0, errorRange])
+//! beside every run frame's EXRs that lacks them; returns how many frames were written.
+int writeRunImages(const std::vector<experiment::Row>& rows, float errorRange);
+
 //! The HTML page.
 void writeHtml(const std::string& directory, const std::vector<Group>& groups,
                const std::vector<Figures>& figures, const std::string& manifestJson);

@@ -145,3 +145,25 @@ sweep:
     EXPECT_NE(err.find("sweep.yaml:6:50:"), std::string::npos) << err;
     EXPECT_NE(err.find("has 2 values but 'grid' has 3"), std::string::npos) << err;
 }
+
+TEST(Sweep, VariantsConcatenateSubSweeps)
+{
+    const auto registry = test::makeTestRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: sphere
+  techniques: {isosurface: {technique: fake_mesher}}
+sweep:
+  scene: [sphere, box]
+  variants:
+    - {isosurface.resolution: [1, 2]}
+    - {isosurface.scale: [3, 4, 5], isosurface.mode: [exact]}
+)",
+                                               "variants.yaml", registry);
+    ASSERT_EQ(e.runs.size(), 2u * (2u + 3u));
+    int exact = 0;
+    for (const auto& r : e.runs)
+        exact += r.techniques.at("isosurface").params.getString("mode") == "exact";
+    EXPECT_EQ(exact, 6);  // only the second variant sets it
+    EXPECT_EQ(e.sweepKeys, (std::vector<std::string>{"scene", "isosurface.resolution", "isosurface.scale",
+                                                     "isosurface.mode"}));
+}
