@@ -130,7 +130,10 @@ int runExperimentCommand(const RunOptions& options)
             std::string techniques;
             for (const auto& [family, choice] : r.techniques)
                 techniques += fmt::format(" {}={}({})", family, choice.technique, choice.params.toString());
-            fmt::print("  {:>4}  {}  scene={} grid={}{}\n", i + 1, r.id(), r.scene, r.grid, techniques);
+            const std::string size = r.techniques.count("isosurface")
+                                          ? fmt::format("grid={}", r.grid)
+                                          : fmt::format("resolution={}x{} frames={}", r.width, r.height, r.frames);
+            fmt::print("  {:>4}  {}  scene={} {}{}\n", i + 1, r.id(), r.scene, size, techniques);
         }
         return kExitOk;
     }

@@ -9,6 +9,7 @@
 #include "experiment/runner.h"
 
 #include "core/error.h"
+#include "experiment/gpu_timing.h"
 #include "experiment/image_files.h"
 #include "gpu/context.h"
 #include "metrics/image_metrics.h"
@@ -29,15 +30,6 @@
 namespace rtlab::experiment {
 
 namespace {
-
-metrics::GpuPassTimes collectGpuPassTimes(gpu::Context& gpu)
-{
-    metrics::GpuPassTimes times;
-    for (const auto& c : gpu.takeRunLog())
-        if (c.gpuMs)
-            times[c.label] += *c.gpuMs;
-    return times;
-}
 
 reference::ReferenceSettings makeReferenceSettings(const plugin::OcclusionDefinition& d, const RunConfig& run)
 {
@@ -135,6 +127,7 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
     base.set("quantity", std::string(getQuantityColumnName(definition.quantity)))
         .set("radius", definition.radius)
         .set("scene_features", scene.computeFeatures().toString());
+    base.set("gpu_time_source", std::string(toString(chooseGpuTimeSource(context.getGpu().getDeviceInfo()))));
 
     gpu::Context& gpu = context.getGpu();
     render::GBufferPass gbufferPass(gpu);

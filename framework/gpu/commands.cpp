@@ -451,10 +451,12 @@ RunResult Context::run(const std::function<void(CommandList&)>& record)
             "vkGetQueryPoolResults");
     }
     const std::uint32_t bits = timestamps ? info.timestampValidBits : 0;
+    const std::uint64_t runIndex = ++run.runCount;
     for (std::uint32_t i = 0; i < count; ++i) {
         result.commands.push_back(
             {commands[i].label,
-             convertTicksToMs(ticks[2 * i], ticks[2 * i + 1], bits, info.timestampPeriodNs)});
+             convertTicksToMs(ticks[2 * i], ticks[2 * i + 1], bits, info.timestampPeriodNs), runIndex,
+             result.cpuSubmitMs});
     }
     if (count > 0)
         result.gpuTotalMs =

@@ -85,6 +85,8 @@ private:
 struct CommandTime {
     std::string label;           //!< the label given, or the pipeline name / command kind
     std::optional<double> gpuMs; //!< empty when the queue has no timestamps
+    std::uint64_t runIndex = 0;  //!< which Context::run() recorded it (counts from 1 per Context)
+    double runSubmitMs = 0.0;    //!< wall time from submit to fence of that whole run
 };
 
 //! What Context::run() measured.

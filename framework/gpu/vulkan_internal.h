@@ -191,6 +191,7 @@ struct RunState {
     std::uint32_t storageImageCapacity = 0;
     std::uint32_t sampledImageCapacity = 0;
     std::vector<CommandTime> log;  //!< every command timed since the last takeRunLog()
+    std::uint64_t runCount = 0;    //!< runs submitted so far
 
     explicit RunState(std::shared_ptr<DeviceState> owner);
     RunState(const RunState&) = delete;

@@ -81,5 +81,23 @@ TEST_F(TimingHarnessTest, SeparatesCompilationFirstUseAndRepeats)
     EXPECT_TRUE(getContext().takeRunLog().empty());  // the log was emptied by every read
 }
 
+TEST_F(TimingHarnessTest, RunLogRecordsEachSubmissionsWallTime)
+{
+    Buffer b = getContext().createBuffer({1024, "b"});
+    getContext().takeRunLog();
+    const RunResult first = getContext().run([&](CommandList& cmd) {
+        cmd.fillBuffer(b, 1u, "a");
+        cmd.fillBuffer(b, 2u, "b");
+    });
+    getContext().run([&](CommandList& cmd) { cmd.fillBuffer(b, 3u, "c"); });
+    const auto log = getContext().takeRunLog();
+    ASSERT_EQ(log.size(), 3u);
+    EXPECT_EQ(log[0].runIndex, log[1].runIndex);  // one submission
+    EXPECT_EQ(log[2].runIndex, log[0].runIndex + 1);
+    EXPECT_EQ(log[0].runSubmitMs, first.cpuSubmitMs);
+    EXPECT_EQ(log[1].runSubmitMs, first.cpuSubmitMs);
+    EXPECT_GT(log[2].runSubmitMs, 0.0);
+}
+
 } // namespace
 } // namespace rtlab::gpu::test
