@@ -77,7 +77,10 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
         return metrics::GpuPassTimes{};
     });
     addTimingColumns(row, "extract", report);
-    row.set("passes", std::string("sample_field:run;extract:run"));
+    PassLog passes;
+    passes.add("sample_field");
+    passes.add("extract");
+    passes.write(row);
 
     // Metrics against the exact distance field.
     const auto deviation =

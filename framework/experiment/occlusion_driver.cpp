@@ -137,10 +137,15 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
         ResultRow row = base;
         row.set("frame", std::int64_t(frame));
         const scene::RenderScene renderScene = scene.buildRenderScene(frame);
+        PassLog passes;
         const std::string sceneHash = renderScene.computeContentHash();
         if (sceneHash != uploadedHash) {
             gbufferPass.setScene(renderScene);
             uploadedHash = sceneHash;
+            passes.add("scene_upload");
+        } else {
+            passes.skip("scene_upload", "geometry unchanged since frame " + std::to_string(frame - 1) +
+                                            " (no edits or moving characters in between)");
         }
         const scene::Camera camera = scene.getCameraAt(frame);
 
@@ -151,6 +156,7 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
             return collectGpuPassTimes(gpu);
         });
         addTimingColumns(row, "gbuffer", gbufferReport);
+        passes.add("gbuffer");
         const scene::GBuffer g = gbufferPass.readBack();
 
         // View-space inputs.
@@ -178,6 +184,7 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
             return collectGpuPassTimes(gpu);
         });
         addTimingColumns(row, "occlusion", report);
+        passes.add("occlusion");
         if (out.ambient.width != g.width || out.ambient.height != g.height)
             throw Error("technique '" + choice.technique + "' returned an ambient image of " +
                         std::to_string(out.ambient.width) + "x" + std::to_string(out.ambient.height) + " for a " +
@@ -186,11 +193,26 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
         // Pass 3: the ground truth of the declared quantity, and of the bent normal and cone.
         const reference::ReferenceSettings settings = makeReferenceSettings(definition, run);
         const reference::ReferenceResult truth = reference::computeReference(renderScene, g, settings);
-        reference::ReferenceSettings bentSettings = settings;
-        bentSettings.quantity = reference::Quantity::Bent;
-        if (!std::isfinite(bentSettings.radius) || bentSettings.radius <= 0.0)
-            bentSettings.radius = std::numeric_limits<double>::infinity();
-        const reference::ReferenceResult bent = reference::computeReference(renderScene, g, bentSettings);
+        if (truth.stats.fromCache)
+            passes.skip("reference", "read from the reference cache (same scene, G-buffer and settings)");
+        else
+            passes.add("reference");
+        const bool hasBent = out.bentNormal.size() == viewNormal.size();
+        const bool hasAperture = out.coneAperture.size() == viewNormal.size();
+        reference::ReferenceResult bent;
+        if (hasBent || hasAperture) {
+            reference::ReferenceSettings bentSettings = settings;
+            bentSettings.quantity = reference::Quantity::Bent;
+            if (!std::isfinite(bentSettings.radius) || bentSettings.radius <= 0.0)
+                bentSettings.radius = std::numeric_limits<double>::infinity();
+            bent = reference::computeReference(renderScene, g, bentSettings);
+            if (bent.stats.fromCache)
+                passes.skip("reference_bent", "read from the reference cache (same scene, G-buffer and settings)");
+            else
+                passes.add("reference_bent");
+        } else {
+            passes.skip("reference_bent", "the technique outputs no bent normal or cone");
+        }
         row.set("reference.seconds", truth.stats.seconds)
             .set("reference.from_cache", truth.stats.fromCache)
             .set("reference.samples_mean", truth.stats.meanSamples)
@@ -208,8 +230,6 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
         addErrorColumns(row, "ao_thin", out.ambient, truth.occlusion, thin, false);
 
         const glm::mat3 toWorld = glm::transpose(toView);
-        const bool hasBent = out.bentNormal.size() == viewNormal.size();
-        const bool hasAperture = out.coneAperture.size() == viewNormal.size();
         row.set("bent.angle_error_deg",
                 hasBent ? computeMaskedMean(surface,
                                             [&](std::size_t i) {
@@ -237,7 +257,7 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
                                                 })
                             : std::nan(""));
         row.set("cone_visibility.count", std::int64_t(out.coneVisibility.size()));
-        row.set("passes", std::string("gbuffer:run;occlusion:run;reference:run"));
+        passes.write(row);
 
         // Images: numbers in EXR (the report makes the PNGs).
         const std::string dir = context.runDirectory() + "/frame" + std::to_string(frame);

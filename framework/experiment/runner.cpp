@@ -40,6 +40,31 @@ gpu::Context& DriverContext::getGpu()
     return *mGpu;
 }
 
+void PassLog::write(ResultRow& row) const
+{
+    std::string text;
+    std::int64_t ran = 0, skipped = 0;
+    for (const auto& [pass, reason] : mEntries) {
+        text += (text.empty() ? "" : ";") + pass + (reason.empty() ? ":run" : ":skipped(" + reason + ")");
+        (reason.empty() ? ran : skipped) += 1;
+    }
+    row.set("passes", text).set("passes_run", ran).set("passes_skipped", skipped);
+}
+
+void addMemoryColumns(ResultRow& row)
+{
+    // VmRSS and VmHWM of /proc/self/status, in kB.
+    std::ifstream in("/proc/self/status");
+    double rss = std::nan(""), peak = std::nan("");
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("VmRSS:", 0) == 0)
+            rss = std::stod(line.substr(6)) / 1024.0;
+        else if (line.rfind("VmHWM:", 0) == 0)
+            peak = std::stod(line.substr(6)) / 1024.0;
+    }
+    row.set("memory.rss_mb", rss).set("memory.peak_rss_mb", peak);
+}
+
 void addTimingColumns(ResultRow& row, const std::string& pass, const metrics::TimingReport& report)
 {
     row.set(pass + ".cpu_ms", report.cpuMs.median);
@@ -117,8 +142,10 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
                 auto driver = familyDrivers().find(family);
                 if (driver == familyDrivers().end())
                     throw Error("family '" + family + "' cannot run in experiments yet (no driver)");
-                for (auto& row : driver->second(run, family, context, common))
+                for (auto& row : driver->second(run, family, context, common)) {
+                    addMemoryColumns(row);
                     rows.push_back(std::move(row));
+                }
             }
             ++summary.succeeded;
         } catch (const std::exception& e) {

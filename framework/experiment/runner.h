@@ -82,6 +82,21 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
 std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::string& family,
                                           DriverContext& context, const ResultRow& common);
 
+//! Which passes of a frame ran and which were skipped, and why. Written as the columns "passes"
+//! ("gbuffer:run;reference:skipped(read from the cache)"), "passes_run" and "passes_skipped".
+class PassLog {
+public:
+    void add(const std::string& pass) { mEntries.push_back({pass, ""}); }
+    void skip(const std::string& pass, const std::string& reason) { mEntries.push_back({pass, reason}); }
+    void write(ResultRow& row) const;
+
+private:
+    std::vector<std::pair<std::string, std::string>> mEntries;  //!< (pass, skip reason or "")
+};
+
+//! Current and peak resident memory of the process: columns memory.rss_mb, memory.peak_rss_mb.
+void addMemoryColumns(ResultRow& row);
+
 //! Adds the timing columns of one pass: <pass>.cpu_ms (median), <pass>.cpu_ms_iqr,
 //! <pass>.first_use_ms, <pass>.setup_ms, and <pass>.gpu_ms when it ran GPU work.
 void addTimingColumns(ResultRow& row, const std::string& pass, const struct metrics::TimingReport& report);

@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 using namespace rtlab;
 
@@ -103,4 +104,36 @@ TEST(OcclusionDriver, AnAnalyticShapeIsARecordedFailure)
     const auto rows = experiment::loadResults(dir.string());
     ASSERT_EQ(rows.size(), 1u);
     EXPECT_NE(rows[0].at("error").find("analytic shape"), std::string::npos) << rows[0].at("error");
+}
+
+TEST(OcclusionDriver, RecordsSkippedPassesAndWhy)
+{
+    // Two frames of a still scene: frame 1 does not upload the scene again, and its ground truth
+    // (same G-buffer, same settings) comes from the cache. Both are recorded as skipped, with why.
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<Unoccluded>(registry, "occlusion", "unoccluded");
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_passes";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "still.yaml") << "scene: still\nbase: ao_testbed\nframes: 2\n";
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: still.yaml
+  resolution: [24, 16]
+  frames: 2
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.05, max_samples: 16}
+  techniques: {occlusion: {technique: unoccluded}}
+)",
+                                               (dir / "passes.yaml").string(), registry);
+    experiment::runExperiment(e, registry, {.outputDirectory = (dir / "out").string(), .quiet = true,
+                                            .queryVulkanForManifest = false});
+    const auto rows = experiment::loadResults((dir / "out").string());
+    ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
+    EXPECT_EQ(rows[0].at("passes").find("scene_upload:run;gbuffer:run;occlusion:run"), 0u) << rows[0].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped(geometry unchanged since frame 0"), std::string::npos)
+        << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("reference:skipped(read from the reference cache"), std::string::npos)
+        << rows[1].at("passes");
+    EXPECT_EQ(rows[1].at("passes_skipped"), "3");  // scene upload and both references
+    EXPECT_GT(experiment::getNumber(rows[0], "memory.peak_rss_mb"), 1.0);
 }
