@@ -1,0 +1,212 @@
+// lsao: Line-Sweep Ambient Obscurance, as Quantum Break shipped it.
+//
+// Registry key: occlusion/lsao
+//
+// Paper: V. Timonen, "Line-Sweep Ambient Obscurance", Computer Graphics Forum 32(4) (Proc.
+// EGSR 2013), 97-105. Seed: 002_2c73d3b2bb6f7a13.txt (Quantum Break, screen-space lighting:
+// "For occlusion, we have SSAO which is based on LSAO": 36 directions, long ~10 px steps, lines
+// ~2 px apart, steps jittered along each line for an even sample distribution, one near-field
+// sample per pixel and direction roughly half-way from the receiver to the nearest sweep sample,
+// occluders clamped to the hemisphere of the pixel's normal, 4 rotating sets of directions).
+//
+// Quantity: Obscurance with falloff rho and radius r, the reference's
+//   W = (1/pi) Int_H rho(d(w)/r) cos(theta) dw,  rho(x) = x or 3x^2 - 2x^3, 1 beyond r or no hit.
+// LSAO solves obscurance per azimuthal direction from horizons [Timonen 2013, Sec. 3], which is
+// this integral written over half-slices: with w(theta) = cos(theta) v + sin(theta) t in the plane
+// through the eye that contains the screen line (v toward the eye, t toward the upstream side),
+// dw = sin(theta) dtheta dphi and
+//   W = 1 - (1/pi) Int_0^2pi Int_occluded (1 - rho) dot(n, w) sin(theta) dtheta dphi,
+// evaluated at N azimuths as W = 1 - (2/N) sum_k O_k (exact for an unoccluded pixel).
+//
+// Algorithm
+// - Layout: N directions phi_k = 2 pi (k + s/S)/N, s = frameIndex mod S (direction_sets). Per
+//   direction, parallel screen lines line_spacing px apart cover the image; each line is cut into
+//   strata of `step` px with one sample per stratum, at a hashed position (jitter) or the middle.
+//   A sample's depth is that of the pixel containing it.
+// - Pass 1 "lsao.sweep", one invocation per line [Timonen 2013, Sec. 3]: the line is walked from
+//   one side of the depth buffer to the other. In (t, 1/depth) (t along the line) the plane of the
+//   line through the eye maps projectively so that eye rays are vertical: the horizon of a sample
+//   over ALL earlier samples of the line is the largest slope back, i.e. the tangent to the upper
+//   convex hull of the earlier samples. The hull lives on a stack: each sample pops the vertices
+//   on or below the chord to it (never a horizon again), the top is its dominant occluder, then
+//   it is pushed - amortised O(1), independent of the radius. The stack holds 32 entries as a
+//   ring; a push onto a full ring forgets the farthest vertex (answers are then exact among the
+//   retained vertices). Per sample the stratum index of its dominant occluder is stored.
+// - Pass 2 "lsao.gather", per pixel and direction [Timonen 2013, Sec. 4]: the two lines that
+//   bracket the pixel (weights by distance) and, on each, the two samples that bracket it along
+//   the line (weights by position). Unlike the paper, which interpolates obscurance computed at
+//   the samples, every occluder is re-evaluated from the receiver (its G-buffer point and normal,
+//   as Quantum Break clamps occluders with the pixel's normal): the upstream sample contributes
+//   itself and its dominant occluder, the downstream sample its dominant occluder (which lies at
+//   or before the upstream sample), and both the near-field sample half-way between the receiver
+//   and the upstream sample (at least 1 px). Points of neighbouring lines are moved into the
+//   receiver's slice plane along its tangent plane (exact for samples of the receiver's plane).
+// - Per half-slice: occluders at angles theta_i from v with distances d_i block the rays from
+//   theta_i down to the tangent plane; a ray is weighted 1 - rho(d/r) with d the distance of the
+//   nearest occluder above it (a single dominant occluder: the occluded part of the slice weighted
+//   by its distance). The cosine-weighted measures are closed-form (GTAO's slice integral):
+//   F(h) = nv sin^2(h)/2 + nt (h - sin h cos h)/2 with nv = n.v, nt = n.t.
+// - Visibility (bent normal, aperture) uses rho = step at r: an occluder counts if d < r.
+//   A = 1 - (2/N) sum_k V_k, aperture = asin(sqrt(A)) (sin^2 = A, cosine convention); bent normal
+//   = normalize((2 pi/3) n - (2 pi/N) sum_k M_k), M_k the occluded first moment
+//   Int w dot(n, w) sin(theta) dtheta of the half-slice; n where nothing is visible.
+// - Deviations from the reference integral: one depth layer (nothing behind the first surface, as
+//   every screen-space method); per half-slice only the horizon is known, so every ray below it
+//   counts as blocked at the distance of the occluder that defines it (a tall wall near the
+//   receiver is weighted by the distance of its top, partly corrected by the near-field and
+//   upstream samples); the dominant occluder is the largest horizon over the whole line, so a
+//   higher occluder beyond the radius hides a lower one inside it; thin objects occlude as if
+//   infinitely thick; geometry off screen is missing; the in-between of two strata is known
+//   only through the near-field sample. See README.md.
+//
+// Parameters
+// | name            | type  | default | range / choices        | unit        |
+// |-----------------|-------|---------|------------------------|-------------|
+// | directions      | int   | 36      | [1, 128]               |             |
+// | line_spacing    | float | 2       | [0.5, 64]              | px          |
+// | step            | float | 10      | [1, 256]               | px          |
+// | jitter          | bool  | true    |                        |             |
+// | near_field      | bool  | true    |                        |             |
+// | direction_sets  | int   | 4       | [1, 64]                |             |
+// | radius          | float | 1       | [0, inf)               | world units |
+// | falloff         | enum  | linear  | {linear, smoothstep}   |             |
+//
+// Config:
+//   techniques:
+//     occlusion: {technique: lsao, params: {radius: 0.5}}
+
+#include "lsao.h"
+
+#include "lsao_cpu.h"
+#include "lsao_gpu.h"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rtlab::occlusion::lsao {
+namespace {
+
+const std::vector<std::string> kFalloffChoices = {"linear", "smoothstep"};
+
+void checkRange(const char* name, double value, double lo, double hi)
+{
+    if (!(value >= lo && value <= hi))
+        throw std::invalid_argument(std::string("lsao: ") + name + " " + std::to_string(value) +
+                                    " is outside [" + std::to_string(lo) + ", " +
+                                    std::to_string(hi) + "]");
+}
+
+} // namespace
+
+plugin::TechniqueInfo Lsao::describe()
+{
+    plugin::TechniqueInfo info;
+    info.summary = "Line-sweep ambient obscurance: per-direction line sweeps keep a convex hull "
+                   "of occluders, dominant occluders from the whole depth buffer";
+    info.reference = "Timonen 2013, Line-Sweep Ambient Obscurance (CGF 32(4), EGSR)";
+    info.seed = "002_2c73d3b2bb6f7a13.txt (Quantum Break screen-space lighting: SSAO based on "
+                "LSAO)";
+    return info;
+}
+
+config::ParamSchema Lsao::declareParams()
+{
+    config::ParamSchema schema;
+    schema.addInt("directions", 36, 1, 128, "",
+                  "sweep directions over the full circle (each one half-slice)");
+    schema.addFloat("line_spacing", 2.0, 0.5, 64.0, "px",
+                    "distance between parallel sweep lines of one direction");
+    schema.addFloat("step", 10.0, 1.0, 256.0, "px", "sample spacing along a line (one sample "
+                                                    "per stratum of this length)");
+    schema.addBool("jitter", true, "jittered sample positions within each step stratum (else "
+                                   "regular, at the stratum middles)");
+    schema.addBool("near_field", true, "one extra sample per pixel and direction half-way to "
+                                       "the nearest upstream sweep sample");
+    schema.addInt("direction_sets", 4, 1, 64, "",
+                  "rotated direction sets, frameIndex modulo this picks the set");
+    schema.addFloat("radius", 1.0, 0.0, std::numeric_limits<double>::infinity(), "world units",
+                    "obscurance falloff radius: occluders at or beyond it do not count");
+    schema.addEnum("falloff", "linear", kFalloffChoices,
+                   "obscurance falloff rho(d/r): linear x or smoothstep 3x^2-2x^3");
+    return schema;
+}
+
+Lsao::Lsao(const config::ParamSet& params)
+{
+    checkRange("directions", double(params.getInt("directions")), 1, 128);
+    checkRange("line_spacing", params.getFloat("line_spacing"), 0.5, 64.0);
+    checkRange("step", params.getFloat("step"), 1.0, 256.0);
+    checkRange("direction_sets", double(params.getInt("direction_sets")), 1, 64);
+    checkRange("radius", params.getFloat("radius"), 0.0, std::numeric_limits<double>::infinity());
+    mParams.directions = int(params.getInt("directions"));
+    mParams.lineSpacing = float(params.getFloat("line_spacing"));
+    mParams.step = float(params.getFloat("step"));
+    mParams.jitter = params.getBool("jitter");
+    mParams.nearField = params.getBool("near_field");
+    mParams.directionSets = int(params.getInt("direction_sets"));
+    mParams.radius = params.getFloat("radius");
+    const std::string& falloff = params.getString("falloff");
+    if (falloff == kFalloffChoices[0])
+        mParams.falloff = Falloff::Linear;
+    else if (falloff == kFalloffChoices[1])
+        mParams.falloff = Falloff::Smoothstep;
+    else
+        throw std::invalid_argument("lsao: falloff '" + falloff +
+                                    "' is not one of linear, smoothstep");
+}
+
+Lsao::~Lsao() = default;
+
+config::ParamSet Lsao::effectiveParams() const
+{
+    config::ParamSet p;
+    p.set("directions", std::int64_t(mParams.directions));
+    p.set("line_spacing", double(mParams.lineSpacing));
+    p.set("step", double(mParams.step));
+    p.set("jitter", mParams.jitter);
+    p.set("near_field", mParams.nearField);
+    p.set("direction_sets", std::int64_t(mParams.directionSets));
+    p.set("radius", mParams.radius);
+    p.set("falloff", kFalloffChoices[mParams.falloff == Falloff::Linear ? 0 : 1]);
+    return p;
+}
+
+plugin::OcclusionDefinition Lsao::definition() const
+{
+    return {plugin::OcclusionQuantity::Obscurance, mParams.radius,
+            mParams.falloff == Falloff::Linear ? plugin::OcclusionFalloff::Linear
+                                               : plugin::OcclusionFalloff::Smoothstep};
+}
+
+void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out)
+{
+    if (input.linearDepth == nullptr || input.normal == nullptr)
+        throw std::invalid_argument("lsao: OcclusionInput needs linearDepth and normal");
+    const Image<float>& depth = *input.linearDepth;
+    const Image<glm::vec3>& normal = *input.normal;
+    if (depth.width != normal.width || depth.height != normal.height)
+        throw std::invalid_argument("lsao: depth and normal images differ in size");
+    const int w = depth.width, h = depth.height;
+    if (w <= 0 || h <= 0) {
+        out.ambient = Image<float>(w, h);
+        out.bentNormal = Image<glm::vec3>(w, h);
+        out.coneAperture = Image<float>(w, h);
+        out.coneVisibility.clear();
+        return;
+    }
+    const plugin::ScreenProjection projection =
+        plugin::ScreenProjection::fromMatrix(input.projection, w, h);
+    const Layout layout = buildLayout(w, h, projection, mParams, input.frameIndex);
+    if (input.gpu == nullptr) {
+        computeOnCpu(layout, projection, mParams, depth, normal, out);
+        return;
+    }
+    if (!mGpu || &mGpu->getContext() != input.gpu)
+        mGpu = std::make_unique<GpuRunner>(*input.gpu);
+    mGpu->run(layout, projection, mParams, depth, normal, out);
+}
+
+} // namespace rtlab::occlusion::lsao
+
+RTLAB_REGISTER_TECHNIQUE(occlusion, lsao, rtlab::occlusion::lsao::Lsao)

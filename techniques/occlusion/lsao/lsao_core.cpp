@@ -1,0 +1,243 @@
+#include "lsao_core.h"
+
+#include <numbers>
+
+namespace rtlab::occlusion::lsao {
+
+Layout buildLayout(int width, int height, const plugin::ScreenProjection& projection,
+                   const Params& params, int frameIndex, std::size_t maxBatchEntries)
+{
+    Layout layout;
+    layout.width = width;
+    layout.height = height;
+    const int sets = std::max(1, params.directionSets);
+    layout.setIndex = std::uint32_t(((frameIndex % sets) + sets) % sets);
+    layout.jitter = params.jitter;
+    layout.spacing = params.lineSpacing;
+    layout.invSpacing = 1.0f / params.lineSpacing;
+    layout.step = params.step;
+    layout.invStep = 1.0f / params.step;
+    layout.projOffset = projection.offset;
+    layout.invScale = 1.0f / projection.scale;
+    layout.invSize = 1.0f / projection.size;
+
+    const int count = std::max(1, params.directions);
+    const glm::vec2 corners[4] = {{0.0f, 0.0f},
+                                  {float(width), 0.0f},
+                                  {0.0f, float(height)},
+                                  {float(width), float(height)}};
+    // A step of one pixel along dir at depth 1 moves the view-space point by this much.
+    const glm::vec2 pixelToView(2.0f / (float(width) * projection.scale.x),
+                                2.0f / (float(height) * projection.scale.y));
+    layout.directions.resize(std::size_t(count));
+    for (int k = 0; k < count; ++k) {
+        // [Quantum Break seed: 36 directions, 4 rotating sets]
+        const double phi = 2.0 * std::numbers::pi *
+                           (double(k) + double(layout.setIndex) / double(sets)) / double(count);
+        Direction& d = layout.directions[std::size_t(k)];
+        d.dir = glm::vec2(float(std::cos(phi)), float(std::sin(phi)));
+        d.perp = glm::vec2(-d.dir.y, d.dir.x);
+        d.axis = glm::vec4(
+            glm::normalize(glm::vec3(d.dir.x * pixelToView.x, d.dir.y * pixelToView.y, 0.0f)),
+            0.0f);
+        float tMin = std::numeric_limits<float>::max(), tMax = -tMin;
+        float cMin = tMin, cMax = -tMin;
+        for (const glm::vec2& c : corners) {
+            const float t = c.x * d.dir.x + c.y * d.dir.y;
+            const float o = c.x * d.perp.x + c.y * d.perp.y;
+            tMin = std::min(tMin, t);
+            tMax = std::max(tMax, t);
+            cMin = std::min(cMin, o);
+            cMax = std::max(cMax, o);
+        }
+        d.tMin = tMin;
+        d.cMin = cMin;
+        // Strata [tMin + j step, tMin + (j+1) step) cover [tMin, tMax]; lines cMin + i spacing
+        // bracket every pixel centre (which lies strictly inside (cMin, cMax)).
+        d.stepCount = std::uint32_t(std::floor((tMax - tMin) * layout.invStep)) + 1u;
+        d.lineCount = std::uint32_t(std::floor((cMax - cMin) * layout.invSpacing)) + 2u;
+        layout.maxLineCount = std::max(layout.maxLineCount, d.lineCount);
+    }
+
+    // Greedy batches: as many consecutive directions as fit maxBatchEntries (at least one).
+    Batch batch;
+    for (std::uint32_t k = 0; k < std::uint32_t(count); ++k) {
+        Direction& d = layout.directions[k];
+        const std::size_t entries = std::size_t(d.lineCount) * d.stepCount;
+        if (batch.end > batch.begin && batch.entryCount + entries > maxBatchEntries) {
+            layout.batches.push_back(batch);
+            batch = Batch{k, k, 0};
+        }
+        d.base = std::uint32_t(batch.entryCount);
+        batch.entryCount += entries;
+        batch.end = k + 1;
+    }
+    layout.batches.push_back(batch);
+    for (const Batch& b : layout.batches)
+        layout.maxBatchEntries = std::max(layout.maxBatchEntries, b.entryCount);
+    return layout;
+}
+
+Constants makeConstants(const Layout& layout, const plugin::ScreenProjection& projection,
+                        const Params& params, std::size_t batch)
+{
+    Constants c;
+    c.projScale = projection.scale;
+    c.projOffset = projection.offset;
+    c.size = projection.size;
+    c.invScale = layout.invScale;
+    c.invSize = layout.invSize;
+    c.width = layout.width;
+    c.height = layout.height;
+    c.spacing = layout.spacing;
+    c.invSpacing = layout.invSpacing;
+    c.step = layout.step;
+    c.invStep = layout.invStep;
+    c.radius = float(params.radius);
+    c.invRadius = params.radius > 0.0 ? float(1.0 / params.radius)
+                                      : std::numeric_limits<float>::infinity();
+    c.dirBegin = layout.batches[batch].begin;
+    c.dirEnd = layout.batches[batch].end;
+    c.dirCount = std::uint32_t(layout.directions.size());
+    c.flags = (params.jitter ? kFlagJitter : 0u) | (params.nearField ? kFlagNearField : 0u) |
+              (params.falloff == Falloff::Smoothstep ? kFlagSmoothstep : 0u) |
+              (batch == 0 ? kFlagFirstBatch : 0u) |
+              (batch + 1 == layout.batches.size() ? kFlagLastBatch : 0u);
+    c.setIndex = layout.setIndex;
+    return c;
+}
+
+Slice makeSlice(const glm::vec3& x, const glm::vec3& n, const glm::vec3& axis)
+{
+    Slice sl;
+    sl.v = glm::normalize(-x);
+    // The screen line through X lies in the plane through the eye spanned by v and axis.
+    const glm::vec3 u = axis - glm::dot(axis, sl.v) * sl.v;
+    sl.t = -glm::normalize(u);
+    sl.m = glm::cross(sl.v, sl.t);
+    sl.nv = glm::dot(n, sl.v);
+    sl.nt = glm::dot(n, sl.t);
+    const float np = std::sqrt(sl.nv * sl.nv + sl.nt * sl.nt);
+    if (!(np > 1e-6f))
+        return sl;
+    // Hemisphere of n within theta in [0, pi]: dot(n, w) = np cos(theta - gamma) > 0.
+    const float cn = sl.nv / np;
+    const float sn = sl.nt / np;
+    if (sl.nv >= 0.0f) {
+        sl.lo = Angle{0.0f, 1.0f, 0.0f};
+        sl.hi = makeAngle(-sn, cn);
+    } else if (sl.nt > 0.0f) {
+        sl.lo = makeAngle(sn, -cn);
+        sl.hi = Angle{3.14159274f, -1.0f, 0.0f};
+    } else {
+        return sl;
+    }
+    sl.hasHemisphere = sl.hi.theta > sl.lo.theta;
+    sl.fHi = computeSliceF(sl, sl.hi);
+    sl.gHi = computeSliceG(sl, sl.hi);
+    const float slope = std::clamp(glm::dot(n, sl.m) / np, -1000.0f, 1000.0f);
+    sl.kv = slope * cn;
+    sl.kt = slope * sn;
+    return sl;
+}
+
+Occluder projectOccluder(const Slice& slice, const glm::vec3& x, const glm::vec3& p,
+                         float minDistance)
+{
+    Occluder o;
+    const float c = glm::dot(p, slice.m);
+    const float a = glm::dot(p - x, slice.v) + c * slice.kv;
+    const float b = glm::dot(p, slice.t) + c * slice.kt;
+    const float r = std::sqrt(a * a + b * b);
+    o.distance = glm::length(p - x);
+    if (!(b > 0.0f) || !(r > minDistance))
+        return o;
+    o.angle = makeAngle(a / r, b / r);
+    o.valid = true;
+    return o;
+}
+
+namespace {
+
+Angle clampAngle(const Slice& slice, const Angle& a)
+{
+    if (a.theta <= slice.lo.theta)
+        return slice.lo;
+    if (a.theta >= slice.hi.theta)
+        return slice.hi;
+    return a;
+}
+
+//! Invalid occluders sort last and block nothing: angle beyond pi, infinitely far.
+Occluder prepareOccluder(const Occluder& o)
+{
+    if (o.valid)
+        return o;
+    Occluder none;
+    none.angle = Angle{4.0f, 1.0f, 0.0f};
+    none.distance = std::numeric_limits<float>::infinity();
+    return none;
+}
+
+void sortPair(Occluder& a, Occluder& b)
+{
+    if (a.angle.theta > b.angle.theta)
+        std::swap(a, b);
+}
+
+} // namespace
+
+Contribution evaluateOccluders(const Slice& slice, Occluder o0, Occluder o1, Occluder o2,
+                               float radius, float invRadius, bool smoothstep)
+{
+    o0 = prepareOccluder(o0);
+    o1 = prepareOccluder(o1);
+    o2 = prepareOccluder(o2);
+    sortPair(o0, o1);
+    sortPair(o1, o2);
+    sortPair(o0, o1);
+    const Angle a0 = clampAngle(slice, o0.angle);
+    const Angle a1 = clampAngle(slice, o1.angle);
+    const Angle a2 = clampAngle(slice, o2.angle);
+    const float f0 = computeSliceF(slice, a0);
+    const float f1 = computeSliceF(slice, a1);
+    const float f2 = computeSliceF(slice, a2);
+    // [Timonen 2013, Sec. 3; Zhukov 1998] obscurance: from each occluder's horizon to the
+    // tangent plane, rays are weighted by 1 - rho of the nearest occluder above them.
+    const float n0 = o0.distance;
+    const float n1 = std::min(n0, o1.distance);
+    const float n2 = std::min(n1, o2.distance);
+    Contribution c;
+    c.obscurance = (1.0f - evaluateFalloff(n0, invRadius, smoothstep)) * std::max(0.0f, f1 - f0) +
+                   (1.0f - evaluateFalloff(n1, invRadius, smoothstep)) * std::max(0.0f, f2 - f1) +
+                   (1.0f - evaluateFalloff(n2, invRadius, smoothstep)) *
+                       std::max(0.0f, slice.fHi - f2);
+    // Visibility (rho = step at the radius): blocked below the highest occluder within it.
+    const bool in0 = o0.distance < radius, in1 = o1.distance < radius, in2 = o2.distance < radius;
+    if (in0 || in1 || in2) {
+        const Angle& a = in0 ? a0 : (in1 ? a1 : a2);
+        const float f = in0 ? f0 : (in1 ? f1 : f2);
+        c.visibility = std::max(0.0f, slice.fHi - f);
+        c.moment = slice.gHi - computeSliceG(slice, a);
+    }
+    return c;
+}
+
+PixelResult resolvePixel(const glm::vec3& n, float sumObscurance, float sumVisibility,
+                         const glm::vec3& sumMoment, int directionCount)
+{
+    // Half-slices at azimuths 2 pi k / N: (1/pi) * (2 pi / N) * sum = (2 / N) * sum.
+    PixelResult r;
+    const float scale = 2.0f / float(directionCount);
+    r.ambient = std::clamp(1.0f - scale * sumObscurance, 0.0f, 1.0f);
+    const float visible = std::clamp(1.0f - scale * sumVisibility, 0.0f, 1.0f);
+    // Int_H w cos dw = (2 pi / 3) n; subtract the occluded moment (2 pi / N) sum, divide by 2pi/3.
+    const glm::vec3 b = n - (3.0f / float(directionCount)) * sumMoment;
+    const float bl = glm::length(b);
+    r.bentNormal = visible > 0.0f && bl > 1e-6f ? b / bl : n;
+    // sin^2(aperture) = visible: aperture = asin(sqrt(visible)).
+    r.aperture = computeAtan2(std::sqrt(visible), std::sqrt(1.0f - visible));
+    return r;
+}
+
+} // namespace rtlab::occlusion::lsao

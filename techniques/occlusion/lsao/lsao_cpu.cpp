@@ -1,0 +1,286 @@
+#include "lsao_cpu.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <utility>
+
+namespace rtlab::occlusion::lsao {
+namespace {
+
+//! Linear depth of `pixel`, or 0 for sky, invalid depth or outside the image.
+float loadDepth(const Image<float>& depth, glm::ivec2 pixel)
+{
+    if (pixel.x < 0 || pixel.y < 0 || pixel.x >= depth.width || pixel.y >= depth.height)
+        return 0.0f;
+    const float z = depth.at(pixel.x, pixel.y);
+    return z > 0.0f && z < std::numeric_limits<float>::infinity() ? z : 0.0f;
+}
+
+//! The G-buffer point of `pixel` (its centre at its depth) as an occluder of the slice.
+Occluder loadOccluder(const Image<float>& depth, const plugin::ScreenProjection& projection,
+                      glm::ivec2 pixel, const Slice& slice, const glm::vec3& x, float minDistance)
+{
+    const float z = loadDepth(depth, pixel);
+    if (z == 0.0f)
+        return Occluder{};
+    return projectOccluder(slice, x, projection.toView(glm::vec2(pixel) + 0.5f, z), minDistance);
+}
+
+//! The view-space point of a line sample: on its line at the depth of its pixel's tangent plane
+//! (computeSampleHeight), or where that is rejected the pixel centre's G-buffer point.
+Occluder loadLineSample(const Layout& layout, const plugin::ScreenProjection& projection,
+                        const Image<float>& depth, const Image<glm::vec3>& normal,
+                        const Direction& d, float c, const LineSample& sample, const Slice& slice,
+                        const glm::vec3& x, float minDistance)
+{
+    const float z = sample.exists ? loadDepth(depth, sample.pixel) : 0.0f;
+    if (z == 0.0f)
+        return Occluder{};
+    const glm::vec2 q = computeLinePoint(d, sample.t, c);
+    const SampleHeight h =
+        computeSampleHeight(layout, q, sample.pixel, z, normal.at(sample.pixel.x, sample.pixel.y));
+    const glm::vec3 p = h.onLine ? projection.toView(q, h.b / h.a)
+                                 : projection.toView(glm::vec2(sample.pixel) + 0.5f, z);
+    return projectOccluder(slice, x, p, minDistance);
+}
+
+void addScaled(Contribution& total, float weight, const Contribution& c)
+{
+    total.obscurance += weight * c.obscurance;
+    total.visibility += weight * c.visibility;
+    total.moment += weight * c.moment;
+}
+
+struct GatherContext {
+    const Layout& layout;
+    const plugin::ScreenProjection& projection;
+    const Image<float>& depth;
+    const Image<glm::vec3>& normal;
+    const std::vector<std::uint32_t>& sweep;
+    bool nearField;
+    bool smoothstep;
+    float radius;
+    float invRadius;
+};
+
+//! The dominant occluder stored for `sample` (kNoOccluder: none) as seen from the receiver.
+Occluder loadDominant(const GatherContext& g, const Direction& d, std::uint32_t k,
+                      std::uint32_t line, float c, std::uint32_t row, const LineSample& sample,
+                      const Slice& slice, const glm::vec3& x, float minDistance)
+{
+    const std::uint32_t id = g.sweep[row + std::uint32_t(sample.stratum)];
+    if (id == kNoOccluder)
+        return Occluder{};
+    const LineSample s = locateSample(g.layout, d, k, line, c, int(id));
+    return loadLineSample(g.layout, g.projection, g.depth, g.normal, d, c, s, slice, x,
+                          minDistance);
+}
+
+//! The contribution of direction k at receiver x (pixel centre p, unit normal n).
+//! [Timonen 2013, Sec. 4] bilinear over the two lines that bracket p and the two samples that
+//! bracket it along each line; each sample's dominant occluder (from the sweep) is seen from the
+//! receiver itself, with the receiver's normal [Quantum Break seed: occluders clamped to the
+//! visible hemisphere]. The gap between the upstream sample and the receiver gets one near-field
+//! sample half-way [Quantum Break seed].
+Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 p,
+                             const glm::vec3& x, const glm::vec3& n)
+{
+    const Layout& layout = g.layout;
+    const Direction& d = layout.directions[k];
+    Contribution total;
+    const Slice slice = makeSlice(x, n, glm::vec3(d.axis));
+    if (!slice.hasHemisphere)
+        return total;
+    const float minDistance = 1e-4f * glm::length(x);
+
+    const float cX = p.x * d.perp.x + p.y * d.perp.y;
+    const float tX = p.x * d.dir.x + p.y * d.dir.y;
+    const float fl = (cX - d.cMin) * layout.invSpacing;
+    const int i0 = std::clamp(int(std::floor(fl)), 0, int(d.lineCount) - 2);
+    const float f = std::clamp(fl - float(i0), 0.0f, 1.0f);
+    const int mX = int(std::floor((tX - d.tMin) * layout.invStep));
+
+    LineSample lower[2], upper[2];
+    float gap = 0.0f;
+    for (int j = 0; j < 2; ++j) {
+        const std::uint32_t line = std::uint32_t(i0 + j);
+        const float c = computeLineOffset(d, line, layout.spacing);
+        // The sample of X's stratum brackets X from below or from above.
+        const LineSample atX = locateSample(layout, d, k, line, c, mX);
+        if (atX.t <= tX) {
+            lower[j] = atX;
+            upper[j] = locateSample(layout, d, k, line, c, mX + 1);
+        } else {
+            lower[j] = locateSample(layout, d, k, line, c, mX - 1);
+            upper[j] = atX;
+        }
+        const float lineGap = lower[j].exists ? tX - lower[j].t : layout.step;
+        gap += (j == 0 ? 1.0f - f : f) * lineGap;
+    }
+
+    Occluder near;
+    if (g.nearField) {
+        // [Quantum Break seed] one sample roughly half-way to the nearest upstream sample.
+        const float delta = std::max(0.5f * gap, 1.0f);
+        const glm::vec2 q(p.x - delta * d.dir.x, p.y - delta * d.dir.y);
+        const glm::ivec2 pixel(int(std::floor(q.x)), int(std::floor(q.y)));
+        near = loadOccluder(g.depth, g.projection, pixel, slice, x, minDistance);
+    }
+
+    for (int j = 0; j < 2; ++j) {
+        const std::uint32_t line = std::uint32_t(i0 + j);
+        const float c = computeLineOffset(d, line, layout.spacing);
+        const float lineWeight = j == 0 ? 1.0f - f : f;
+        const std::uint32_t row = d.base + line * d.stepCount;
+        float wLower = 0.0f, wUpper = 0.0f, wNear = 0.0f;
+        if (lower[j].exists && upper[j].exists) {
+            wUpper = std::clamp((tX - lower[j].t) / (upper[j].t - lower[j].t), 0.0f, 1.0f);
+            wLower = 1.0f - wUpper;
+        } else if (lower[j].exists) {
+            wLower = 1.0f;
+        } else if (upper[j].exists) {
+            wUpper = 1.0f;
+        } else {
+            wNear = 1.0f;
+        }
+        if (wLower > 0.0f) {
+            // The upstream sample itself and its dominant occluder.
+            const Occluder dominant =
+                loadDominant(g, d, k, line, c, row, lower[j], slice, x, minDistance);
+            const Occluder self = loadLineSample(layout, g.projection, g.depth, g.normal, d, c,
+                                                 lower[j], slice, x, minDistance);
+            addScaled(total, lineWeight * wLower,
+                      evaluateOccluders(slice, dominant, self, near, g.radius, g.invRadius,
+                                        g.smoothstep));
+        }
+        if (wUpper > 0.0f) {
+            // The downstream sample's dominant occluder lies at or before the upstream sample.
+            const Occluder dominant =
+                loadDominant(g, d, k, line, c, row, upper[j], slice, x, minDistance);
+            addScaled(total, lineWeight * wUpper,
+                      evaluateOccluders(slice, dominant, near, Occluder{}, g.radius, g.invRadius,
+                                        g.smoothstep));
+        }
+        if (wNear > 0.0f) {
+            addScaled(total, lineWeight * wNear,
+                      evaluateOccluders(slice, near, Occluder{}, Occluder{}, g.radius,
+                                        g.invRadius, g.smoothstep));
+        }
+    }
+    return total;
+}
+
+} // namespace
+
+std::vector<std::uint32_t> runSweepCpu(const Layout& layout, std::size_t batchIndex,
+                                       const Image<float>& depth, const Image<glm::vec3>& normal)
+{
+    const Batch& batch = layout.batches[batchIndex];
+    std::vector<std::uint32_t> sweep(batch.entryCount, kNoOccluder);
+    // One task per (direction, line), as one GPU invocation per line.
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> lines;
+    for (std::uint32_t k = batch.begin; k < batch.end; ++k)
+        for (std::uint32_t i = 0; i < layout.directions[k].lineCount; ++i)
+            lines.emplace_back(k, i);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines.size(), 32),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t r = range.begin(); r != range.end(); ++r) {
+            const auto [k, line] = lines[r];
+            const Direction& d = layout.directions[k];
+            const float c = computeLineOffset(d, line, layout.spacing);
+            std::uint32_t* out = sweep.data() + d.base + std::size_t(line) * d.stepCount;
+            // [Timonen 2013, Sec. 3] walk the line across the whole depth buffer; the hull holds
+            // every earlier sample that can still be a horizon.
+            OccluderHull hull;
+            for (std::uint32_t m = 0; m < d.stepCount; ++m) {
+                const LineSample s = locateSample(layout, d, k, line, c, int(m));
+                const float z = s.exists ? loadDepth(depth, s.pixel) : 0.0f;
+                if (z == 0.0f)
+                    continue;  // outside or sky: no point, no occluder (entry stays kNoOccluder)
+                const SampleHeight h = computeSampleHeight(
+                    layout, computeLinePoint(d, s.t, c), s.pixel, z, normal.at(s.pixel.x, s.pixel.y));
+                out[m] = hull.findDominant(s.t, h);
+                hull.push(s.t, h, m);
+            }
+        }
+    });
+    return sweep;
+}
+
+void runGatherCpu(const Layout& layout, std::size_t batchIndex,
+                  const plugin::ScreenProjection& projection, const Params& params,
+                  const Image<float>& depth, const Image<glm::vec3>& normal,
+                  const std::vector<std::uint32_t>& sweep, Accumulators& sums)
+{
+    const Batch& batch = layout.batches[batchIndex];
+    const GatherContext g{layout,
+                          projection,
+                          depth,
+                          normal,
+                          sweep,
+                          params.nearField,
+                          params.falloff == Falloff::Smoothstep,
+                          float(params.radius),
+                          params.radius > 0.0 ? float(1.0 / params.radius)
+                                              : std::numeric_limits<float>::infinity()};
+    const int w = layout.width;
+    tbb::parallel_for(tbb::blocked_range<int>(0, layout.height),
+                      [&](const tbb::blocked_range<int>& rows) {
+        for (int py = rows.begin(); py != rows.end(); ++py) {
+            for (int px = 0; px < w; ++px) {
+                const float z = depth.at(px, py);
+                const glm::vec3 nRaw = normal.at(px, py);
+                if (!hasSurface(z, nRaw))
+                    continue;
+                const glm::vec3 n = glm::normalize(nRaw);
+                const glm::vec2 p(float(px) + 0.5f, float(py) + 0.5f);
+                const glm::vec3 x = projection.toView(p, z);
+                const std::size_t i = std::size_t(py) * std::size_t(w) + std::size_t(px);
+                for (std::uint32_t k = batch.begin; k < batch.end; ++k) {
+                    const Contribution c = gatherDirection(g, k, p, x, n);
+                    sums.obscurance[i] += c.obscurance;
+                    sums.visibility[i] += c.visibility;
+                    sums.moment[i] += c.moment;
+                }
+            }
+        }
+    });
+}
+
+void computeOnCpu(const Layout& layout, const plugin::ScreenProjection& projection,
+                  const Params& params, const Image<float>& depth,
+                  const Image<glm::vec3>& normal, plugin::OcclusionOutput& out)
+{
+    const int w = layout.width, h = layout.height;
+    const std::size_t count = std::size_t(w) * std::size_t(h);
+    Accumulators sums{std::vector<float>(count, 0.0f), std::vector<float>(count, 0.0f),
+                      std::vector<glm::vec3>(count, glm::vec3(0.0f))};
+    for (std::size_t b = 0; b < layout.batches.size(); ++b) {
+        const std::vector<std::uint32_t> sweep = runSweepCpu(layout, b, depth, normal);
+        runGatherCpu(layout, b, projection, params, depth, normal, sweep, sums);
+    }
+    out.ambient = Image<float>(w, h, 1.0f);
+    out.bentNormal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
+    out.coneAperture = Image<float>(w, h, 0.0f);
+    out.coneVisibility.clear();
+    const int directionCount = int(layout.directions.size());
+    tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
+        for (int py = rows.begin(); py != rows.end(); ++py) {
+            for (int px = 0; px < w; ++px) {
+                const glm::vec3 nRaw = normal.at(px, py);
+                if (!hasSurface(depth.at(px, py), nRaw))
+                    continue;
+                const std::size_t i = std::size_t(py) * std::size_t(w) + std::size_t(px);
+                const PixelResult r =
+                    resolvePixel(glm::normalize(nRaw), sums.obscurance[i], sums.visibility[i],
+                                 sums.moment[i], directionCount);
+                out.ambient.at(px, py) = r.ambient;
+                out.bentNormal.at(px, py) = r.bentNormal;
+                out.coneAperture.at(px, py) = r.aperture;
+            }
+        }
+    });
+}
+
+} // namespace rtlab::occlusion::lsao

@@ -1,0 +1,156 @@
+#include "lsao_gpu.h"
+
+#include "gpu/shader_compiler.h"
+#include "render/gbuffer_pass.h"
+
+#include <cstdlib>
+#include <string>
+
+namespace rtlab::occlusion::lsao {
+
+std::filesystem::path getShaderDir()
+{
+    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
+        return std::filesystem::path(root) / "techniques" / "occlusion" / "lsao" / "shaders";
+    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+}
+
+namespace {
+
+constexpr std::uint32_t kSweepGroupSize = 64;
+constexpr std::uint32_t kGatherGroupSize = 8;
+
+gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderCompiler& compiler,
+                                    const char* file, const char* name,
+                                    std::vector<gpu::BindingSlot> bindings)
+{
+    const std::vector<gpu::ShaderDefine> defines = {
+        {"LSAO_HULL_CAPACITY", std::to_string(kHullCapacity)}};
+    gpu::ComputePipelineDesc desc;
+    desc.name = name;
+    desc.spirv = compiler.compileFile(getShaderDir() / file, defines).spirv;
+    desc.bindings = std::move(bindings);
+    desc.pushConstantSize = sizeof(Constants);
+    return context.createPipeline(desc);
+}
+
+} // namespace
+
+GpuRunner::GpuRunner(gpu::Context& context) : mContext(&context)
+{
+    gpu::ShaderCompilerOptions options;
+    options.includeDirs = {getShaderDir(), render::getRenderShaderDir()};
+    const gpu::ShaderCompiler compiler(options);
+    using gpu::BindingType;
+    mSweep = createPipeline(context, compiler, "lsao_sweep.comp", "lsao.sweep",
+                            {{0, BindingType::StorageImage},
+                             {1, BindingType::StorageBuffer},
+                             {2, BindingType::StorageBuffer},
+                             {3, BindingType::StorageImage}});
+    mGather = createPipeline(context, compiler, "lsao_gather.comp", "lsao.gather",
+                             {{0, BindingType::StorageImage},
+                              {1, BindingType::StorageBuffer},
+                              {2, BindingType::StorageBuffer},
+                              {3, BindingType::StorageImage},
+                              {4, BindingType::StorageImage},
+                              {5, BindingType::StorageImage}});
+}
+
+void GpuRunner::prepare(const Layout& layout)
+{
+    if (layout.width != mWidth || layout.height != mHeight) {
+        const auto w = std::uint32_t(layout.width), h = std::uint32_t(layout.height);
+        using gpu::Format;
+        using gpu::ImageDimension;
+        using gpu::ImageUsage;
+        mDepth = mContext->createImage(
+            {ImageDimension::Image2D, Format::R32Float, w, h, 1, ImageUsage::Storage, "lsao.depth"});
+        mNormal = mContext->createImage({ImageDimension::Image2D, Format::RGBA32Float, w, h, 1,
+                                         ImageUsage::Storage, "lsao.normal"});
+        mAccumA = mContext->createImage({ImageDimension::Image2D, Format::RGBA32Float, w, h, 1,
+                                         ImageUsage::Storage, "lsao.accum_a"});
+        mAccumB = mContext->createImage(
+            {ImageDimension::Image2D, Format::R32Float, w, h, 1, ImageUsage::Storage, "lsao.accum_b"});
+        mWidth = layout.width;
+        mHeight = layout.height;
+    }
+    if (layout.directions.size() > mDirectionCapacity) {
+        mDirectionCapacity = layout.directions.size();
+        mDirections =
+            mContext->createBuffer({mDirectionCapacity * sizeof(Direction), "lsao.directions"});
+    }
+    const std::size_t sweepEntries = std::max<std::size_t>(layout.maxBatchEntries, 1);
+    if (sweepEntries > mSweepCapacity) {
+        mSweepCapacity = sweepEntries;
+        mSweepBuffer =
+            mContext->createBuffer({mSweepCapacity * sizeof(std::uint32_t), "lsao.sweep"});
+    }
+}
+
+void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projection,
+                    const Params& params, const Image<float>& depth,
+                    const Image<glm::vec3>& normal, plugin::OcclusionOutput& out)
+{
+    prepare(layout);
+    const int w = layout.width, h = layout.height;
+    const std::size_t count = std::size_t(w) * std::size_t(h);
+    mDepth.upload(depth.pixels.data(), count * sizeof(float));
+    mStaging.resize(count * 4);
+    for (std::size_t i = 0; i < count; ++i) {
+        mStaging[4 * i + 0] = normal.pixels[i].x;
+        mStaging[4 * i + 1] = normal.pixels[i].y;
+        mStaging[4 * i + 2] = normal.pixels[i].z;
+        mStaging[4 * i + 3] = 0.0f;
+    }
+    mNormal.upload(mStaging.data(), count * 4 * sizeof(float));
+    mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));
+
+    std::vector<Constants> constants;
+    for (std::size_t b = 0; b < layout.batches.size(); ++b)
+        constants.push_back(makeConstants(layout, projection, params, b));
+    mContext->run([&](gpu::CommandList& cmd) {
+        for (std::size_t b = 0; b < layout.batches.size(); ++b) {
+            const Batch& batch = layout.batches[b];
+            cmd.dispatch(mSweep,
+                         {gpu::Binding::storageImage(0, mDepth),
+                          gpu::Binding::storageBuffer(1, mDirections),
+                          gpu::Binding::storageBuffer(2, mSweepBuffer),
+                          gpu::Binding::storageImage(3, mNormal)},
+                         gpu::PushConstants(constants[b]),
+                         gpu::GroupCount{gpu::computeGroupCount(layout.maxLineCount, kSweepGroupSize),
+                                         batch.end - batch.begin, 1},
+                         "lsao.sweep");
+            cmd.dispatch(mGather,
+                         {gpu::Binding::storageImage(0, mDepth),
+                          gpu::Binding::storageBuffer(1, mDirections),
+                          gpu::Binding::storageBuffer(2, mSweepBuffer),
+                          gpu::Binding::storageImage(3, mNormal),
+                          gpu::Binding::storageImage(4, mAccumA),
+                          gpu::Binding::storageImage(5, mAccumB)},
+                         gpu::PushConstants(constants[b]),
+                         gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), kGatherGroupSize),
+                                         gpu::computeGroupCount(std::uint64_t(h), kGatherGroupSize),
+                                         1},
+                         "lsao.gather");
+        }
+    });
+
+    const std::vector<float> a = mAccumA.downloadVector<float>();
+    const std::vector<float> b = mAccumB.downloadVector<float>();
+    out.ambient = Image<float>(w, h, 1.0f);
+    out.bentNormal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
+    out.coneAperture = Image<float>(w, h, 0.0f);
+    out.coneVisibility.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+        out.ambient.pixels[i] = b[i];
+        out.bentNormal.pixels[i] = glm::vec3(a[4 * i + 0], a[4 * i + 1], a[4 * i + 2]);
+        out.coneAperture.pixels[i] = a[4 * i + 3];
+    }
+}
+
+std::vector<std::uint32_t> GpuRunner::downloadSweep(std::size_t entryCount) const
+{
+    return mSweepBuffer.downloadVector<std::uint32_t>(entryCount);
+}
+
+} // namespace rtlab::occlusion::lsao

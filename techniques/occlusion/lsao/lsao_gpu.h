@@ -1,0 +1,57 @@
+#pragma once
+// The Vulkan version: shaders/lsao_sweep.comp ("lsao.sweep") and shaders/lsao_gather.comp
+// ("lsao.gather"), one pair of dispatches per batch of directions (one batch at the default
+// settings). Pipelines are built on first use; images and buffers are kept across frames and
+// rebuilt when the image size or the layout grows.
+
+#include "lsao_core.h"
+
+#include "core/image.h"
+#include "gpu/context.h"
+#include "plugin/occlusion.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace rtlab::occlusion::lsao {
+
+//! Where the shaders are: $RTLAB_SOURCE_DIR/techniques/occlusion/lsao/shaders when set, else the
+//! source folder the technique was built from.
+std::filesystem::path getShaderDir();
+
+class GpuRunner {
+public:
+    //! Compiles the shaders and creates the pipelines on `context`, which must outlive this.
+    explicit GpuRunner(gpu::Context& context);
+
+    gpu::Context& getContext() const { return *mContext; }
+
+    //! Both passes of every batch of `layout` in one submission, then reads back the outputs.
+    void run(const Layout& layout, const plugin::ScreenProjection& projection,
+             const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
+             plugin::OcclusionOutput& out);
+
+    //! The sweep buffer of the last batch of the last run (for tests).
+    std::vector<std::uint32_t> downloadSweep(std::size_t entryCount) const;
+
+private:
+    void prepare(const Layout& layout);
+
+    gpu::Context* mContext = nullptr;
+    gpu::ComputePipeline mSweep;
+    gpu::ComputePipeline mGather;
+    gpu::Image mDepth;
+    gpu::Image mNormal;
+    gpu::Image mAccumA;
+    gpu::Image mAccumB;
+    gpu::Buffer mDirections;
+    gpu::Buffer mSweepBuffer;
+    int mWidth = 0;
+    int mHeight = 0;
+    std::size_t mDirectionCapacity = 0;
+    std::size_t mSweepCapacity = 0;
+    std::vector<float> mStaging;
+};
+
+} // namespace rtlab::occlusion::lsao

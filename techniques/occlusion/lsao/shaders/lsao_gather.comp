@@ -1,0 +1,180 @@
+// Pass 2 "lsao.gather" of Line-Sweep Ambient Obscurance [Timonen 2013, Sec. 4]: one invocation per
+// pixel. For each direction of the batch it interpolates bilinearly between the samples of the
+// two lines that bracket the pixel and the two samples that bracket it along each line, each
+// sample's dominant occluder seen from the pixel itself with its normal, plus one near-field
+// sample [Quantum Break seed], and adds the half-slice contributions to the accumulators.
+// The last batch turns the sums into the outputs: accumA = (bent normal, aperture), accumB =
+// ambient. The twin of lsao::runGatherCpu and the resolve of lsao::computeOnCpu.
+#version 450
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+#include "lsao_common.glsl"
+
+layout(std430, set = 0, binding = 2) readonly buffer Sweep { uint sweep[]; };
+layout(set = 0, binding = 4, rgba32f) uniform image2D accumA;  // moment.xyz, obscurance
+layout(set = 0, binding = 5, r32f) uniform image2D accumB;     // visibility
+
+Occluder lsaoLoadOccluder(ivec2 pixel, Slice sl, vec3 x, float minDistance)
+{
+    float z = lsaoLoadDepth(pixel);
+    if (z == 0.0)
+        return lsaoNoOccluder();
+    vec3 p = screenToView(vec2(pixel) + 0.5, z, pc.projScale, pc.projOffset, pc.size);
+    return lsaoProjectOccluder(sl, x, p, minDistance);
+}
+
+// The point of a line sample: on its line at its tangent-plane depth, else its pixel centre.
+Occluder lsaoLoadLineSample(Direction d, float c, LineSample ls, Slice sl, vec3 x,
+                            float minDistance)
+{
+    float z = ls.exists ? lsaoLoadDepth(ls.pixel) : 0.0;
+    if (z == 0.0)
+        return lsaoNoOccluder();
+    precise float qx = ls.t * d.dir.x + c * d.perp.x;
+    precise float qy = ls.t * d.dir.y + c * d.perp.y;
+    vec2 q = vec2(qx, qy);
+    vec3 h = lsaoSampleHeight(q, ls.pixel, z, imageLoad(normalImage, ls.pixel).xyz);
+    vec3 p = h.z != 0.0 ? screenToView(q, h.y / h.x, pc.projScale, pc.projOffset, pc.size)
+                        : screenToView(vec2(ls.pixel) + 0.5, z, pc.projScale, pc.projOffset,
+                                       pc.size);
+    return lsaoProjectOccluder(sl, x, p, minDistance);
+}
+
+Occluder lsaoLoadDominant(Direction d, uint k, uint line, float c, uint row, LineSample ls,
+                          Slice sl, vec3 x, float minDistance)
+{
+    uint id = sweep[row + uint(ls.stratum)];
+    if (id == LSAO_NO_OCCLUDER)
+        return lsaoNoOccluder();
+    LineSample s = lsaoLocateSample(d, k, line, c, int(id));
+    return lsaoLoadLineSample(d, c, s, sl, x, minDistance);
+}
+
+void lsaoAddScaled(inout Contribution total, float weight, Contribution c)
+{
+    total.obscurance += weight * c.obscurance;
+    total.visibility += weight * c.visibility;
+    total.moment += weight * c.moment;
+}
+
+Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
+{
+    Direction d = directions[k];
+    Contribution total = Contribution(0.0, 0.0, vec3(0.0));
+    Slice sl = lsaoMakeSlice(x, n, d.axis.xyz);
+    if (!sl.hasHemisphere)
+        return total;
+    float minDistance = 1e-4 * length(x);
+
+    precise float cX = p.x * d.perp.x + p.y * d.perp.y;
+    precise float tX = p.x * d.dir.x + p.y * d.dir.y;
+    precise float fl = (cX - d.cMin) * pc.invSpacing;
+    int i0 = clamp(int(floor(fl)), 0, int(d.lineCount) - 2);
+    float f = clamp(fl - float(i0), 0.0, 1.0);
+    precise float fs = (tX - d.tMin) * pc.invStep;
+    int mX = int(floor(fs));
+
+    LineSample lower[2];
+    LineSample upper[2];
+    precise float gap = 0.0;
+    for (int j = 0; j < 2; ++j) {
+        uint line = uint(i0 + j);
+        float c = lsaoLineOffset(d, line);
+        LineSample atX = lsaoLocateSample(d, k, line, c, mX);
+        if (atX.t <= tX) {
+            lower[j] = atX;
+            upper[j] = lsaoLocateSample(d, k, line, c, mX + 1);
+        } else {
+            lower[j] = lsaoLocateSample(d, k, line, c, mX - 1);
+            upper[j] = atX;
+        }
+        precise float lineGap = lower[j].exists ? tX - lower[j].t : pc.step;
+        gap += (j == 0 ? 1.0 - f : f) * lineGap;
+    }
+
+    Occluder nearSample = lsaoNoOccluder();
+    if ((pc.flags & LSAO_FLAG_NEAR_FIELD) != 0u) {
+        // [Quantum Break seed] one sample roughly half-way to the nearest upstream sample.
+        precise float delta = max(0.5 * gap, 1.0);
+        precise float qx = p.x - delta * d.dir.x;
+        precise float qy = p.y - delta * d.dir.y;
+        nearSample = lsaoLoadOccluder(ivec2(int(floor(qx)), int(floor(qy))), sl, x, minDistance);
+    }
+
+    for (int j = 0; j < 2; ++j) {
+        uint line = uint(i0 + j);
+        float c = lsaoLineOffset(d, line);
+        float lineWeight = j == 0 ? 1.0 - f : f;
+        uint row = d.base + line * d.stepCount;
+        float wLower = 0.0;
+        float wUpper = 0.0;
+        float wNear = 0.0;
+        if (lower[j].exists && upper[j].exists) {
+            wUpper = clamp((tX - lower[j].t) / (upper[j].t - lower[j].t), 0.0, 1.0);
+            wLower = 1.0 - wUpper;
+        } else if (lower[j].exists) {
+            wLower = 1.0;
+        } else if (upper[j].exists) {
+            wUpper = 1.0;
+        } else {
+            wNear = 1.0;
+        }
+        if (wLower > 0.0) {
+            Occluder dominant =
+                lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, minDistance);
+            Occluder self = lsaoLoadLineSample(d, c, lower[j], sl, x, minDistance);
+            lsaoAddScaled(total, lineWeight * wLower,
+                          lsaoEvaluateOccluders(sl, dominant, self, nearSample));
+        }
+        if (wUpper > 0.0) {
+            Occluder dominant =
+                lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, minDistance);
+            lsaoAddScaled(total, lineWeight * wUpper,
+                          lsaoEvaluateOccluders(sl, dominant, nearSample, lsaoNoOccluder()));
+        }
+        if (wNear > 0.0) {
+            Occluder none = lsaoNoOccluder();
+            lsaoAddScaled(total, lineWeight * wNear,
+                          lsaoEvaluateOccluders(sl, nearSample, none, none));
+        }
+    }
+    return total;
+}
+
+void main()
+{
+    ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (pixel.x >= pc.width || pixel.y >= pc.height)
+        return;
+    float z = imageLoad(depthImage, pixel).r;
+    vec3 nRaw = imageLoad(normalImage, pixel).xyz;
+    bool surface = lsaoHasSurface(z, nRaw);
+    bool first = (pc.flags & LSAO_FLAG_FIRST_BATCH) != 0u;
+    bool last = (pc.flags & LSAO_FLAG_LAST_BATCH) != 0u;
+    vec4 sumA = first ? vec4(0.0) : imageLoad(accumA, pixel);
+    float sumB = first ? 0.0 : imageLoad(accumB, pixel).r;
+    vec3 n = vec3(0.0);
+    if (surface) {
+        n = normalize(nRaw);
+        vec2 p = vec2(pixel) + 0.5;
+        vec3 x = screenToView(p, z, pc.projScale, pc.projOffset, pc.size);
+        for (uint k = pc.dirBegin; k < pc.dirEnd; ++k) {
+            Contribution c = lsaoGatherDirection(k, p, x, n);
+            sumA.w += c.obscurance;
+            sumB += c.visibility;
+            sumA.xyz += c.moment;
+        }
+    }
+    if (!last) {
+        imageStore(accumA, pixel, sumA);
+        imageStore(accumB, pixel, vec4(sumB));
+    } else if (surface) {
+        PixelResult r = lsaoResolvePixel(n, sumA.w, sumB, sumA.xyz);
+        imageStore(accumA, pixel, vec4(r.bentNormal, r.aperture));
+        imageStore(accumB, pixel, vec4(r.ambient));
+    } else {
+        imageStore(accumA, pixel, vec4(0.0));
+        imageStore(accumB, pixel, vec4(1.0));
+    }
+}
