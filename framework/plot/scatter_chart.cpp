@@ -86,14 +86,17 @@ void writeScatter(const ScatterSpec& spec, const std::string& pathWithoutExtensi
                     .push_back(
                         {series.x[i], series.y[i], onFront[i] ? colors[s] : fadeColor(colors[s])});
         if (front) {
-            vtkSmartPointer<vtkTable> table;
-            table.TakeReference(detail::makeXyTable(front->stepX, front->stepY));
-            auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
-            line->SetInputData(table, 0, 1);
-            detail::setLineColor(line, colors[s]);
-            line->SetWidth(2.0f * scale);
-            line->SetMarkerStyle(vtkPlotPoints::NONE);
-            line->SetLegendVisibility(false);
+            // A front of one point has no staircase to draw (VTK refuses lines of < 2 points).
+            if (front->stepX.size() >= 2) {
+                vtkSmartPointer<vtkTable> table;
+                table.TakeReference(detail::makeXyTable(front->stepX, front->stepY));
+                auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
+                line->SetInputData(table, 0, 1);
+                detail::setLineColor(line, colors[s]);
+                line->SetWidth(2.0f * scale);
+                line->SetMarkerStyle(vtkPlotPoints::NONE);
+                line->SetLegendVisibility(false);
+            }
             const std::size_t last = front->pointIndices.back();
             frontLabels.push_back(
                 {series.x[last], series.y[last], series.label, colors[s], true, false, true});
