@@ -103,6 +103,20 @@ TEST(Cli, DryRunPrintsTheExpandedRuns)
     EXPECT_NE(r.output.find("marching_cubes"), std::string::npos) << r.output;
 }
 
+TEST(Cli, EveryShippedExperimentValidates)
+{
+    // The study files under experiments/ are part of the product: each must expand cleanly.
+    int count = 0;
+    for (const auto& entry : fs::directory_iterator(fs::path(RTLAB_SOURCE_DIR) / "experiments")) {
+        if (entry.path().extension() != ".yaml")
+            continue;
+        const auto r = runRtlab("run --dry-run " + entry.path().string());
+        EXPECT_EQ(r.exitCode, 0) << entry.path() << ":\n" << r.output;
+        ++count;
+    }
+    EXPECT_GE(count, 3);
+}
+
 TEST(Cli, NewTechniqueScaffoldsFromTheTemplate)
 {
     const auto root = freshDirectory("scaffold");
