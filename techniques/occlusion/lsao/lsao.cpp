@@ -11,7 +11,7 @@
 //
 // Quantity: Obscurance with falloff rho and radius r, the reference's
 //   W = (1/pi) Int_H rho(d(w)/r) cos(theta) dw,  rho(x) = x or 3x^2 - 2x^3, 1 beyond r or no hit.
-// LSAO solves obscurance per azimuthal direction from horizons [Timonen 2013, Sec. 3], which is
+// LSAO solves obscurance per azimuthal direction from horizons [Timonen 2013: sweeps], which is
 // this integral written over half-slices: with w(theta) = cos(theta) v + sin(theta) t in the plane
 // through the eye that contains the screen line (v toward the eye, t toward the upstream side),
 // dw = sin(theta) dtheta dphi and
@@ -19,45 +19,57 @@
 // evaluated at N azimuths as W = 1 - (2/N) sum_k O_k (exact for an unoccluded pixel).
 //
 // Algorithm
-// - Layout: N directions phi_k = 2 pi (k + s/S)/N, s = frameIndex mod S (direction_sets). Per
-//   direction, parallel screen lines line_spacing px apart cover the image; each line is cut into
-//   strata of `step` px with one sample per stratum, at a hashed position (jitter) or the middle.
-//   A sample's depth is that of the pixel containing it.
-// - Pass 1 "lsao.sweep", one invocation per line [Timonen 2013, Sec. 3]: the line is walked from
+// - Layout: N directions phi_k = 2 pi (k + s/S)/N, s = frameIndex mod S (direction_sets) [Quantum
+//   Break seed: 4 sets of 36]. Per direction, parallel screen lines line_spacing px apart cover
+//   the image; each line is cut into strata of `step` px with one sample per stratum, at a hashed
+//   position (jitter, "for an even sample distribution") or the stratum middle (regular).
+// - Sample points: the point on the line, at the depth of the tangent plane (depth, normal) of
+//   the pixel that contains it; where that plane is seen edge-on (depth changes more than 2x
+//   within the pixel) or the normal is zero, the pixel centre's depth (and in the gather its
+//   G-buffer point). The paper takes the nearest pixel's depth; on tilted planes that staircase
+//   poses as horizons (a quantisation step one pixel back can out-slope a wall far along the
+//   line) and the hull then loses the true dominant occluder.
+// - Pass 1 "lsao.sweep", one invocation per line [Timonen 2013: sweeps]: the line is walked from
 //   one side of the depth buffer to the other. In (t, 1/depth) (t along the line) the plane of the
 //   line through the eye maps projectively so that eye rays are vertical: the horizon of a sample
 //   over ALL earlier samples of the line is the largest slope back, i.e. the tangent to the upper
-//   convex hull of the earlier samples. The hull lives on a stack: each sample pops the vertices
-//   on or below the chord to it (never a horizon again), the top is its dominant occluder, then
-//   it is pushed - amortised O(1), independent of the radius. The stack holds 32 entries as a
-//   ring; a push onto a full ring forgets the farthest vertex (answers are then exact among the
-//   retained vertices). Per sample the stratum index of its dominant occluder is stored.
-// - Pass 2 "lsao.gather", per pixel and direction [Timonen 2013, Sec. 4]: the two lines that
+//   convex hull of the earlier samples. The hull lives on a stack [Timonen 2013: occluder hull]:
+//   each sample pops the vertices on or below the chord to it (never a horizon again), the top is
+//   its dominant occluder, then it is pushed - amortised O(1), independent of the radius. The
+//   test is division-free (1/depth kept as a fraction) so CPU and GPU take identical decisions.
+//   The stack holds 32 entries as a ring; a push onto a full ring forgets the farthest vertex
+//   (answers are then exact among the retained vertices). Per sample, the stratum index of its
+//   dominant occluder is stored (uint32; no occluder: 0xffffffff).
+// - Pass 2 "lsao.gather", per pixel and direction [Timonen 2013: gathering]: the two lines that
 //   bracket the pixel (weights by distance) and, on each, the two samples that bracket it along
 //   the line (weights by position). Unlike the paper, which interpolates obscurance computed at
 //   the samples, every occluder is re-evaluated from the receiver (its G-buffer point and normal,
 //   as Quantum Break clamps occluders with the pixel's normal): the upstream sample contributes
 //   itself and its dominant occluder, the downstream sample its dominant occluder (which lies at
 //   or before the upstream sample), and both the near-field sample half-way between the receiver
-//   and the upstream sample (at least 1 px). Points of neighbouring lines are moved into the
-//   receiver's slice plane along its tangent plane (exact for samples of the receiver's plane).
-// - Per half-slice: occluders at angles theta_i from v with distances d_i block the rays from
-//   theta_i down to the tangent plane; a ray is weighted 1 - rho(d/r) with d the distance of the
-//   nearest occluder above it (a single dominant occluder: the occluded part of the slice weighted
-//   by its distance). The cosine-weighted measures are closed-form (GTAO's slice integral):
-//   F(h) = nv sin^2(h)/2 + nt (h - sin h cos h)/2 with nv = n.v, nt = n.t.
+//   and the upstream sample (at least 1 px) [Quantum Break seed]. Points of neighbouring lines
+//   are moved into the receiver's slice plane along its tangent plane (exact for samples of the
+//   receiver's plane at any incidence); their side (upstream or not) is taken relative to the eye.
+// - Per half-slice (w(theta) = cos(theta) v + sin(theta) t, theta from the view vector v toward
+//   the upstream side t): up to three occluders at angles theta_i with distances d_i; each blocks
+//   the rays from theta_i down to the tangent plane, and a ray is weighted 1 - rho(d/r) with d the
+//   distance of the nearest occluder above it. So the occluded part of the slice is weighted by
+//   the distance of the occluder that defines it (the dominant occluder's above the near samples'
+//   horizons). Cosine-weighted measures are closed-form, GTAO's slice integral:
+//   F(h) = Int_0^h dot(n, w) sin(theta) dtheta = nv sin^2(h)/2 + nt (h - sin h cos h)/2.
 // - Visibility (bent normal, aperture) uses rho = step at r: an occluder counts if d < r.
 //   A = 1 - (2/N) sum_k V_k, aperture = asin(sqrt(A)) (sin^2 = A, cosine convention); bent normal
-//   = normalize((2 pi/3) n - (2 pi/N) sum_k M_k), M_k the occluded first moment
-//   Int w dot(n, w) sin(theta) dtheta of the half-slice; n where nothing is visible.
-// - Deviations from the reference integral: one depth layer (nothing behind the first surface, as
-//   every screen-space method); per half-slice only the horizon is known, so every ray below it
-//   counts as blocked at the distance of the occluder that defines it (a tall wall near the
-//   receiver is weighted by the distance of its top, partly corrected by the near-field and
-//   upstream samples); the dominant occluder is the largest horizon over the whole line, so a
-//   higher occluder beyond the radius hides a lower one inside it; thin objects occlude as if
-//   infinitely thick; geometry off screen is missing; the in-between of two strata is known
-//   only through the near-field sample. See README.md.
+//   = normalize((2 pi/3) n - (2 pi/N) sum_k M_k), M_k = Int_occluded w dot(n, w) sin dtheta, the
+//   occluded first moment of the half-slice (the unoccluded hemisphere gives (2 pi/3) n); n where
+//   nothing is visible.
+// - Deviations from the reference integral: one depth layer, thin objects occlude as if infinitely
+//   thick, off-screen geometry is missing (as every screen-space method); per half-slice only
+//   horizons are known, so every ray below one counts as blocked at that occluder's distance (a
+//   tall wall next to the receiver is weighted by the distance of its top where no nearer sample
+//   rises above the tangent plane); the dominant occluder is the largest horizon over the whole
+//   line, so a higher occluder beyond the radius hides a lower one within it (the near-field and
+//   upstream samples keep some of it); between two samples of a line only the near-field sample
+//   is seen; N discrete azimuths. See README.md for measured errors.
 //
 // Parameters
 // | name            | type  | default | range / choices        | unit        |
@@ -117,12 +129,15 @@ config::ParamSchema Lsao::declareParams()
                   "sweep directions over the full circle (each one half-slice)");
     schema.addFloat("line_spacing", 2.0, 0.5, 64.0, "px",
                     "distance between parallel sweep lines of one direction");
-    schema.addFloat("step", 10.0, 1.0, 256.0, "px", "sample spacing along a line (one sample "
-                                                    "per stratum of this length)");
-    schema.addBool("jitter", true, "jittered sample positions within each step stratum (else "
-                                   "regular, at the stratum middles)");
-    schema.addBool("near_field", true, "one extra sample per pixel and direction half-way to "
-                                       "the nearest upstream sweep sample");
+    schema.addFloat("step", 10.0, 1.0, 256.0, "px",
+                    "sample spacing along a line (one sample "
+                    "per stratum of this length)");
+    schema.addBool("jitter", true,
+                   "jittered sample positions within each step stratum (else "
+                   "regular, at the stratum middles)");
+    schema.addBool("near_field", true,
+                   "one extra sample per pixel and direction half-way to "
+                   "the nearest upstream sweep sample");
     schema.addInt("direction_sets", 4, 1, 64, "",
                   "rotated direction sets, frameIndex modulo this picks the set");
     schema.addFloat("radius", 1.0, 0.0, std::numeric_limits<double>::infinity(), "world units",

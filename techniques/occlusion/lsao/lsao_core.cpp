@@ -22,10 +22,8 @@ Layout buildLayout(int width, int height, const plugin::ScreenProjection& projec
     layout.invSize = 1.0f / projection.size;
 
     const int count = std::max(1, params.directions);
-    const glm::vec2 corners[4] = {{0.0f, 0.0f},
-                                  {float(width), 0.0f},
-                                  {0.0f, float(height)},
-                                  {float(width), float(height)}};
+    const glm::vec2 corners[4] = {
+        {0.0f, 0.0f}, {float(width), 0.0f}, {0.0f, float(height)}, {float(width), float(height)}};
     // A step of one pixel along dir at depth 1 moves the view-space point by this much.
     const glm::vec2 pixelToView(2.0f / (float(width) * projection.scale.x),
                                 2.0f / (float(height) * projection.scale.y));
@@ -94,8 +92,8 @@ Constants makeConstants(const Layout& layout, const plugin::ScreenProjection& pr
     c.step = layout.step;
     c.invStep = layout.invStep;
     c.radius = float(params.radius);
-    c.invRadius = params.radius > 0.0 ? float(1.0 / params.radius)
-                                      : std::numeric_limits<float>::infinity();
+    c.invRadius =
+        params.radius > 0.0 ? float(1.0 / params.radius) : std::numeric_limits<float>::infinity();
     c.dirBegin = layout.batches[batch].begin;
     c.dirEnd = layout.batches[batch].end;
     c.dirCount = std::uint32_t(layout.directions.size());
@@ -202,16 +200,16 @@ Contribution evaluateOccluders(const Slice& slice, Occluder o0, Occluder o1, Occ
     const float f0 = computeSliceF(slice, a0);
     const float f1 = computeSliceF(slice, a1);
     const float f2 = computeSliceF(slice, a2);
-    // [Timonen 2013, Sec. 3; Zhukov 1998] obscurance: from each occluder's horizon to the
+    // [Timonen 2013: obscurance; Zhukov 1998] obscurance: from each occluder's horizon to the
     // tangent plane, rays are weighted by 1 - rho of the nearest occluder above them.
     const float n0 = o0.distance;
     const float n1 = std::min(n0, o1.distance);
     const float n2 = std::min(n1, o2.distance);
     Contribution c;
-    c.obscurance = (1.0f - evaluateFalloff(n0, invRadius, smoothstep)) * std::max(0.0f, f1 - f0) +
-                   (1.0f - evaluateFalloff(n1, invRadius, smoothstep)) * std::max(0.0f, f2 - f1) +
-                   (1.0f - evaluateFalloff(n2, invRadius, smoothstep)) *
-                       std::max(0.0f, slice.fHi - f2);
+    c.obscurance =
+        (1.0f - evaluateFalloff(n0, invRadius, smoothstep)) * std::max(0.0f, f1 - f0) +
+        (1.0f - evaluateFalloff(n1, invRadius, smoothstep)) * std::max(0.0f, f2 - f1) +
+        (1.0f - evaluateFalloff(n2, invRadius, smoothstep)) * std::max(0.0f, slice.fHi - f2);
     // Visibility (rho = step at the radius): blocked below the highest occluder within it.
     const bool in0 = o0.distance < radius, in1 = o1.distance < radius, in2 = o2.distance < radius;
     if (in0 || in1 || in2) {

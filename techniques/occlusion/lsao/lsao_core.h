@@ -36,26 +36,26 @@ enum class Falloff { Linear, Smoothstep };
 
 //! The technique's parameters (lsao.cpp declares them with units and ranges).
 struct Params {
-    int directions = 36;       //!< sweep directions over the full circle, [1, 128]
-    float lineSpacing = 2.0f;  //!< px between parallel lines of one direction
-    float step = 10.0f;        //!< px between samples along a line (mean, with jitter)
-    bool jitter = true;        //!< jittered step positions instead of regular ones
-    bool nearField = true;     //!< one extra sample per pixel and direction near the receiver
-    int directionSets = 4;     //!< rotated direction sets, one per frame in turn
-    double radius = 1.0;       //!< world units: falloff radius
+    int directions = 36;      //!< sweep directions over the full circle, [1, 128]
+    float lineSpacing = 2.0f; //!< px between parallel lines of one direction
+    float step = 10.0f;       //!< px between samples along a line (mean, with jitter)
+    bool jitter = true;       //!< jittered step positions instead of regular ones
+    bool nearField = true;    //!< one extra sample per pixel and direction near the receiver
+    int directionSets = 4;    //!< rotated direction sets, one per frame in turn
+    double radius = 1.0;      //!< world units: falloff radius
     Falloff falloff = Falloff::Linear;
 };
 
 //! One direction of the layout, as the shaders read it (std430, 64 bytes).
 struct Direction {
-    glm::vec2 dir{1.0f, 0.0f};   //!< unit screen direction of the sweep (pixels, y down)
-    glm::vec2 perp{0.0f, 1.0f};  //!< (-dir.y, dir.x): lines are offset along it
-    glm::vec4 axis{0.0f};        //!< xyz: unit view-space direction of a step along dir
-    float tMin = 0.0f;           //!< px: smallest dot(pixel, dir) over the image corners
-    float cMin = 0.0f;           //!< px: offset of line 0 along perp
+    glm::vec2 dir{1.0f, 0.0f};  //!< unit screen direction of the sweep (pixels, y down)
+    glm::vec2 perp{0.0f, 1.0f}; //!< (-dir.y, dir.x): lines are offset along it
+    glm::vec4 axis{0.0f};       //!< xyz: unit view-space direction of a step along dir
+    float tMin = 0.0f;          //!< px: smallest dot(pixel, dir) over the image corners
+    float cMin = 0.0f;          //!< px: offset of line 0 along perp
     std::uint32_t lineCount = 0;
-    std::uint32_t stepCount = 0;  //!< step strata per line
-    std::uint32_t base = 0;       //!< first entry of this direction in its batch's sweep buffer
+    std::uint32_t stepCount = 0; //!< step strata per line
+    std::uint32_t base = 0;      //!< first entry of this direction in its batch's sweep buffer
     std::uint32_t pad[3] = {0, 0, 0};
 };
 static_assert(sizeof(Direction) == 64, "must match lsao_common.glsl");
@@ -71,15 +71,15 @@ struct Batch {
 struct Layout {
     int width = 0;
     int height = 0;
-    std::uint32_t setIndex = 0;  //!< direction set of this frame
-    bool jitter = true;          //!< jittered step positions (else regular)
+    std::uint32_t setIndex = 0; //!< direction set of this frame
+    bool jitter = true;         //!< jittered step positions (else regular)
     float spacing = 2.0f;
     float invSpacing = 0.5f;
     float step = 10.0f;
     float invStep = 0.1f;
-    glm::vec2 projOffset{0.0f};  //!< ScreenProjection::offset
-    glm::vec2 invScale{1.0f};    //!< 1 / ScreenProjection::scale
-    glm::vec2 invSize{1.0f};     //!< 1 / image size
+    glm::vec2 projOffset{0.0f}; //!< ScreenProjection::offset
+    glm::vec2 invScale{1.0f};   //!< 1 / ScreenProjection::scale
+    glm::vec2 invSize{1.0f};    //!< 1 / image size
     std::vector<Direction> directions;
     std::vector<Batch> batches;
     std::uint32_t maxLineCount = 0;
@@ -103,7 +103,7 @@ struct Constants {
     float invRadius = 1.0f;
     std::uint32_t dirBegin = 0;
     std::uint32_t dirEnd = 0;
-    std::uint32_t dirCount = 0;  //!< all directions of the frame (normalisation)
+    std::uint32_t dirCount = 0; //!< all directions of the frame (normalisation)
     std::uint32_t flags = 0;
     std::uint32_t setIndex = 0;
     std::uint32_t pad = 0;
@@ -141,8 +141,8 @@ inline std::uint32_t mixHash(std::uint32_t h, std::uint32_t value)
 
 //! Position of the sample in stratum `stepIndex` of a line, as a fraction of the step in [0, 1):
 //! 0.5 without jitter (regular steps), else a hash of direction, line, stratum and set.
-inline float computeStepJitter(std::uint32_t direction, std::uint32_t line,
-                               std::uint32_t stepIndex, std::uint32_t setIndex, bool jitter)
+inline float computeStepJitter(std::uint32_t direction, std::uint32_t line, std::uint32_t stepIndex,
+                               std::uint32_t setIndex, bool jitter)
 {
     if (!jitter)
         return 0.5f;
@@ -161,8 +161,7 @@ inline float computeLineOffset(const Direction& d, std::uint32_t line, float spa
 
 //! px: position along Direction::dir of the sample in stratum `stepIndex`, whose position
 //! within its stratum is `fraction` (computeStepJitter).
-inline float computeSampleT(const Direction& d, std::uint32_t stepIndex, float fraction,
-                            float step)
+inline float computeSampleT(const Direction& d, std::uint32_t stepIndex, float fraction, float step)
 {
     return d.tMin + (float(stepIndex) + fraction) * step;
 }
@@ -196,8 +195,8 @@ inline LineSample locateSample(const Layout& layout, const Direction& d, std::ui
     s.t = computeSampleT(d, std::uint32_t(stratum), xi, layout.step);
     const glm::vec2 pos = computeLinePoint(d, s.t, c);
     s.pixel = glm::ivec2(int(std::floor(pos.x)), int(std::floor(pos.y)));
-    s.exists = s.pixel.x >= 0 && s.pixel.y >= 0 && s.pixel.x < layout.width &&
-               s.pixel.y < layout.height;
+    s.exists =
+        s.pixel.x >= 0 && s.pixel.y >= 0 && s.pixel.x < layout.width && s.pixel.y < layout.height;
     return s;
 }
 
@@ -223,14 +222,14 @@ inline SampleHeight computeSampleHeight(const Layout& layout, glm::vec2 q, glm::
 {
     const float cx = float(pixel.x) + 0.5f;
     const float cy = float(pixel.y) + 0.5f;
-    const float px = z * (((2.0f * cx) * layout.invSize.x - 1.0f + layout.projOffset.x) *
-                          layout.invScale.x);
-    const float py = z * (((2.0f * cy) * layout.invSize.y - 1.0f + layout.projOffset.y) *
-                          layout.invScale.y);
-    const float rx = ((2.0f * q.x) * layout.invSize.x - 1.0f + layout.projOffset.x) *
-                     layout.invScale.x;
-    const float ry = ((2.0f * q.y) * layout.invSize.y - 1.0f + layout.projOffset.y) *
-                     layout.invScale.y;
+    const float px =
+        z * (((2.0f * cx) * layout.invSize.x - 1.0f + layout.projOffset.x) * layout.invScale.x);
+    const float py =
+        z * (((2.0f * cy) * layout.invSize.y - 1.0f + layout.projOffset.y) * layout.invScale.y);
+    const float rx =
+        ((2.0f * q.x) * layout.invSize.x - 1.0f + layout.projOffset.x) * layout.invScale.x;
+    const float ry =
+        ((2.0f * q.y) * layout.invSize.y - 1.0f + layout.projOffset.y) * layout.invScale.y;
     float a = rx * n.x + ry * n.y - n.z;
     float b = px * n.x + py * n.y - z * n.z;
     if (b < 0.0f) {
@@ -243,7 +242,7 @@ inline SampleHeight computeSampleHeight(const Layout& layout, glm::vec2 q, glm::
     return {1.0f, z, false};
 }
 
-// ---- Occluder hull of a line [Timonen 2013, Sec. 3] --------------------------------------
+// ---- Occluder hull of a line [Timonen 2013: occluder hull] ------------------------------
 
 //! True when B lies on or below the chord from A to C in the (t, 1/depth) plane, t increasing
 //! from A to C. In that plane (a projective image of the line's plane through the eye) the eye
@@ -259,10 +258,10 @@ inline bool isOnOrBelowChord(float tA, SampleHeight hA, float tB, SampleHeight h
 }
 
 //! The upper convex hull of the samples of one line seen so far, in (t, 1/depth), kept on a
-//! stack [Timonen 2013, Sec. 3]. findDominant(q) pops the vertices that lie on or below the chord
-//! from their predecessor to q (they can never be the horizon of q or of any later sample), and
-//! the vertex left on top is the dominant occluder of q: the earlier sample with the largest
-//! horizon angle seen from q over the whole line, found in amortised O(1).
+//! stack [Timonen 2013: occluder hull]. findDominant(q) pops the vertices that lie on or below
+//! the chord from their predecessor to q (they can never be the horizon of q or of any later
+//! sample), and the vertex left on top is the dominant occluder of q: the earlier sample with
+//! the largest horizon angle seen from q over the whole line, found in amortised O(1).
 //! The stack is a ring of kHullCapacity entries: pushing onto a full ring overwrites the bottom,
 //! i.e. forgets the farthest hull vertex; the answers are then the exact dominant occluder among
 //! the retained vertices (overflowed() tells). Ties (collinear samples) keep the farther sample.
@@ -298,7 +297,10 @@ public:
         else
             mOverflowed = true;
     }
-    void push(float t, float depth, std::uint32_t id) { push(t, SampleHeight{1.0f, depth, false}, id); }
+    void push(float t, float depth, std::uint32_t id)
+    {
+        push(t, SampleHeight{1.0f, depth, false}, id);
+    }
 
     int size() const { return mSize; }
     bool overflowed() const { return mOverflowed; }
@@ -347,7 +349,7 @@ inline float computeAtan2(float y, float x)
 
 //! An angle in a half-slice with its cosine and sine.
 struct Angle {
-    float theta = 0.0f;  //!< radians from the view vector toward the upstream side, [0, pi]
+    float theta = 0.0f; //!< radians from the view vector toward the upstream side, [0, pi]
     float c = 1.0f;
     float s = 0.0f;
 };
@@ -361,21 +363,21 @@ inline Angle makeAngle(float c, float s)
 //! and the screen line through X along the sweep direction, restricted to the upstream side
 //! (where the sweep's occluders lie). Directions w(theta) = cos(theta) v + sin(theta) t.
 struct Slice {
-    glm::vec3 v{0.0f};       //!< unit, from X toward the eye
-    glm::vec3 t{0.0f};       //!< unit, perpendicular to v in the plane, toward -dir on screen
-    glm::vec3 m{0.0f};       //!< unit normal of the plane
-    float nv = 0.0f;         //!< dot(n, v)
-    float nt = 0.0f;         //!< dot(n, t)
+    glm::vec3 v{0.0f}; //!< unit, from X toward the eye
+    glm::vec3 t{0.0f}; //!< unit, perpendicular to v in the plane, toward -dir on screen
+    glm::vec3 m{0.0f}; //!< unit normal of the plane
+    float nv = 0.0f;   //!< dot(n, v)
+    float nt = 0.0f;   //!< dot(n, t)
     //! A point at offset c along m moves into the plane along the receiver's tangent plane by
     //! c (kv v + kt t): k = dot(n, m) (nv, nt) / (nv^2 + nt^2), |k| <= 1000 (a half-slice
     //! weighs |(nv, nt)| in the integral, so the clamp only acts where it weighs < 1e-3).
     float kv = 0.0f;
     float kt = 0.0f;
-    Angle lo;                //!< where the hemisphere of n starts in the half-slice
-    Angle hi;                //!< where it ends (the tangent plane)
-    float fHi = 0.0f;        //!< computeSliceF(hi)
-    glm::vec3 gHi{0.0f};     //!< computeSliceG(hi)
-    bool hasHemisphere = false;  //!< false: the half-slice holds no direction of the hemisphere
+    Angle lo;                   //!< where the hemisphere of n starts in the half-slice
+    Angle hi;                   //!< where it ends (the tangent plane)
+    float fHi = 0.0f;           //!< computeSliceF(hi)
+    glm::vec3 gHi{0.0f};        //!< computeSliceG(hi)
+    bool hasHemisphere = false; //!< false: the half-slice holds no direction of the hemisphere
 };
 
 //! Cosine-weighted measure of directions [0, a] of the half-slice, the integral of
@@ -402,8 +404,8 @@ Slice makeSlice(const glm::vec3& x, const glm::vec3& n, const glm::vec3& axis);
 //! An occluder point seen from the receiver in its half-slice.
 struct Occluder {
     Angle angle;
-    float distance = 0.0f;  //!< world units, |p - x|
-    bool valid = false;     //!< on the upstream side and not the receiver itself
+    float distance = 0.0f; //!< world units, |p - x|
+    bool valid = false;    //!< on the upstream side and not the receiver itself
 };
 
 //! Projects the view-space point `p` (a G-buffer sample, possibly from a neighbouring line)

@@ -78,7 +78,7 @@ Occluder loadDominant(const GatherContext& g, const Direction& d, std::uint32_t 
 }
 
 //! The contribution of direction k at receiver x (pixel centre p, unit normal n).
-//! [Timonen 2013, Sec. 4] bilinear over the two lines that bracket p and the two samples that
+//! [Timonen 2013: gathering] bilinear over the two lines that bracket p and the two samples that
 //! bracket it along each line; each sample's dominant occluder (from the sweep) is seen from the
 //! receiver itself, with the receiver's normal [Quantum Break seed: occluders clamped to the
 //! visible hemisphere]. The gap between the upstream sample and the receiver gets one near-field
@@ -164,8 +164,8 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
         }
         if (wNear > 0.0f) {
             addScaled(total, lineWeight * wNear,
-                      evaluateOccluders(slice, near, Occluder{}, Occluder{}, g.radius,
-                                        g.invRadius, g.smoothstep));
+                      evaluateOccluders(slice, near, Occluder{}, Occluder{}, g.radius, g.invRadius,
+                                        g.smoothstep));
         }
     }
     return total;
@@ -183,28 +183,30 @@ std::vector<std::uint32_t> runSweepCpu(const Layout& layout, std::size_t batchIn
     for (std::uint32_t k = batch.begin; k < batch.end; ++k)
         for (std::uint32_t i = 0; i < layout.directions[k].lineCount; ++i)
             lines.emplace_back(k, i);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, lines.size(), 32),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t r = range.begin(); r != range.end(); ++r) {
-            const auto [k, line] = lines[r];
-            const Direction& d = layout.directions[k];
-            const float c = computeLineOffset(d, line, layout.spacing);
-            std::uint32_t* out = sweep.data() + d.base + std::size_t(line) * d.stepCount;
-            // [Timonen 2013, Sec. 3] walk the line across the whole depth buffer; the hull holds
-            // every earlier sample that can still be a horizon.
-            OccluderHull hull;
-            for (std::uint32_t m = 0; m < d.stepCount; ++m) {
-                const LineSample s = locateSample(layout, d, k, line, c, int(m));
-                const float z = s.exists ? loadDepth(depth, s.pixel) : 0.0f;
-                if (z == 0.0f)
-                    continue;  // outside or sky: no point, no occluder (entry stays kNoOccluder)
-                const SampleHeight h = computeSampleHeight(
-                    layout, computeLinePoint(d, s.t, c), s.pixel, z, normal.at(s.pixel.x, s.pixel.y));
-                out[m] = hull.findDominant(s.t, h);
-                hull.push(s.t, h, m);
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, lines.size(), 32),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t r = range.begin(); r != range.end(); ++r) {
+                const auto [k, line] = lines[r];
+                const Direction& d = layout.directions[k];
+                const float c = computeLineOffset(d, line, layout.spacing);
+                std::uint32_t* out = sweep.data() + d.base + std::size_t(line) * d.stepCount;
+                // [Timonen 2013: sweeps] walk the line across the whole depth buffer; the hull
+                // holds every earlier sample that can still be a horizon.
+                OccluderHull hull;
+                for (std::uint32_t m = 0; m < d.stepCount; ++m) {
+                    const LineSample s = locateSample(layout, d, k, line, c, int(m));
+                    const float z = s.exists ? loadDepth(depth, s.pixel) : 0.0f;
+                    if (z == 0.0f)
+                        continue; // outside or sky: no point, no occluder (entry stays kNoOccluder)
+                    const SampleHeight h =
+                        computeSampleHeight(layout, computeLinePoint(d, s.t, c), s.pixel, z,
+                                            normal.at(s.pixel.x, s.pixel.y));
+                    out[m] = hull.findDominant(s.t, h);
+                    hull.push(s.t, h, m);
+                }
             }
-        }
-    });
+        });
     return sweep;
 }
 
@@ -225,32 +227,32 @@ void runGatherCpu(const Layout& layout, std::size_t batchIndex,
                           params.radius > 0.0 ? float(1.0 / params.radius)
                                               : std::numeric_limits<float>::infinity()};
     const int w = layout.width;
-    tbb::parallel_for(tbb::blocked_range<int>(0, layout.height),
-                      [&](const tbb::blocked_range<int>& rows) {
-        for (int py = rows.begin(); py != rows.end(); ++py) {
-            for (int px = 0; px < w; ++px) {
-                const float z = depth.at(px, py);
-                const glm::vec3 nRaw = normal.at(px, py);
-                if (!hasSurface(z, nRaw))
-                    continue;
-                const glm::vec3 n = glm::normalize(nRaw);
-                const glm::vec2 p(float(px) + 0.5f, float(py) + 0.5f);
-                const glm::vec3 x = projection.toView(p, z);
-                const std::size_t i = std::size_t(py) * std::size_t(w) + std::size_t(px);
-                for (std::uint32_t k = batch.begin; k < batch.end; ++k) {
-                    const Contribution c = gatherDirection(g, k, p, x, n);
-                    sums.obscurance[i] += c.obscurance;
-                    sums.visibility[i] += c.visibility;
-                    sums.moment[i] += c.moment;
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, layout.height), [&](const tbb::blocked_range<int>& rows) {
+            for (int py = rows.begin(); py != rows.end(); ++py) {
+                for (int px = 0; px < w; ++px) {
+                    const float z = depth.at(px, py);
+                    const glm::vec3 nRaw = normal.at(px, py);
+                    if (!hasSurface(z, nRaw))
+                        continue;
+                    const glm::vec3 n = glm::normalize(nRaw);
+                    const glm::vec2 p(float(px) + 0.5f, float(py) + 0.5f);
+                    const glm::vec3 x = projection.toView(p, z);
+                    const std::size_t i = std::size_t(py) * std::size_t(w) + std::size_t(px);
+                    for (std::uint32_t k = batch.begin; k < batch.end; ++k) {
+                        const Contribution c = gatherDirection(g, k, p, x, n);
+                        sums.obscurance[i] += c.obscurance;
+                        sums.visibility[i] += c.visibility;
+                        sums.moment[i] += c.moment;
+                    }
                 }
             }
-        }
-    });
+        });
 }
 
 void computeOnCpu(const Layout& layout, const plugin::ScreenProjection& projection,
-                  const Params& params, const Image<float>& depth,
-                  const Image<glm::vec3>& normal, plugin::OcclusionOutput& out)
+                  const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
+                  plugin::OcclusionOutput& out)
 {
     const int w = layout.width, h = layout.height;
     const std::size_t count = std::size_t(w) * std::size_t(h);

@@ -33,8 +33,8 @@ void runGatherCpu(const Layout& layout, std::size_t batch,
 
 //! Both passes over all batches, then the outputs.
 void computeOnCpu(const Layout& layout, const plugin::ScreenProjection& projection,
-                  const Params& params, const Image<float>& depth,
-                  const Image<glm::vec3>& normal, plugin::OcclusionOutput& out);
+                  const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
+                  plugin::OcclusionOutput& out);
 
 //! Whether a G-buffer pixel holds a surface: finite positive depth and a non-zero normal.
 inline bool hasSurface(float depth, const glm::vec3& normal)

@@ -63,14 +63,14 @@ void GpuRunner::prepare(const Layout& layout)
         using gpu::Format;
         using gpu::ImageDimension;
         using gpu::ImageUsage;
-        mDepth = mContext->createImage(
-            {ImageDimension::Image2D, Format::R32Float, w, h, 1, ImageUsage::Storage, "lsao.depth"});
+        mDepth = mContext->createImage({ImageDimension::Image2D, Format::R32Float, w, h, 1,
+                                        ImageUsage::Storage, "lsao.depth"});
         mNormal = mContext->createImage({ImageDimension::Image2D, Format::RGBA32Float, w, h, 1,
                                          ImageUsage::Storage, "lsao.normal"});
         mAccumA = mContext->createImage({ImageDimension::Image2D, Format::RGBA32Float, w, h, 1,
                                          ImageUsage::Storage, "lsao.accum_a"});
-        mAccumB = mContext->createImage(
-            {ImageDimension::Image2D, Format::R32Float, w, h, 1, ImageUsage::Storage, "lsao.accum_b"});
+        mAccumB = mContext->createImage({ImageDimension::Image2D, Format::R32Float, w, h, 1,
+                                         ImageUsage::Storage, "lsao.accum_b"});
         mWidth = layout.width;
         mHeight = layout.height;
     }
@@ -88,8 +88,8 @@ void GpuRunner::prepare(const Layout& layout)
 }
 
 void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projection,
-                    const Params& params, const Image<float>& depth,
-                    const Image<glm::vec3>& normal, plugin::OcclusionOutput& out)
+                    const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
+                    plugin::OcclusionOutput& out)
 {
     prepare(layout);
     const int w = layout.width, h = layout.height;
@@ -111,27 +111,25 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
     mContext->run([&](gpu::CommandList& cmd) {
         for (std::size_t b = 0; b < layout.batches.size(); ++b) {
             const Batch& batch = layout.batches[b];
-            cmd.dispatch(mSweep,
-                         {gpu::Binding::storageImage(0, mDepth),
-                          gpu::Binding::storageBuffer(1, mDirections),
-                          gpu::Binding::storageBuffer(2, mSweepBuffer),
-                          gpu::Binding::storageImage(3, mNormal)},
-                         gpu::PushConstants(constants[b]),
-                         gpu::GroupCount{gpu::computeGroupCount(layout.maxLineCount, kSweepGroupSize),
-                                         batch.end - batch.begin, 1},
-                         "lsao.sweep");
-            cmd.dispatch(mGather,
-                         {gpu::Binding::storageImage(0, mDepth),
-                          gpu::Binding::storageBuffer(1, mDirections),
-                          gpu::Binding::storageBuffer(2, mSweepBuffer),
-                          gpu::Binding::storageImage(3, mNormal),
-                          gpu::Binding::storageImage(4, mAccumA),
-                          gpu::Binding::storageImage(5, mAccumB)},
-                         gpu::PushConstants(constants[b]),
-                         gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), kGatherGroupSize),
-                                         gpu::computeGroupCount(std::uint64_t(h), kGatherGroupSize),
-                                         1},
-                         "lsao.gather");
+            cmd.dispatch(
+                mSweep,
+                {gpu::Binding::storageImage(0, mDepth), gpu::Binding::storageBuffer(1, mDirections),
+                 gpu::Binding::storageBuffer(2, mSweepBuffer),
+                 gpu::Binding::storageImage(3, mNormal)},
+                gpu::PushConstants(constants[b]),
+                gpu::GroupCount{gpu::computeGroupCount(layout.maxLineCount, kSweepGroupSize),
+                                batch.end - batch.begin, 1},
+                "lsao.sweep");
+            cmd.dispatch(
+                mGather,
+                {gpu::Binding::storageImage(0, mDepth), gpu::Binding::storageBuffer(1, mDirections),
+                 gpu::Binding::storageBuffer(2, mSweepBuffer),
+                 gpu::Binding::storageImage(3, mNormal), gpu::Binding::storageImage(4, mAccumA),
+                 gpu::Binding::storageImage(5, mAccumB)},
+                gpu::PushConstants(constants[b]),
+                gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), kGatherGroupSize),
+                                gpu::computeGroupCount(std::uint64_t(h), kGatherGroupSize), 1},
+                "lsao.gather");
         }
     });
 

@@ -28,8 +28,8 @@ public:
     gpu::Context& getContext() const { return *mContext; }
 
     //! Both passes of every batch of `layout` in one submission, then reads back the outputs.
-    void run(const Layout& layout, const plugin::ScreenProjection& projection,
-             const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
+    void run(const Layout& layout, const plugin::ScreenProjection& projection, const Params& params,
+             const Image<float>& depth, const Image<glm::vec3>& normal,
              plugin::OcclusionOutput& out);
 
     //! The sweep buffer of the last batch of the last run (for tests).

@@ -39,8 +39,8 @@ protected:
 
 struct Differences {
     float ambient = 0.0f;
-    float visible = 0.0f;   //!< of sin^2(aperture), the visible fraction A
-    float aperture = 0.0f;  //!< radians (reported only: asin(sqrt(A)) has slope 1/(2 sqrt(A(1-A))))
+    float visible = 0.0f;  //!< of sin^2(aperture), the visible fraction A
+    float aperture = 0.0f; //!< radians (reported only: asin(sqrt(A)) has slope 1/(2 sqrt(A(1-A))))
     float bent = 0.0f;
 };
 
@@ -50,7 +50,8 @@ Differences compareOutputs(const plugin::OcclusionOutput& a, const plugin::Occlu
     EXPECT_EQ(a.ambient.pixels.size(), b.ambient.pixels.size());
     for (std::size_t i = 0; i < a.ambient.pixels.size(); ++i) {
         d.ambient = std::max(d.ambient, std::fabs(a.ambient.pixels[i] - b.ambient.pixels[i]));
-        const float sa = std::sin(a.coneAperture.pixels[i]), sb = std::sin(b.coneAperture.pixels[i]);
+        const float sa = std::sin(a.coneAperture.pixels[i]),
+                    sb = std::sin(b.coneAperture.pixels[i]);
         d.visible = std::max(d.visible, std::fabs(sa * sa - sb * sb));
         d.aperture =
             std::max(d.aperture, std::fabs(a.coneAperture.pixels[i] - b.coneAperture.pixels[i]));
@@ -98,8 +99,12 @@ TEST_F(LsaoGpu, MatchesTheCpuPathAndTheSweepBuffersAreIdentical)
     const Overrides configs[] = {
         {},
         {{"falloff", std::string("smoothstep")}, {"radius", 0.3}},
-        {{"jitter", false}, {"near_field", false}, {"directions", std::int64_t(7)},
-         {"step", 3.5}, {"line_spacing", 1.5}, {"radius", 1e6}},
+        {{"jitter", false},
+         {"near_field", false},
+         {"directions", std::int64_t(7)},
+         {"step", 3.5},
+         {"line_spacing", 1.5},
+         {"radius", 1e6}},
     };
     for (int frame : {0, 3}) {
         for (const Overrides& o : configs) {
@@ -173,12 +178,14 @@ TEST_F(LsaoGpu, IsDeterministicAndReusesItsResourcesAcrossSizes)
 //! zero normals, grazing normals, discontinuities.
 void makeHostileGBuffer(int w, int h, Image<float>& depth, Image<glm::vec3>& normal)
 {
-    const float depths[] = {1e-3f, 0.5f, 1e5f, std::numeric_limits<float>::infinity(), 3.0f,
-                            3.001f, 2e-3f, 7.0f};
-    const glm::vec3 normals[] = {glm::vec3(0.0f, 0.0f, 1.0f), glm::vec3(0.0f),
+    const float depths[] = {1e-3f, 0.5f,   1e5f,  std::numeric_limits<float>::infinity(),
+                            3.0f,  3.001f, 2e-3f, 7.0f};
+    const glm::vec3 normals[] = {glm::vec3(0.0f, 0.0f, 1.0f),
+                                 glm::vec3(0.0f),
                                  glm::normalize(glm::vec3(1.0f, 1.0f, 1.0f)),
                                  glm::normalize(glm::vec3(1.0f, 0.0f, 1e-3f)),
-                                 glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 0.0f, 1e-8f),
+                                 glm::vec3(0.0f, 1.0f, 0.0f),
+                                 glm::vec3(0.0f, 0.0f, 1e-8f),
                                  glm::normalize(glm::vec3(-0.3f, 0.2f, 0.9f))};
     depth = Image<float>(w, h);
     normal = Image<glm::vec3>(w, h);
@@ -198,8 +205,8 @@ TEST_F(LsaoGpu, OutputIsValidOnHostileInputsOnBothPaths)
         Image<glm::vec3> normal;
         makeHostileGBuffer(size.x, size.y, depth, normal);
         scene::Camera camera;
-        const glm::mat4 projection = camera.projectionMatrix(float(size.x) / float(size.y),
-                                                             glm::vec2(0.4f, -0.3f), size);
+        const glm::mat4 projection =
+            camera.projectionMatrix(float(size.x) / float(size.y), glm::vec2(0.4f, -0.3f), size);
         for (const double radius : {0.0, 1e-3, 1.0, 1e6}) {
             for (const char* falloff : {"linear", "smoothstep"}) {
                 Lsao lsao = makeLsao({{"radius", radius}, {"falloff", std::string(falloff)}});
@@ -255,7 +262,7 @@ GBuffer makePlanesGBuffer(int w, int h, const std::vector<std::pair<glm::vec3, g
     g.normal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
     for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
-            const glm::vec3 r = g.screen.toView({x + 0.5f, y + 0.5f}, 1.0f);  // depth 1
+            const glm::vec3 r = g.screen.toView({x + 0.5f, y + 0.5f}, 1.0f); // depth 1
             for (std::size_t i = 0; i < planes.size(); ++i) {
                 const auto& [point, n] = planes[i];
                 // Plane 0 only inside |x/z|, |y/z| < maxSlope (a box face in front).
@@ -280,10 +287,13 @@ TEST_F(LsaoGpu, OutputIsValidOnTheFamilyStabilityCases)
     const glm::vec3 up(0, 1, 0), front(0, 0, 1);
     const std::pair<const char*, GBuffer> cases[] = {
         {"crease", makePlanesGBuffer(64, 48, {{{0, -1, 0}, up}, {{0, 0, -4}, front}})},
-        {"depth step", makePlanesGBuffer(48, 32, {{{0, 0, -1}, front}, {{0, 0, -50}, front}}, 0.2f)},
-        {"grazing", makePlanesGBuffer(40, 30, {{{0, -0.05f, 0}, glm::normalize(glm::vec3(0, 1, 0.02f))}})},
+        {"depth step",
+         makePlanesGBuffer(48, 32, {{{0, 0, -1}, front}, {{0, 0, -50}, front}}, 0.2f)},
+        {"grazing",
+         makePlanesGBuffer(40, 30, {{{0, -0.05f, 0}, glm::normalize(glm::vec3(0, 1, 0.02f))}})},
         {"near", makePlanesGBuffer(32, 24, {{{0, 0, -1e-3f}, front}})},
-        {"far", makePlanesGBuffer(32, 24, {{{0, -1e4f, -1e5f}, glm::normalize(glm::vec3(0, 1, 1))}})},
+        {"far",
+         makePlanesGBuffer(32, 24, {{{0, -1e4f, -1e5f}, glm::normalize(glm::vec3(0, 1, 1))}})},
     };
     for (const auto& [name, g] : cases) {
         for (const double radius : {0.0, 0.5, 1e6}) {

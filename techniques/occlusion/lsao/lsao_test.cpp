@@ -94,11 +94,11 @@ TEST(Lsao, HullFindsTheBruteForceDominantOccluderOnRandomProfiles)
         const float slope = (uniform(rng) - 0.5f) * 0.2f;
         const float noise = profile % 3 == 0 ? 0.0f : 0.5f * uniform(rng) * base;
         for (int i = 0; i < n; ++i) {
-            t[i] = 10.0f * (float(i) + uniform(rng));  // jittered strata of 10 px
+            t[i] = 10.0f * (float(i) + uniform(rng)); // jittered strata of 10 px
             d[i] = std::max(0.05f, base + slope * t[i] + noise * (uniform(rng) - 0.5f) +
                                        (uniform(rng) < 0.05f ? -0.5f * base : 0.0f));
             if (uniform(rng) < 0.03f)
-                d[i] = 0.0f;  // sky: skipped, as the sweep does
+                d[i] = 0.0f; // sky: skipped, as the sweep does
         }
         OccluderHull hull;
         for (int q = 0; q < n; ++q) {
@@ -113,7 +113,8 @@ TEST(Lsao, HullFindsTheBruteForceDominantOccluderOnRandomProfiles)
                 ++queries;
                 const double got = (1.0 / d[id] - 1.0 / d[q]) / (double(t[q]) - double(t[id]));
                 sameIndex += int(id) == best;
-                const double rel = std::fabs(got - bestSlope) / std::max(1e-12, std::fabs(bestSlope));
+                const double rel =
+                    std::fabs(got - bestSlope) / std::max(1e-12, std::fabs(bestSlope));
                 worstRelative = std::max(worstRelative, rel);
             }
             hull.push(t[q], d[q], std::uint32_t(q));
@@ -150,7 +151,8 @@ TEST(Lsao, HullFindsExactHorizonOnPlanesAndConcaveProfiles)
     OccluderHull bowl;
     for (int i = 0; i < 20; ++i) {
         const float w = 1.0f - 0.001f * float(i - 10) * float(i - 10);
-        EXPECT_EQ(bowl.findDominant(float(i), 1.0f / w), i == 0 ? kNoOccluder : std::uint32_t(i - 1));
+        EXPECT_EQ(bowl.findDominant(float(i), 1.0f / w),
+                  i == 0 ? kNoOccluder : std::uint32_t(i - 1));
         bowl.push(float(i), 1.0f / w, std::uint32_t(i));
     }
     EXPECT_EQ(bowl.size(), 20);
@@ -165,7 +167,8 @@ TEST(Lsao, HullOverflowForgetsTheFarthestVertices)
         t.push_back(float(i));
         const float w = 2.0f - 0.0001f * float(i - 50) * float(i - 50);
         d.push_back(1.0f / w);
-        EXPECT_EQ(hull.findDominant(t.back(), d.back()), i == 0 ? kNoOccluder : std::uint32_t(i - 1));
+        EXPECT_EQ(hull.findDominant(t.back(), d.back()),
+                  i == 0 ? kNoOccluder : std::uint32_t(i - 1));
         hull.push(t.back(), d.back(), std::uint32_t(i));
     }
     EXPECT_TRUE(hull.overflowed());
@@ -228,8 +231,8 @@ TEST(Lsao, TiltedFloorIsUnoccluded)
 //! of makeWallScene: 1 minus the form factor of the part of the wall's front face in the frustum.
 double computeWallAo(const GBuffer& g, const SceneDesc& s, float wallHeight, glm::vec3 receiver)
 {
-    std::vector<glm::dvec3> wall = {{-30.0, 0.0, 0.0}, {30.0, 0.0, 0.0},
-                                    {30.0, wallHeight, 0.0}, {-30.0, wallHeight, 0.0}};
+    std::vector<glm::dvec3> wall = {
+        {-30.0, 0.0, 0.0}, {30.0, 0.0, 0.0}, {30.0, wallHeight, 0.0}, {-30.0, wallHeight, 0.0}};
     wall = clipToFrustum(g, s.camera, wall);
     return 1.0 - computePolygonFormFactor(glm::dvec3(receiver), glm::dvec3(0.0, 1.0, 0.0), wall);
 }
@@ -267,8 +270,10 @@ TEST(Lsao, WallMatchesTheFormFactorOfItsVisiblePartAndOccludesFromFarAway)
         int directions;
     };
     const Config configs[] = {
-        {"dense", {{"directions", std::int64_t(128)}, {"step", 1.0}, {"line_spacing", 1.0},
-                   {"radius", 1e6}}, 1.0f, 128},
+        {"dense",
+         {{"directions", std::int64_t(128)}, {"step", 1.0}, {"line_spacing", 1.0}, {"radius", 1e6}},
+         1.0f,
+         128},
         {"default", {{"radius", 1e6}}, 10.0f, 36}};
     const int x = 160;
     for (const Config& c : configs) {
@@ -295,14 +300,16 @@ TEST(Lsao, WallMatchesTheFormFactorOfItsVisiblePartAndOccludesFromFarAway)
             // is the visible fraction (radius 1e6: = ambient), with the ambient's bound; the
             // bent vector n - (3/N) sum M moves by at most 3 dtheta + 3/N (same argument), so its
             // direction by that over its length.
-            std::vector<glm::dvec3> wall = {{-30.0, 0.0, 0.0}, {30.0, 0.0, 0.0},
-                                            {30.0, wallHeight, 0.0}, {-30.0, wallHeight, 0.0}};
+            std::vector<glm::dvec3> wall = {{-30.0, 0.0, 0.0},
+                                            {30.0, 0.0, 0.0},
+                                            {30.0, wallHeight, 0.0},
+                                            {-30.0, wallHeight, 0.0}};
             const auto [visible, bentRaw] =
                 integrateFloorVisibility(glm::dvec3(p), clipToFrustum(g, s.camera, wall));
             const double sinAperture = std::sin(double(out.coneAperture.at(x, y)));
             EXPECT_NEAR(sinAperture * sinAperture, visible, tol) << c.name << " row " << y;
-            const glm::dvec3 bentWorld = glm::transpose(glm::dmat3(glm::mat3(g.view))) *
-                                         glm::dvec3(out.bentNormal.at(x, y));
+            const glm::dvec3 bentWorld =
+                glm::transpose(glm::dmat3(glm::mat3(g.view))) * glm::dvec3(out.bentNormal.at(x, y));
             const double angle = std::acos(std::clamp(
                 glm::dot(glm::normalize(bentWorld), glm::normalize(bentRaw)), -1.0, 1.0));
             const double angleTol = 1.5 * tol / glm::length(bentRaw);
@@ -379,7 +386,7 @@ TEST(Lsao, IsDeterministicAndRotatesDirectionSetsOverFrames)
     EXPECT_EQ(a.coneAperture.pixels, b.coneAperture.pixels);
     EXPECT_TRUE(a.bentNormal.pixels == b.bentNormal.pixels);
     const auto next = runCpu({}, g, 1);
-    const auto again = runCpu({}, g, 4);  // 4 sets: frame 4 uses set 0 again
+    const auto again = runCpu({}, g, 4); // 4 sets: frame 4 uses set 0 again
     EXPECT_NE(a.ambient.pixels, next.ambient.pixels);
     EXPECT_EQ(a.ambient.pixels, again.ambient.pixels);
 }
@@ -400,14 +407,14 @@ TEST(Lsao, MoreDirectionsLowerTheErrorAgainstADenseEvaluation)
         EXPECT_LT(err, previous) << n;
         previous = err;
     }
-    EXPECT_LT(previous, 0.005);
+    EXPECT_LT(previous, 1e-3);
 }
 
 TEST(Lsao, JitteredAndRegularStepsBothConverge)
 {
     const GBuffer g = renderScene(makeFloorBoxScene(), 160, 120);
-    const Overrides dense = {{"directions", std::int64_t(128)}, {"step", 1.0},
-                             {"line_spacing", 1.0}, {"jitter", false}};
+    const Overrides dense = {
+        {"directions", std::int64_t(128)}, {"step", 1.0}, {"line_spacing", 1.0}, {"jitter", false}};
     const auto reference = runCpu(dense, g);
     for (const bool jitter : {false, true}) {
         double previous = 1.0;
@@ -420,7 +427,7 @@ TEST(Lsao, JitteredAndRegularStepsBothConverge)
             EXPECT_LT(err, previous) << jitter << " " << step;
             previous = err;
         }
-        EXPECT_LT(previous, jitter ? 0.005 : 1e-7);
+        EXPECT_LT(previous, jitter ? 1e-3 : 1e-7);
     }
 }
 

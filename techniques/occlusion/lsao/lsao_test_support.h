@@ -42,7 +42,7 @@ struct Box {
 struct SceneDesc {
     scene::Camera camera;
     glm::vec2 jitter{0.0f};
-    bool floor = true;  //!< the plane y = 0, normal +y
+    bool floor = true; //!< the plane y = 0, normal +y
     std::vector<Box> boxes;
 };
 
@@ -67,8 +67,8 @@ struct GBuffer {
     //! World position of the surface point of pixel (x, y).
     glm::vec3 getWorldPoint(int x, int y) const
     {
-        const glm::vec3 v = screen.toView(glm::vec2(float(x) + 0.5f, float(y) + 0.5f),
-                                          depth.at(x, y));
+        const glm::vec3 v =
+            screen.toView(glm::vec2(float(x) + 0.5f, float(y) + 0.5f), depth.at(x, y));
         return glm::vec3(glm::inverse(view) * glm::vec4(v, 1.0f));
     }
 };
@@ -177,7 +177,8 @@ inline SceneDesc makeWallScene(float wallHeight)
 
 //! Form factor from a differential area at `x` with unit normal `n` to the polygon `poly`
 //! (Lambert's formula; the polygon must lie above the tangent plane of x).
-inline double computePolygonFormFactor(glm::dvec3 x, glm::dvec3 n, const std::vector<glm::dvec3>& poly)
+inline double computePolygonFormFactor(glm::dvec3 x, glm::dvec3 n,
+                                       const std::vector<glm::dvec3>& poly)
 {
     double sum = 0.0;
     for (std::size_t i = 0; i < poly.size(); ++i) {

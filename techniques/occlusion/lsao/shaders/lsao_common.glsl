@@ -131,7 +131,8 @@ bool lsaoHasSurface(float depth, vec3 normal)
 }
 
 // lsao::computeSampleHeight: 1/depth = h.x / h.y of the line point q, from the tangent plane
-// of its pixel (centre depth z, normal n), else 1/z; h.z = 1 when on the line (SampleHeight::onLine).
+// of its pixel (centre depth z, normal n), else 1/z; h.z = 1 when on the line
+// (SampleHeight::onLine).
 vec3 lsaoSampleHeight(vec2 q, ivec2 pixel, float z, vec3 n)
 {
     float cx = float(pixel.x) + 0.5;
@@ -154,7 +155,7 @@ vec3 lsaoSampleHeight(vec2 q, ivec2 pixel, float z, vec3 n)
     return vec3(1.0, z, 0.0);
 }
 
-// ---- Occluder hull [Timonen 2013, Sec. 3] ----------------------------------------------------
+// ---- Occluder hull [Timonen 2013: occluder hull] --------------------------------------------
 
 // B on or below the chord A -> C in (t, 1/depth), 1/depth = h.x / h.y, multiplied through by
 // hA.y hB.y hC.y > 0.
@@ -351,8 +352,8 @@ Contribution lsaoEvaluateOccluders(Slice sl, Occluder o0, Occluder o1, Occluder 
     float f0 = lsaoSliceF(sl, a0);
     float f1 = lsaoSliceF(sl, a1);
     float f2 = lsaoSliceF(sl, a2);
-    // [Timonen 2013, Sec. 3; Zhukov 1998] rays from each occluder's horizon to the tangent plane
-    // are weighted by 1 - rho of the nearest occluder above them.
+    // [Timonen 2013: obscurance; Zhukov 1998] rays from each occluder's horizon to the tangent
+    // plane are weighted by 1 - rho of the nearest occluder above them.
     float n0 = o0.distance;
     float n1 = min(n0, o1.distance);
     float n2 = min(n1, o2.distance);

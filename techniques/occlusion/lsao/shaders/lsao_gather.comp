@@ -1,5 +1,5 @@
-// Pass 2 "lsao.gather" of Line-Sweep Ambient Obscurance [Timonen 2013, Sec. 4]: one invocation per
-// pixel. For each direction of the batch it interpolates bilinearly between the samples of the
+// Pass 2 "lsao.gather" of Line-Sweep Ambient Obscurance [Timonen 2013: gathering]: one invocation
+// per pixel. For each direction of the batch it interpolates bilinearly between the samples of the
 // two lines that bracket the pixel and the two samples that bracket it along each line, each
 // sample's dominant occluder seen from the pixel itself with its normal, plus one near-field
 // sample [Quantum Break seed], and adds the half-slice contributions to the accumulators.

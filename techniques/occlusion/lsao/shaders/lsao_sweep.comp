@@ -1,5 +1,5 @@
-// Pass 1 "lsao.sweep" of Line-Sweep Ambient Obscurance [Timonen 2013, Sec. 3]: one invocation per
-// line of a direction (x: line, y: direction of the batch). It walks its line across the whole
+// Pass 1 "lsao.sweep" of Line-Sweep Ambient Obscurance [Timonen 2013: sweeps]: one invocation
+// per line of a direction (x: line, y: direction of the batch). It walks its line across the whole
 // depth buffer in step strata and keeps the earlier samples that can still be a horizon as an
 // upper convex hull in (t, 1/depth) on a stack of LSAO_HULL_CAPACITY entries (a ring: a push onto
 // a full stack forgets the farthest vertex). Per stratum it stores the stratum index of the
