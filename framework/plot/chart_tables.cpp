@@ -32,4 +32,20 @@ void checkSeriesLengths(const std::string& what, const std::string& label, std::
                     " point labels (expected as many x as y, and no labels or one per point)");
 }
 
+void setUpXyAxes(const std::string& what, const std::vector<Series>& series, const std::string& xLabel,
+                 AxisScale xScale, const std::string& yLabel, AxisScale yScale, AxisSetup& xAxis,
+                 AxisSetup& yAxis)
+{
+    std::vector<double> allX, allY;
+    for (const auto& s : series) {
+        checkSeriesLengths(what, s.label, s.x.size(), s.y.size(), s.pointLabels.size());
+        allX.insert(allX.end(), s.x.begin(), s.x.end());
+        allY.insert(allY.end(), s.y.begin(), s.y.end());
+    }
+    xAxis = AxisSetup{xLabel, isLogAxis(xScale, allX)};
+    yAxis = AxisSetup{yLabel, isLogAxis(yScale, allY)};
+    computeAxisRange(allX, xAxis.log, xAxis.min, xAxis.max);
+    computeAxisRange(allY, yAxis.log, yAxis.min, yAxis.max);
+}
+
 } // namespace rtlab::plot::detail

@@ -18,17 +18,9 @@ namespace rtlab::plot {
 
 void writeLineChart(const LineSpec& spec, const std::string& pathWithoutExtension)
 {
-    std::vector<double> allX, allY;
-    for (const auto& s : spec.series) {
-        detail::checkSeriesLengths("line chart", s.label, s.x.size(), s.y.size(),
-                                   s.pointLabels.size());
-        allX.insert(allX.end(), s.x.begin(), s.x.end());
-        allY.insert(allY.end(), s.y.begin(), s.y.end());
-    }
-    detail::AxisSetup xAxis{spec.xLabel, isLogAxis(spec.xScale, allX)};
-    detail::AxisSetup yAxis{spec.yLabel, isLogAxis(spec.yScale, allY)};
-    detail::computeAxisRange(allX, xAxis.log, xAxis.min, xAxis.max);
-    detail::computeAxisRange(allY, yAxis.log, yAxis.min, yAxis.max);
+    detail::AxisSetup xAxis, yAxis;
+    detail::setUpXyAxes("line chart", spec.series, spec.xLabel, spec.xScale, spec.yLabel, spec.yScale, xAxis,
+                        yAxis);
     const auto colors = getSeriesColors(spec.series, spec.colors);
 
     auto lock = detail::lockRendering();
