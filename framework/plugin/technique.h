@@ -13,6 +13,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rtlab::plugin {
@@ -34,6 +35,9 @@ public:
     //! The parameters actually in effect: every declared parameter, after defaults and any
     //! clamping or derivation the technique applies. Stored beside every result.
     virtual config::ParamSet effectiveParams() const = 0;
+    //! Named counts or ratios from the last call (e.g. "vertices_left_cell_share"), which the
+    //! harness stores as `counter.<name>` columns. Most techniques have none.
+    virtual std::vector<std::pair<std::string, double>> counters() const { return {}; }
 };
 
 //! A registered technique: its description, declared parameters and factory.
