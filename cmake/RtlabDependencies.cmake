@@ -74,4 +74,6 @@ endforeach()
 rtlab_require(TinyGLTF CONFIG DEBIAN libtinygltf-dev)
 rtlab_require(VTK 9.1 CONFIG COMPONENTS ChartsCore CommonColor CommonCore CommonDataModel
     IOExportPDF IOImage RenderingContext2D RenderingContextOpenGL2 RenderingCore RenderingFreeType
-    RenderingOpenGL2 DEBIAN libvtk9-dev)
+    RenderingOpenGL2 CommonExecutionModel FiltersCore IOXML IOPLY DEBIAN libvtk9-dev)
+# cmake/FindOpenVDB.cmake (the package's own module needs Boost iostreams' dev files; see there).
+rtlab_require(OpenVDB 10 DEBIAN libopenvdb-dev)
