@@ -1,0 +1,884 @@
+#include "extraction.h"
+
+#include "qef.h"
+
+#include <glm/geometric.hpp>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace rtlab::isosurface::dc {
+namespace {
+
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kNoNan = std::numeric_limits<std::size_t>::max();
+//! Bit of SampleFlags that marks an inside sample; bits 0..2 mark crossed edges along x, y, z.
+constexpr std::uint8_t kInsideBit = 8;
+//! A solved vertex counts as outside its cell when a coordinate leaves [0, 1] by more than this
+//! (cells), which is far above the solvers' rounding and far below any visible displacement.
+constexpr double kOutsideTolerance = 1e-9;
+//! Newton steps when a relaxed vertex is projected back onto the exact surface.
+constexpr int kProjectionSteps = 8;
+//! Halvings of a relaxation step whose projection leaves the vertex's cell before it is dropped.
+constexpr int kMaxStepHalvings = 4;
+
+bool isFinite(const glm::dvec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+glm::dvec3 normalizeOrZero(const glm::dvec3& v)
+{
+    const double length = glm::length(v);
+    if (!std::isfinite(length) || !(length > 0.0))
+        return glm::dvec3(0.0);
+    return v / length;
+}
+
+glm::dvec3 axisVector(int axis)
+{
+    glm::dvec3 v(0.0);
+    v[axis] = 1.0;
+    return v;
+}
+
+//! Read-only view of the field and the per-sample flags shared by all passes. Coordinates are
+//! grid units: sample (x, y, z) is at (x, y, z), world = origin + spacing * grid.
+class Grid {
+public:
+    Grid(const plugin::SampledField& field, double isoValue)
+        : mField(field), mIso(isoValue), mSize(field.samples),
+          mStride{1, std::size_t(field.samples.x), std::size_t(field.samples.x) * field.samples.y}
+    {
+    }
+
+    int size(int axis) const { return mSize[axis]; }
+    int cells(int axis) const { return mSize[axis] - 1; }
+    std::size_t stride(int axis) const { return mStride[axis]; }
+    std::size_t index(const glm::ivec3& s) const { return mField.index(s.x, s.y, s.z); }
+    std::size_t cellIndex(const glm::ivec3& c) const
+    {
+        return (std::size_t(c.z) * cells(1) + c.y) * cells(0) + c.x;
+    }
+    glm::ivec3 sampleOf(std::size_t i) const
+    {
+        return glm::ivec3(int(i % mStride[1]), int((i / mStride[1]) % mSize.y), int(i / mStride[2]));
+    }
+    //! Value relative to the iso-value; f < iso exactly when relative < 0.
+    double relative(std::size_t i) const { return double(mField.values[i]) - mIso; }
+    double iso() const { return mIso; }
+    glm::dvec3 toWorld(const glm::dvec3& grid) const
+    {
+        return mField.origin + mField.spacing * grid;
+    }
+    double spacing() const { return mField.spacing; }
+
+    //! Field gradient at a sample, field units per sample step: central differences inside the
+    //! grid, one-sided on its boundary.
+    glm::dvec3 sampleGradient(const glm::ivec3& s) const
+    {
+        const std::size_t i = index(s);
+        glm::dvec3 gradient(0.0);
+        for (int axis = 0; axis < 3; ++axis) {
+            const std::size_t step = mStride[axis];
+            const int c = s[axis];
+            if (c > 0 && c + 1 < mSize[axis])
+                gradient[axis] = 0.5 * (relative(i + step) - relative(i - step));
+            else if (c == 0)
+                gradient[axis] = relative(i + step) - relative(i);
+            else
+                gradient[axis] = relative(i) - relative(i - step);
+        }
+        return gradient;
+    }
+
+private:
+    const plugin::SampledField& mField;
+    double mIso;
+    glm::ivec3 mSize;
+    std::size_t mStride[3];
+};
+
+//! One crossed grid edge's Hermite point and normal (grid units; normal unit or zero).
+struct Crossing {
+    glm::dvec3 point{0.0};
+    glm::dvec3 normal{0.0};
+};
+
+//! The crossed edges, numbered in scan order (layer, row, sample, axis), and where to find them.
+struct EdgeTable {
+    std::vector<std::uint8_t> flags;     //!< per sample: kInsideBit | crossed-axis bits
+    std::vector<std::uint32_t> base;     //!< per sample: number of the first edge starting there
+    std::vector<std::uint64_t> edges;    //!< per edge: sample index * 3 + axis
+    std::vector<Crossing> crossings;     //!< per edge
+
+    //! Number of the crossed edge (sample, axis), or kNone when it is not crossed.
+    std::uint32_t find(std::size_t sample, int axis) const
+    {
+        const std::uint8_t f = flags[sample];
+        if (((f >> axis) & 1u) == 0)
+            return kNone;
+        return base[sample] + std::uint32_t(std::popcount(unsigned(f & ((1u << axis) - 1u))));
+    }
+};
+
+void validate(const plugin::IsosurfaceInput& input)
+{
+    if (input.field == nullptr)
+        throw std::invalid_argument("dual_contouring: IsosurfaceInput::field is null");
+    const plugin::SampledField& field = *input.field;
+    if (!(std::isfinite(field.spacing) && field.spacing > 0.0))
+        throw std::invalid_argument("dual_contouring: the field spacing must be finite and > 0, got " +
+                                    std::to_string(field.spacing));
+    if (!isFinite(field.origin))
+        throw std::invalid_argument("dual_contouring: the field origin must be finite");
+    if (field.samples.x < 0 || field.samples.y < 0 || field.samples.z < 0)
+        throw std::invalid_argument("dual_contouring: negative sample count");
+    const std::size_t expected = std::size_t(field.samples.x) * field.samples.y * field.samples.z;
+    if (field.values.size() != expected)
+        throw std::invalid_argument("dual_contouring: the field has " +
+                                    std::to_string(field.values.size()) + " values for " +
+                                    std::to_string(expected) + " samples");
+    if (!std::isfinite(input.isoValue))
+        throw std::invalid_argument("dual_contouring: the iso-value must be finite, got " +
+                                    std::to_string(input.isoValue));
+    if (input.materials != nullptr && input.materials->size() != expected)
+        throw std::invalid_argument("dual_contouring: " + std::to_string(input.materials->size()) +
+                                    " materials for " + std::to_string(expected) + " samples");
+    if (input.hermite != nullptr && input.hermite->samples != field.samples)
+        throw std::invalid_argument("dual_contouring: the Hermite data refers to another grid");
+}
+
+//! Pass 1: inside flags and crossed-edge bits per sample, NaN check, edge numbering.
+void buildEdgeTable(const Grid& grid, EdgeTable& table)
+{
+    const int nx = grid.size(0);
+    const int ny = grid.size(1);
+    const int nz = grid.size(2);
+    const std::size_t layer = grid.stride(2);
+    const std::size_t total = layer * nz;
+    table.flags.assign(total, 0);
+    table.base.assign(total, 0);
+
+    std::vector<std::size_t> firstNan(nz, kNoNan);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
+        for (int z = range.begin(); z != range.end(); ++z) {
+            for (std::size_t i = z * layer; i < (z + 1) * layer; ++i) {
+                const double r = grid.relative(i);
+                if (std::isnan(r) && firstNan[z] == kNoNan)
+                    firstNan[z] = i;
+                table.flags[i] = r < 0.0 ? kInsideBit : 0;
+            }
+        }
+    });
+    for (int z = 0; z < nz; ++z) {
+        if (firstNan[z] != kNoNan) {
+            const glm::ivec3 s = grid.sampleOf(firstNan[z]);
+            throw std::invalid_argument("dual_contouring: NaN sample at (" + std::to_string(s.x) +
+                                        ", " + std::to_string(s.y) + ", " + std::to_string(s.z) +
+                                        ")");
+        }
+    }
+
+    // Crossed-edge bits go to their own array first: a layer's task reads the inside bits of the
+    // layer above, which another task owns.
+    std::vector<std::uint8_t> crossed(total, 0);
+    std::vector<std::uint64_t> layerCount(nz + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
+        for (int z = range.begin(); z != range.end(); ++z) {
+            std::uint64_t count = 0;
+            for (int y = 0; y < ny; ++y) {
+                std::size_t i = grid.index({0, y, z});
+                for (int x = 0; x < nx; ++x, ++i) {
+                    const std::uint8_t in = table.flags[i] & kInsideBit;
+                    std::uint8_t bits = 0;
+                    if (x + 1 < nx && in != (table.flags[i + 1] & kInsideBit))
+                        bits |= 1;
+                    if (y + 1 < ny && in != (table.flags[i + grid.stride(1)] & kInsideBit))
+                        bits |= 2;
+                    if (z + 1 < nz && in != (table.flags[i + layer] & kInsideBit))
+                        bits |= 4;
+                    crossed[i] = bits;
+                    count += std::popcount(unsigned(bits));
+                }
+            }
+            layerCount[z + 1] = count;
+        }
+    });
+    for (int z = 0; z < nz; ++z)
+        layerCount[z + 1] += layerCount[z];
+    const std::uint64_t edgeCount = layerCount[nz];
+    if (edgeCount >= kNone)
+        throw std::length_error("dual_contouring: " + std::to_string(edgeCount) +
+                                " crossed edges exceed 32-bit indices");
+    table.edges.resize(edgeCount);
+    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
+        for (int z = range.begin(); z != range.end(); ++z) {
+            std::uint32_t next = std::uint32_t(layerCount[z]);
+            for (std::size_t i = z * layer; i < (z + 1) * layer; ++i) {
+                table.flags[i] |= crossed[i];
+                table.base[i] = next;
+                for (int axis = 0; axis < 3; ++axis) {
+                    if ((crossed[i] >> axis) & 1u)
+                        table.edges[next++] = std::uint64_t(i) * 3u + std::uint64_t(axis);
+                }
+            }
+        }
+    });
+}
+
+//! Hermite data of the crossed edges, from the first available source (see ExtractionOptions).
+class CrossingSource {
+public:
+    CrossingSource(const Grid& grid, const plugin::IsosurfaceInput& input,
+                   const ExtractionOptions& options)
+        : mGrid(grid), mInput(input), mOptions(options)
+    {
+        const bool automatic = options.hermite == HermiteMode::Auto;
+        mUseHermite = automatic && input.hermite != nullptr;
+        mUseExactValue = automatic && bool(input.exactValue);
+        mUseExactGradient = automatic && bool(input.exactGradient);
+        // Halvings until the bracketing interval is at most crossingPrecision cells wide.
+        mBisectionSteps = int(std::ceil(std::log2(1.0 / options.crossingPrecision)));
+        mBisectionSteps = std::clamp(mBisectionSteps, 1, 60);
+    }
+
+    HermiteSource source() const
+    {
+        if (mUseHermite)
+            return HermiteSource::Hermite;
+        return mUseExactValue || mUseExactGradient ? HermiteSource::Exact : HermiteSource::Samples;
+    }
+    bool hasExactProjection() const { return mUseExactValue && mUseExactGradient; }
+
+    //! The crossing on edge (sample, axis); `missing` is set when input.hermite lacked it.
+    Crossing compute(const glm::ivec3& s, int axis, bool& missing) const
+    {
+        missing = false;
+        if (mUseHermite) {
+            const plugin::HermiteEdge* edge = mInput.hermite->find(s, axis);
+            if (edge != nullptr && std::isfinite(edge->t)) {
+                Crossing c;
+                c.point = glm::dvec3(s) + std::clamp(edge->t, 0.0, 1.0) * axisVector(axis);
+                c.normal = normalizeOrZero(edge->normal);
+                return c;
+            }
+            missing = true;
+        }
+        const std::size_t i = mGrid.index(s);
+        const std::size_t j = i + mGrid.stride(axis);
+        double t;
+        if (mUseExactValue)
+            t = bisect(s, axis, mGrid.relative(i) < 0.0);
+        else
+            t = interpolateLinear(mGrid.relative(i), mGrid.relative(j));
+        Crossing c;
+        c.point = glm::dvec3(s) + t * axisVector(axis);
+        if (mUseExactGradient) {
+            // Outward normal: the field grows outward. Uniform scaling keeps directions, so the
+            // world gradient's direction is the grid-unit normal.
+            c.normal = normalizeOrZero(mInput.exactGradient(mGrid.toWorld(c.point)));
+        } else {
+            glm::ivec3 s1 = s;
+            ++s1[axis];
+            c.normal = normalizeOrZero((1.0 - t) * mGrid.sampleGradient(s) +
+                                       t * mGrid.sampleGradient(s1));
+        }
+        return c;
+    }
+
+private:
+    //! Zero of the linear interpolant; an infinite end puts the crossing on the finite end.
+    static double interpolateLinear(double a, double b)
+    {
+        const bool finiteA = std::isfinite(a);
+        const bool finiteB = std::isfinite(b);
+        if (!finiteA && !finiteB)
+            return 0.5;
+        if (!finiteA)
+            return 1.0;
+        if (!finiteB)
+            return 0.0;
+        return std::clamp(a / (a - b), 0.0, 1.0);
+    }
+
+    //! Bisection of exactValue along the edge, keeping the end whose sample is inside on the
+    //! inside: after k halvings the crossing is bracketed within 2^-k cells; the midpoint of the
+    //! bracket is returned (|t - t_true| <= crossingPrecision / 2 where the exact field's sign
+    //! agrees with the samples' at the ends).
+    double bisect(const glm::ivec3& s, int axis, bool lowInside) const
+    {
+        double a = 0.0;
+        double b = 1.0;
+        const glm::dvec3 start(s);
+        const glm::dvec3 direction = axisVector(axis);
+        for (int k = 0; k < mBisectionSteps; ++k) {
+            const double mid = 0.5 * (a + b);
+            const double f = mInput.exactValue(mGrid.toWorld(start + mid * direction)) - mGrid.iso();
+            if (std::isnan(f))
+                break;
+            if ((f < 0.0) == lowInside)
+                a = mid;
+            else
+                b = mid;
+        }
+        return 0.5 * (a + b);
+    }
+
+    const Grid& mGrid;
+    const plugin::IsosurfaceInput& mInput;
+    const ExtractionOptions& mOptions;
+    bool mUseHermite = false;
+    bool mUseExactValue = false;
+    bool mUseExactGradient = false;
+    int mBisectionSteps = 20;
+};
+
+//! The 12 edges of a cell: start corner offset and axis.
+struct CellEdgeOffset {
+    glm::ivec3 offset;
+    int axis;
+};
+
+const std::array<CellEdgeOffset, 12>& getCellEdgeOffsets()
+{
+    static const std::array<CellEdgeOffset, 12> edges = [] {
+        std::array<CellEdgeOffset, 12> e{};
+        int k = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+            const int b = (axis + 1) % 3;
+            const int c = (axis + 2) % 3;
+            for (int j = 0; j < 2; ++j)
+                for (int i = 0; i < 2; ++i) {
+                    glm::ivec3 o(0);
+                    o[b] = i;
+                    o[c] = j;
+                    e[k++] = {o, axis};
+                }
+        }
+        return e;
+    }();
+    return edges;
+}
+
+//! Whether the crossed edge (sample, axis) has all four cells around it (gives a quad).
+bool isInteriorEdge(const Grid& grid, const glm::ivec3& s, int axis)
+{
+    const int b = (axis + 1) % 3;
+    const int c = (axis + 2) % 3;
+    return s[b] >= 1 && s[b] + 1 < grid.size(b) && s[c] >= 1 && s[c] + 1 < grid.size(c);
+}
+
+//! The four cells around edge (sample, axis), counter-clockwise seen from +axis.
+std::array<glm::ivec3, 4> getCellsAroundEdge(const glm::ivec3& s, int axis)
+{
+    const int b = (axis + 1) % 3;
+    const int c = (axis + 2) % 3;
+    std::array<glm::ivec3, 4> cells;
+    constexpr int kOrder[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int k = 0; k < 4; ++k) {
+        glm::ivec3 cell = s;
+        cell[b] -= 1 - kOrder[k][0];
+        cell[c] -= 1 - kOrder[k][1];
+        cells[k] = cell;
+    }
+    return cells;
+}
+
+struct CellVertices {
+    std::vector<std::uint32_t> vertexOfCell; //!< per cell, kNone when the cell has no sign change
+    std::vector<glm::ivec3> cell;            //!< per vertex
+    std::vector<glm::dvec3> local;           //!< per vertex, position relative to its cell, cells
+    std::vector<glm::dvec3> normal;          //!< per vertex, unit
+    std::vector<QefSystem> qef;              //!< per vertex, kept for the relaxation only
+};
+
+//! Pass 2: number the cells with a sign change in scan order.
+void numberCells(const Grid& grid, const EdgeTable& table, CellVertices& vertices)
+{
+    const glm::ivec3 cells(grid.cells(0), grid.cells(1), grid.cells(2));
+    const std::size_t cellLayer = std::size_t(cells.x) * cells.y;
+    vertices.vertexOfCell.assign(cellLayer * cells.z, kNone);
+    std::vector<std::uint64_t> layerCount(cells.z + 1, 0);
+    std::array<std::size_t, 8> corner{};
+    for (int k = 0; k < 8; ++k)
+        corner[k] = grid.index({k & 1, (k >> 1) & 1, (k >> 2) & 1});
+    const auto isActive = [&](std::size_t sample) {
+        const std::uint8_t in = table.flags[sample] & kInsideBit;
+        for (int k = 1; k < 8; ++k) {
+            if ((table.flags[sample + corner[k]] & kInsideBit) != in)
+                return true;
+        }
+        return false;
+    };
+    tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
+        for (int z = r.begin(); z != r.end(); ++z) {
+            std::uint64_t count = 0;
+            for (int y = 0; y < cells.y; ++y)
+                for (int x = 0; x < cells.x; ++x)
+                    count += isActive(grid.index({x, y, z}));
+            layerCount[z + 1] = count;
+        }
+    });
+    for (int z = 0; z < cells.z; ++z)
+        layerCount[z + 1] += layerCount[z];
+    const std::uint64_t total = layerCount[cells.z];
+    if (total >= kNone)
+        throw std::length_error("dual_contouring: " + std::to_string(total) +
+                                " vertices exceed 32-bit indices");
+    vertices.cell.resize(total);
+    tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
+        for (int z = r.begin(); z != r.end(); ++z) {
+            std::uint32_t next = std::uint32_t(layerCount[z]);
+            for (int y = 0; y < cells.y; ++y)
+                for (int x = 0; x < cells.x; ++x) {
+                    if (!isActive(grid.index({x, y, z})))
+                        continue;
+                    vertices.vertexOfCell[grid.cellIndex({x, y, z})] = next;
+                    vertices.cell[next++] = glm::ivec3(x, y, z);
+                }
+        }
+    });
+}
+
+bool isInsideBox(const glm::dvec3& p)
+{
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!(p[axis] >= -kOutsideTolerance && p[axis] <= 1.0 + kOutsideTolerance))
+            return false;
+    }
+    return true;
+}
+
+//! Pass 3: one QEF vertex per cell [Ju et al. 2002, sec. 2.2], in the cell's frame (its lowest
+//! sample at the origin, the box [0, 1]^3).
+void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOptions& options,
+                   bool keepQef, CellVertices& vertices, ExtractionStats& stats)
+{
+    const std::size_t count = vertices.cell.size();
+    vertices.local.assign(count, glm::dvec3(0.0));
+    vertices.normal.assign(count, glm::dvec3(0.0));
+    if (keepQef)
+        vertices.qef.assign(count, QefSystem{});
+    std::vector<std::uint8_t> rank(count, 0);
+    std::vector<std::uint8_t> left(count, 0);
+    std::vector<std::uint8_t> skipped(count, 0);
+    std::vector<std::uint8_t> noPlanes(count, 0);
+    const auto& cellEdges = getCellEdgeOffsets();
+
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::array<glm::dvec3, 12> points;
+        std::array<glm::dvec3, 12> normals;
+        for (std::size_t v = range.begin(); v != range.end(); ++v) {
+            const glm::ivec3 cell = vertices.cell[v];
+            int n = 0;
+            glm::dvec3 normalSum(0.0);
+            for (const CellEdgeOffset& e : cellEdges) {
+                const std::uint32_t id = table.find(grid.index(cell + e.offset), e.axis);
+                if (id == kNone)
+                    continue;
+                const Crossing& c = table.crossings[id];
+                points[n] = c.point - glm::dvec3(cell);
+                normals[n] = c.normal;
+                normalSum += c.normal;
+                ++n;
+            }
+            int skippedHere = 0;
+            const QefSystem qef = buildQef(std::span(points.data(), n),
+                                           std::span(normals.data(), n), &skippedHere);
+            skipped[v] = std::uint8_t(skippedHere);
+            QefSolution solution;
+            if (options.solver == QefSolver::Svd) {
+                solution = solveQefSvd(qef, options.svdThreshold);
+            } else {
+                const glm::dvec3 start = options.schmitzStart == SchmitzStart::MassPoint
+                                             ? qef.massPoint
+                                             : glm::dvec3(0.5);
+                solution = solveQefSchmitz(qef, start, options.schmitzIterations,
+                                           options.schmitzStep);
+            }
+            glm::dvec3 p = solution.position;
+            if (qef.planeCount == 0) {
+                noPlanes[v] = 1;
+                p = qef.massPoint;
+            }
+            if (!isFinite(p))
+                p = qef.massPoint;
+            if (!isInsideBox(p)) {
+                left[v] = 1;
+                switch (options.outsidePolicy) {
+                case OutsidePolicy::Clamp:
+                    p = glm::clamp(p, glm::dvec3(0.0), glm::dvec3(1.0));
+                    break;
+                case OutsidePolicy::MassPoint:
+                    p = qef.massPoint;
+                    break;
+                case OutsidePolicy::Keep:
+                    break;
+                }
+            }
+            vertices.local[v] = p;
+            rank[v] = std::uint8_t(solution.rank);
+            if (keepQef)
+                vertices.qef[v] = qef;
+            if (options.computeNormals) {
+                glm::dvec3 normal = normalizeOrZero(normalSum);
+                if (normal == glm::dvec3(0.0)) {
+                    // No usable crossing normal: the sampled field's gradient over the cell.
+                    glm::dvec3 gradient(0.0);
+                    for (int k = 0; k < 8; ++k)
+                        gradient += grid.sampleGradient(cell + glm::ivec3(k & 1, (k >> 1) & 1,
+                                                                          (k >> 2) & 1));
+                    normal = normalizeOrZero(gradient);
+                }
+                if (normal == glm::dvec3(0.0))
+                    normal = glm::dvec3(0.0, 0.0, 1.0);
+                vertices.normal[v] = normal;
+            }
+        }
+    });
+    for (std::size_t v = 0; v < count; ++v) {
+        ++stats.rank[std::min<int>(rank[v], 3)];
+        stats.leftCell += left[v];
+        stats.skippedNormals += skipped[v];
+        stats.cellsWithoutPlanes += noPlanes[v];
+    }
+}
+
+//! Elastic relaxation of the vertices on material boundaries, as The Tomorrow Children does it
+//! (seed 000_3da000e866ebc485.txt, "Polygonization / Dual Contouring": every quad takes the
+//! material of the edge it crosses, which gives blocky transitions, so "whenever a DC vertex is
+//! involved in DC quads of different materials, we relax/average it with DC vertices around (in
+//! an elastic mesh fashion), we make sure they don't move outside their DC cube").
+class MaterialRelaxation {
+public:
+    MaterialRelaxation(const Grid& grid, const EdgeTable& table,
+                       const std::vector<std::uint32_t>& materials,
+                       const ExtractionOptions& options, const CrossingSource& source,
+                       const plugin::IsosurfaceInput& input, CellVertices& vertices)
+        : mGrid(grid), mTable(table), mMaterials(materials), mOptions(options), mSource(source),
+          mInput(input), mVertices(vertices)
+    {
+    }
+
+    //! Finds the boundary vertices and their boundary neighbours; returns their count.
+    std::size_t findBoundary()
+    {
+        const std::size_t count = mVertices.cell.size();
+        mBoundary.assign(count, 0);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t v = range.begin(); v != range.end(); ++v)
+                mBoundary[v] = hasMixedQuads(mVertices.cell[v]) ? 1 : 0;
+        });
+        mNeighbourStart.assign(count + 1, 0);
+        std::vector<std::uint32_t> found(6 * count);
+        std::vector<std::uint8_t> foundCount(count, 0);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                if (mBoundary[v])
+                    foundCount[v] = std::uint8_t(findBoundaryNeighbours(v, &found[6 * v]));
+            }
+        });
+        for (std::size_t v = 0; v < count; ++v)
+            mNeighbourStart[v + 1] = mNeighbourStart[v] + foundCount[v];
+        mNeighbours.resize(mNeighbourStart[count]);
+        for (std::size_t v = 0; v < count; ++v)
+            std::copy_n(found.begin() + 6 * v, foundCount[v], mNeighbours.begin() + mNeighbourStart[v]);
+        std::size_t boundary = 0;
+        for (std::uint8_t b : mBoundary)
+            boundary += b;
+        return boundary;
+    }
+
+    //! Runs the iterations (Jacobi order, so the result does not depend on the thread count);
+    //! returns the largest displacement of a vertex, cells.
+    double relax(int iterations)
+    {
+        const std::size_t count = mVertices.cell.size();
+        const std::vector<glm::dvec3> initial = mVertices.local;
+        std::vector<glm::dvec3> next = mVertices.local;
+        for (int it = 0; it < iterations; ++it) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
+                              [&](const tbb::blocked_range<std::size_t>& range) {
+                for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                    const std::uint32_t first = mNeighbourStart[v];
+                    const std::uint32_t last = mNeighbourStart[v + 1];
+                    if (!mBoundary[v] || first == last) {
+                        next[v] = mVertices.local[v];
+                        continue;
+                    }
+                    // Laplacian step toward the mean of the boundary neighbours, in the vertex's
+                    // cell frame.
+                    const glm::ivec3 cell = mVertices.cell[v];
+                    glm::dvec3 mean(0.0);
+                    for (std::uint32_t k = first; k < last; ++k) {
+                        const std::uint32_t u = mNeighbours[k];
+                        mean += mVertices.local[u] + glm::dvec3(mVertices.cell[u] - cell);
+                    }
+                    mean /= double(last - first);
+                    // "we make sure they don't move outside their DC cube": a step whose
+                    // projection leaves the cell is halved (up to kMaxStepHalvings times), else
+                    // the vertex stays, so relaxed vertices are on the surface and in their cell.
+                    const glm::dvec3 p = mVertices.local[v];
+                    double weight = mOptions.materialRelaxationWeight;
+                    next[v] = p;
+                    for (int k = 0; k <= kMaxStepHalvings; ++k, weight *= 0.5) {
+                        const glm::dvec3 target = project(v, p + weight * (mean - p));
+                        if (isFinite(target) && isInsideBox(target)) {
+                            next[v] = target;
+                            break;
+                        }
+                    }
+                }
+            });
+            mVertices.local.swap(next);
+        }
+        double shift = 0.0;
+        for (std::size_t v = 0; v < count; ++v)
+            shift = std::max(shift, glm::length(mVertices.local[v] - initial[v]));
+        return shift;
+    }
+
+private:
+    //! Material of the quad around a crossed edge: the material of its inside sample.
+    std::uint32_t getEdgeMaterial(std::size_t sample, int axis) const
+    {
+        const bool lowInside = (mTable.flags[sample] & kInsideBit) != 0;
+        return mMaterials[lowInside ? sample : sample + mGrid.stride(axis)];
+    }
+
+    //! Whether the quads of the cell's crossed interior edges carry more than one material.
+    bool hasMixedQuads(const glm::ivec3& cell) const
+    {
+        bool any = false;
+        std::uint32_t material = 0;
+        for (const CellEdgeOffset& e : getCellEdgeOffsets()) {
+            const glm::ivec3 s = cell + e.offset;
+            const std::size_t sample = mGrid.index(s);
+            if (mTable.find(sample, e.axis) == kNone || !isInteriorEdge(mGrid, s, e.axis))
+                continue;
+            const std::uint32_t m = getEdgeMaterial(sample, e.axis);
+            if (any && m != material)
+                return true;
+            any = true;
+            material = m;
+        }
+        return false;
+    }
+
+    //! Boundary vertices joined to v by a quad side: cells across a face of v's cell that has a
+    //! crossed interior edge (a quad around that edge has both cells as consecutive corners).
+    int findBoundaryNeighbours(std::size_t v, std::uint32_t* out) const
+    {
+        const glm::ivec3 cell = mVertices.cell[v];
+        int n = 0;
+        for (int axis = 0; axis < 3; ++axis) {
+            for (int side = -1; side <= 1; side += 2) {
+                glm::ivec3 other = cell;
+                other[axis] += side;
+                if (other[axis] < 0 || other[axis] >= mGrid.cells(axis))
+                    continue;
+                const std::uint32_t u = mVertices.vertexOfCell[mGrid.cellIndex(other)];
+                if (u == kNone || !mBoundary[u])
+                    continue;
+                // The shared face lies at cell[axis] + (side > 0); its four edges run along the
+                // two other axes.
+                glm::ivec3 faceOrigin = cell;
+                faceOrigin[axis] += side > 0 ? 1 : 0;
+                bool joined = false;
+                for (int k = 1; k <= 2 && !joined; ++k) {
+                    const int along = (axis + k) % 3;
+                    const int across = (axis + 3 - k) % 3;
+                    for (int j = 0; j < 2 && !joined; ++j) {
+                        glm::ivec3 s = faceOrigin;
+                        s[across] += j;
+                        joined = mTable.find(mGrid.index(s), along) != kNone &&
+                                 isInteriorEdge(mGrid, s, along);
+                    }
+                }
+                if (joined)
+                    out[n++] = u;
+            }
+        }
+        return n;
+    }
+
+    //! Back onto the surface: Newton steps on the exact field when there is one, else the QEF
+    //! minimiser nearest to the point (moves only along the cell's constrained directions).
+    glm::dvec3 project(std::size_t v, glm::dvec3 p) const
+    {
+        const glm::dvec3 cell(mVertices.cell[v]);
+        if (mSource.hasExactProjection()) {
+            for (int k = 0; k < kProjectionSteps; ++k) {
+                const glm::dvec3 world = mGrid.toWorld(cell + p);
+                const double f = mInput.exactValue(world) - mGrid.iso();
+                const glm::dvec3 g = mInput.exactGradient(world);
+                const double g2 = glm::dot(g, g);
+                if (!std::isfinite(f) || !std::isfinite(g2) || !(g2 > 0.0))
+                    break;
+                p -= (f / g2) * g / mGrid.spacing();
+                if (std::abs(f) <= 1e-12 * mGrid.spacing())
+                    break;
+            }
+            return p;
+        }
+        return solveQefNear(mVertices.qef[v], p, mOptions.svdThreshold).position;
+    }
+
+    const Grid& mGrid;
+    const EdgeTable& mTable;
+    const std::vector<std::uint32_t>& mMaterials;
+    const ExtractionOptions& mOptions;
+    const CrossingSource& mSource;
+    const plugin::IsosurfaceInput& mInput;
+    CellVertices& mVertices;
+    std::vector<std::uint8_t> mBoundary;
+    std::vector<std::uint32_t> mNeighbourStart;
+    std::vector<std::uint32_t> mNeighbours;
+};
+
+//! Splits quad (v0, v1, v2, v3) into two triangles. Rule: the diagonal whose two triangles'
+//! unit normals agree best (largest dot product), which never folds a planar non-convex quad and
+//! follows the crease of a bent one; a tie (|difference| <= 1e-12, e.g. planar convex quads)
+//! takes the diagonal through the quad's smallest vertex index, which does not depend on where
+//! the quad's cycle starts. Returns true for the diagonal v1-v3.
+bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<glm::dvec3, 4>& p)
+{
+    const auto normal = [&](int a, int b, int c) {
+        return normalizeOrZero(glm::cross(p[b] - p[a], p[c] - p[a]));
+    };
+    const double agree02 = glm::dot(normal(0, 1, 2), normal(0, 2, 3));
+    const double agree13 = glm::dot(normal(0, 1, 3), normal(1, 2, 3));
+    if (std::abs(agree02 - agree13) > 1e-12)
+        return agree13 > agree02;
+    const int smallest = int(std::min_element(q.begin(), q.end()) - q.begin());
+    return smallest % 2 == 1;
+}
+
+} // namespace
+
+void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOptions& options,
+                        TriangleMesh& out, ExtractionStats& stats)
+{
+    validate(input);
+    stats = ExtractionStats{};
+    const plugin::SampledField& field = *input.field;
+    const Grid grid(field, input.isoValue);
+    const CrossingSource source(grid, input, options);
+    stats.source = source.source();
+    if (field.samples.x < 2 || field.samples.y < 2 || field.samples.z < 2) {
+        out.clear();
+        return;
+    }
+
+    EdgeTable table;
+    buildEdgeTable(grid, table);
+    const std::size_t edgeCount = table.edges.size();
+    stats.crossedEdges = edgeCount;
+
+    // Hermite data [Ju et al. 2002, sec. 2]: one crossing and normal per crossed edge.
+    table.crossings.resize(edgeCount);
+    std::atomic<std::size_t> missing{0};
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edgeCount),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+        std::size_t missingHere = 0;
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const std::size_t sample = std::size_t(table.edges[k] / 3u);
+            const int axis = int(table.edges[k] % 3u);
+            bool edgeMissing = false;
+            table.crossings[k] = source.compute(grid.sampleOf(sample), axis, edgeMissing);
+            missingHere += edgeMissing;
+        }
+        missing += missingHere;
+    });
+    stats.hermiteMissing = missing.load();
+
+    CellVertices vertices;
+    numberCells(grid, table, vertices);
+    const bool relaxing = input.materials != nullptr && options.materialRelaxationIterations > 0;
+    placeVertices(grid, table, options, relaxing && !source.hasExactProjection(), vertices, stats);
+    stats.cells = vertices.cell.size();
+
+    if (input.materials != nullptr) {
+        MaterialRelaxation relaxation(grid, table, *input.materials, options, source, input,
+                                      vertices);
+        stats.boundaryVertices = relaxation.findBoundary();
+        if (relaxing)
+            stats.maxRelaxationShift = relaxation.relax(options.materialRelaxationIterations);
+    }
+
+    // One quad per crossed edge with four cells around it [Ju et al. 2002, sec. 2.1], wound
+    // counter-clockwise seen from the outside: when the edge's low end is inside the outward
+    // normal points along +axis, and the cells come counter-clockwise seen from +axis.
+    std::vector<std::array<std::uint32_t, 3>> triangles(2 * edgeCount);
+    std::vector<std::uint8_t> hasQuad(edgeCount, 0);
+    std::vector<std::uint8_t> flipped(edgeCount, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edgeCount),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const std::size_t sample = std::size_t(table.edges[k] / 3u);
+            const int axis = int(table.edges[k] % 3u);
+            const glm::ivec3 s = grid.sampleOf(sample);
+            if (!isInteriorEdge(grid, s, axis))
+                continue;
+            const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
+            const bool lowInside = (table.flags[sample] & kInsideBit) != 0;
+            std::array<std::uint32_t, 4> q;
+            std::array<glm::dvec3, 4> p;
+            for (int c = 0; c < 4; ++c) {
+                const glm::ivec3 cell = cells[lowInside ? c : (4 - c) % 4];
+                q[c] = vertices.vertexOfCell[grid.cellIndex(cell)];
+                p[c] = glm::dvec3(cell - s) + vertices.local[q[c]];
+            }
+            hasQuad[k] = 1;
+            if (chooseDiagonal13(q, p)) {
+                flipped[k] = 1;
+                triangles[2 * k] = {q[0], q[1], q[3]};
+                triangles[2 * k + 1] = {q[1], q[2], q[3]};
+            } else {
+                triangles[2 * k] = {q[0], q[1], q[2]};
+                triangles[2 * k + 1] = {q[0], q[2], q[3]};
+            }
+        }
+    });
+
+    TriangleMesh mesh;
+    const std::size_t vertexCount = vertices.cell.size();
+    mesh.positions.resize(vertexCount);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertexCount),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t v = range.begin(); v != range.end(); ++v)
+            mesh.positions[v] =
+                glm::vec3(grid.toWorld(glm::dvec3(vertices.cell[v]) + vertices.local[v]));
+    });
+    if (options.computeNormals) {
+        mesh.normals.resize(vertexCount);
+        for (std::size_t v = 0; v < vertexCount; ++v)
+            mesh.normals[v] = glm::vec3(vertices.normal[v]);
+    }
+    for (std::size_t k = 0; k < edgeCount; ++k) {
+        if (!hasQuad[k])
+            continue;
+        ++stats.quads;
+        stats.flippedSplits += flipped[k];
+        for (int t = 0; t < 2; ++t)
+            mesh.indices.insert(mesh.indices.end(), triangles[2 * k + t].begin(),
+                                triangles[2 * k + t].end());
+    }
+    out = std::move(mesh);
+}
+
+} // namespace rtlab::isosurface::dc

@@ -1,0 +1,195 @@
+#include "qef.h"
+
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace rtlab::isosurface::dc {
+namespace {
+
+bool isFinite(const glm::dvec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
+
+} // namespace
+
+double QefSystem::evaluate(const glm::dvec3& x) const
+{
+    // |A y - b|^2 = y^T A^T A y - 2 y^T A^T b + b^T b
+    const glm::dvec3 y = x - massPoint;
+    return glm::dot(y, ata * y) - 2.0 * glm::dot(y, atb) + btb;
+}
+
+QefSystem buildQef(std::span<const glm::dvec3> points, std::span<const glm::dvec3> normals,
+                   int* skipped)
+{
+    QefSystem qef;
+    const std::size_t count = std::min(points.size(), normals.size());
+    glm::dvec3 sum(0.0);
+    int finitePoints = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        if (!isFinite(points[i]))
+            continue;
+        sum += points[i];
+        ++finitePoints;
+    }
+    qef.pointCount = finitePoints;
+    if (finitePoints == 0) {
+        if (skipped != nullptr)
+            *skipped = int(count);
+        return qef;
+    }
+    qef.massPoint = sum / double(finitePoints);
+
+    int skippedCount = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const glm::dvec3 n = normals[i];
+        const double length = glm::length(n);
+        if (!isFinite(points[i]) || !std::isfinite(length) || !(length > 0.0)) {
+            ++skippedCount;
+            continue;
+        }
+        const glm::dvec3 unit = n / length;
+        const double b = glm::dot(unit, points[i] - qef.massPoint);
+        qef.ata += glm::outerProduct(unit, unit);
+        qef.atb += unit * b;
+        qef.btb += b * b;
+        ++qef.planeCount;
+    }
+    if (skipped != nullptr)
+        *skipped = skippedCount;
+    return qef;
+}
+
+SymmetricEigen computeSymmetricEigen(const glm::dmat3& m)
+{
+    // a[r][c] row-major copy, symmetrised.
+    double a[3][3];
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            a[r][c] = 0.5 * (m[c][r] + m[r][c]);
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+    double scale = 0.0;
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+            scale = std::max(scale, std::abs(a[r][c]));
+
+    SymmetricEigen result;
+    if (!(scale > 0.0) || !std::isfinite(scale)) {
+        result.values = glm::dvec3(a[0][0], a[1][1], a[2][2]);
+        return result;
+    }
+    constexpr int kPairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+    for (int sweep = 0; sweep < kMaxJacobiSweeps; ++sweep) {
+        const double off = std::abs(a[0][1]) + std::abs(a[0][2]) + std::abs(a[1][2]);
+        if (off <= 1e-18 * scale)
+            break;
+        result.sweeps = sweep + 1;
+        for (const auto& pair : kPairs) {
+            const int p = pair[0];
+            const int q = pair[1];
+            const double apq = a[p][q];
+            if (std::abs(apq) <= 1e-300)
+                continue;
+            // Rotation that zeroes a[p][q] (Golub & Van Loan, Algorithm 8.5.1, "sym.schur2"):
+            // t = tan(angle), the smaller root of t^2 + 2 theta t - 1 = 0.
+            const double theta = (a[q][q] - a[p][p]) / (2.0 * apq);
+            double t;
+            if (std::abs(theta) > 1e150)
+                t = 0.5 / theta;
+            else
+                t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+            const double c = 1.0 / std::sqrt(t * t + 1.0);
+            const double s = t * c;
+            a[p][p] -= t * apq;
+            a[q][q] += t * apq;
+            a[p][q] = a[q][p] = 0.0;
+            for (int r = 0; r < 3; ++r) {
+                if (r != p && r != q) {
+                    const double arp = a[r][p];
+                    const double arq = a[r][q];
+                    a[r][p] = a[p][r] = c * arp - s * arq;
+                    a[r][q] = a[q][r] = s * arp + c * arq;
+                }
+                const double vrp = v[r][p];
+                const double vrq = v[r][q];
+                v[r][p] = c * vrp - s * vrq;
+                v[r][q] = s * vrp + c * vrq;
+            }
+        }
+    }
+    for (int k = 0; k < 3; ++k) {
+        result.values[k] = a[k][k];
+        for (int r = 0; r < 3; ++r)
+            result.vectors[k][r] = v[r][k];
+    }
+    return result;
+}
+
+QefSolution solveQefNear(const QefSystem& qef, const glm::dvec3& reference, double threshold)
+{
+    QefSolution solution;
+    solution.position = reference;
+    if (qef.planeCount == 0)
+        return solution;
+    const SymmetricEigen eigen = computeSymmetricEigen(qef.ata);
+    double largest = 0.0;
+    for (int k = 0; k < 3; ++k)
+        largest = std::max(largest, eigen.values[k]);
+    if (!(largest > 0.0) || !std::isfinite(largest))
+        return solution;
+    // Truncated SVD [Ju et al. 2002, sec. 2.3]: A^T A = V diag(sigma^2) V^T, so dropping a
+    // singular value sigma_k of A is dropping the eigenvalue sigma_k^2 of A^T A.
+    const double sigmaMax = std::sqrt(largest);
+    const double cut = std::max(threshold, kSingularFloor) * sigmaMax;
+    // Residual of the normal equations at the reference: A^T b - A^T A (reference - m).
+    const glm::dvec3 y0 = reference - qef.massPoint;
+    const glm::dvec3 residual = qef.atb - qef.ata * y0;
+    glm::dvec3 step(0.0);
+    for (int k = 0; k < 3; ++k) {
+        const double lambda = eigen.values[k];
+        const double sigma = lambda > 0.0 ? std::sqrt(lambda) : 0.0;
+        if (sigma < cut)
+            continue;
+        const glm::dvec3 axis = eigen.vectors[k];
+        step += axis * (glm::dot(axis, residual) / lambda);
+        ++solution.rank;
+    }
+    solution.position = reference + step;
+    return solution;
+}
+
+QefSolution solveQefSvd(const QefSystem& qef, double threshold)
+{
+    return solveQefNear(qef, qef.massPoint, threshold);
+}
+
+QefSolution solveQefSchmitz(const QefSystem& qef, const glm::dvec3& start, int iterations,
+                            double step)
+{
+    QefSolution solution;
+    solution.position = start;
+    if (qef.planeCount == 0)
+        return solution;
+    solution.rank = 3;
+    // Schmitz et al. 2009, sec. 4: the force on the particle is the sum over the cell's planes of
+    // n_i times the particle's signed distance to plane i (they evaluate it at the 8 cell corners
+    // and interpolate trilinearly; the force is affine in x, so the interpolation is exact and it
+    // is evaluated here directly). In the mass-point frame, sum_i n_i (n_i . (p_i - x)) =
+    // A^T b - A^T A y. Averaging over the planes bounds the largest eigenvalue of the iteration
+    // matrix by 1 (unit normals: trace(A^T A) / k = 1), so every step in (0, 2) converges.
+    const double inverseCount = 1.0 / double(qef.planeCount);
+    glm::dvec3 y = start - qef.massPoint;
+    for (int i = 0; i < iterations; ++i) {
+        const glm::dvec3 force = (qef.atb - qef.ata * y) * inverseCount;
+        y += step * force;
+    }
+    solution.position = qef.massPoint + y;
+    return solution;
+}
+
+} // namespace rtlab::isosurface::dc
