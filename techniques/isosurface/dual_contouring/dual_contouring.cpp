@@ -118,16 +118,15 @@ DualContouring::DualContouring(const config::ParamSet& params)
         findChoice("schmitz_start", params.getString("schmitz_start"), kStartChoices) == 0
             ? dc::SchmitzStart::MassPoint
             : dc::SchmitzStart::CellCenter;
-    constexpr dc::OutsidePolicy kPolicies[] = {dc::OutsidePolicy::Clamp,
-                                               dc::OutsidePolicy::MassPoint,
-                                               dc::OutsidePolicy::Keep};
+    constexpr dc::OutsidePolicy kPolicies[] = {
+        dc::OutsidePolicy::Clamp, dc::OutsidePolicy::MassPoint, dc::OutsidePolicy::Keep};
     mOptions.outsidePolicy =
         kPolicies[findChoice("outside_policy", params.getString("outside_policy"), kPolicyChoices)];
     mOptions.hermite = findChoice("hermite", params.getString("hermite"), kHermiteChoices) == 0
                            ? dc::HermiteMode::Auto
                            : dc::HermiteMode::Samples;
-    mOptions.crossingPrecision = getFloatIn(params, "crossing_precision", kMinCrossingPrecision,
-                                            kMaxCrossingPrecision);
+    mOptions.crossingPrecision =
+        getFloatIn(params, "crossing_precision", kMinCrossingPrecision, kMaxCrossingPrecision);
     mOptions.materialRelaxationIterations =
         getIntIn(params, "material_relaxation_iterations", 0, kMaxRelaxationIterations);
     mOptions.materialRelaxationWeight = getFloatIn(params, "material_relaxation_weight", 0.0, 1.0);

@@ -1,8 +1,8 @@
 #include "dual_contouring.h"
 
 #include "extraction.h"
-#include "qef.h"
 #include "plugin/technique.h"
+#include "qef.h"
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
@@ -13,8 +13,10 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <map>
@@ -65,7 +67,10 @@ struct Box {
     glm::dvec3 half{0.5};
     glm::dmat3 rotation{1.0};
 
-    glm::dvec3 toLocal(const glm::dvec3& p) const { return glm::transpose(rotation) * (p - center); }
+    glm::dvec3 toLocal(const glm::dvec3& p) const
+    {
+        return glm::transpose(rotation) * (p - center);
+    }
     double value(const glm::dvec3& p) const
     {
         const glm::dvec3 q = glm::abs(toLocal(p)) - half;
@@ -188,10 +193,10 @@ struct Topology {
     std::size_t vertices = 0; //!< referenced by some triangle
     std::size_t edges = 0;    //!< undirected
     std::size_t faces = 0;
-    std::size_t badIndices = 0;        //!< out of range or repeated within a triangle
-    std::size_t unbalancedEdges = 0;   //!< a->b used a different number of times than b->a
-    std::size_t nonManifoldEdges = 0;  //!< undirected edges not used by exactly two triangles
-    std::size_t repeatedDirected = 0;  //!< directed edges used more than once
+    std::size_t badIndices = 0;       //!< out of range or repeated within a triangle
+    std::size_t unbalancedEdges = 0;  //!< a->b used a different number of times than b->a
+    std::size_t nonManifoldEdges = 0; //!< undirected edges not used by exactly two triangles
+    std::size_t repeatedDirected = 0; //!< directed edges used more than once
     std::size_t unreferenced = 0;
 
     long euler() const { return long(vertices) - long(edges) + long(faces); }
@@ -285,8 +290,8 @@ double computeSignedVolume(const TriangleMesh& mesh)
 // QEF solver
 
 //! Points on the plane n . x = d, spread around `around`, with normal n.
-void addPlanePoints(std::vector<glm::dvec3>& points, std::vector<glm::dvec3>& normals,
-                    glm::dvec3 n, double d, glm::dvec3 around, int count, std::mt19937& rng)
+void addPlanePoints(std::vector<glm::dvec3>& points, std::vector<glm::dvec3>& normals, glm::dvec3 n,
+                    double d, glm::dvec3 around, int count, std::mt19937& rng)
 {
     n = glm::normalize(n);
     std::uniform_real_distribution<double> u(-0.4, 0.4);
@@ -362,10 +367,10 @@ TEST(DualContouringQef, TwoPlanesGiveThePointOfTheirEdgeNearestTheMassPoint)
     for (const auto& pair : pairs) {
         std::vector<glm::dvec3> points;
         std::vector<glm::dvec3> normals;
-        addPlanePoints(points, normals, pair[0], glm::dot(glm::normalize(pair[0]), onEdge),
-                       onEdge, 3, rng);
-        addPlanePoints(points, normals, pair[1], glm::dot(glm::normalize(pair[1]), onEdge),
-                       onEdge, 2, rng);
+        addPlanePoints(points, normals, pair[0], glm::dot(glm::normalize(pair[0]), onEdge), onEdge,
+                       3, rng);
+        addPlanePoints(points, normals, pair[1], glm::dot(glm::normalize(pair[1]), onEdge), onEdge,
+                       2, rng);
         const QefSystem qef = dc::buildQef(points, normals);
         const dc::QefSolution s = dc::solveQefSvd(qef, 0.1);
         EXPECT_EQ(s.rank, 2);
@@ -394,8 +399,8 @@ TEST(DualContouringQef, ParallelNormalsGiveTheMidPlaneAtTheMassPoint)
 {
     // Two sheets of a feature thinner than a cell: z = 0.3 facing down, z = 0.5 facing up. The
     // QEF is rank 1; its minimiser nearest the mass point is the mass point moved to z = 0.4.
-    const std::vector<glm::dvec3> points = {{0.2, 0.1, 0.3}, {0.9, 0.4, 0.3}, {0.3, 0.7, 0.5},
-                                            {0.6, 0.8, 0.5}};
+    const std::vector<glm::dvec3> points = {
+        {0.2, 0.1, 0.3}, {0.9, 0.4, 0.3}, {0.3, 0.7, 0.5}, {0.6, 0.8, 0.5}};
     const std::vector<glm::dvec3> normals = {{0, 0, -1}, {0, 0, -1}, {0, 0, 1}, {0, 0, 1}};
     const QefSystem qef = dc::buildQef(points, normals);
     const dc::QefSolution s = dc::solveQefSvd(qef, 0.1);
@@ -461,7 +466,7 @@ TEST(DualContouringQef, NanInfiniteAndZeroNormalsAreSkipped)
     const double inf = std::numeric_limits<double>::infinity();
     const std::vector<glm::dvec3> points = {{0.3, 0.1, 0.2}, {0.1, 0.6, 0.9}, {0.9, 0.2, 0.2},
                                             {0.5, 0.5, 0.5}, {0.2, 0.2, 0.8}, {0.7, 0.7, 0.1}};
-    const std::vector<glm::dvec3> normals = {{1, 0, 0}, {0, 1, 0},     {nan, 0, 1},
+    const std::vector<glm::dvec3> normals = {{1, 0, 0}, {0, 1, 0},   {nan, 0, 1},
                                              {0, 0, 0}, {inf, 1, 0}, {0, 0, 1}};
     int skipped = -1;
     const QefSystem qef = dc::buildQef(points, normals, &skipped);
@@ -553,8 +558,8 @@ void expectSharpBox(const TriangleMesh& mesh, const Box& box, double tolerance)
         double nearest = std::numeric_limits<double>::infinity();
         for (const glm::vec3& p : mesh.positions)
             nearest = std::min(nearest, glm::length(glm::dvec3(p) - corner));
-        EXPECT_LE(nearest, tolerance) << "corner " << corner.x << " " << corner.y << " "
-                                      << corner.z;
+        EXPECT_LE(nearest, tolerance)
+            << "corner " << corner.x << " " << corner.y << " " << corner.z;
     }
     double worstSurface = 0.0;
     for (const glm::vec3& p : mesh.positions)
@@ -569,9 +574,9 @@ void expectSharpBox(const TriangleMesh& mesh, const Box& box, double tolerance)
             for (int side = 0; side < 2; ++side) {
                 double d = 0.0;
                 for (int k = 0; k < 3; ++k)
-                    d = std::max(d, box.distanceToFacePlane(
-                                        glm::dvec3(mesh.positions[mesh.indices[3 * f + k]]),
-                                        axis, side));
+                    d = std::max(
+                        d, box.distanceToFacePlane(
+                               glm::dvec3(mesh.positions[mesh.indices[3 * f + k]]), axis, side));
                 best = std::min(best, d);
             }
         worstTriangle = std::max(worstTriangle, best);
@@ -639,9 +644,9 @@ TEST(DualContouringCube, AxisAlignedCubeFromHermiteDataOfSchmitzSolver)
     const Box box{glm::dvec3(0.031, -0.017, 0.052), glm::dvec3(0.55), glm::dmat3(1.0)};
     const Sdf sdf = box.sdf();
     const plugin::SampledField field = sampleUnitCube(33, sdf);
-    const Extraction r = extract(field, &sdf,
-                                 {{"solver", std::string("schmitz")},
-                                  {"schmitz_iterations", std::int64_t(400)}});
+    const Extraction r =
+        extract(field, &sdf,
+                {{"solver", std::string("schmitz")}, {"schmitz_iterations", std::int64_t(400)}});
     expectClosedManifold(analyzeTopology(r.mesh));
     expectSharpBox(r.mesh, box, 1e-4 * field.spacing);
     EXPECT_EQ(r.counters.at("qef_solver"), 1.0);
@@ -751,7 +756,9 @@ TEST(DualContouringDegenerate, TinyAndHugeScalesGiveTheSameMesh)
     const auto make = [](double scale, glm::dvec3 offset) {
         Sdf unit = makeSphere(glm::dvec3(0.013, -0.021, 0.008), 0.7);
         Sdf scaled;
-        scaled.value = [=](const glm::dvec3& p) { return scale * unit.value((p - offset) / scale); };
+        scaled.value = [=](const glm::dvec3& p) {
+            return scale * unit.value((p - offset) / scale);
+        };
         scaled.gradient = [=](const glm::dvec3& p) { return unit.gradient((p - offset) / scale); };
         return scaled;
     };
@@ -763,13 +770,12 @@ TEST(DualContouringDegenerate, TinyAndHugeScalesGiveTheSameMesh)
         double scale;
         glm::dvec3 offset;
     };
-    for (const Case c : {Case{1e-4, glm::dvec3(0.0)}, Case{1e4, glm::dvec3(1e6)},
-                         Case{1e-4, glm::dvec3(3.0)}}) {
+    for (const Case c :
+         {Case{1e-4, glm::dvec3(0.0)}, Case{1e4, glm::dvec3(1e6)}, Case{1e-4, glm::dvec3(3.0)}}) {
         SCOPED_TRACE("scale " + std::to_string(c.scale));
         const Sdf sdf = make(c.scale, c.offset);
-        const plugin::SampledField field =
-            sampleField(glm::ivec3(n), c.offset - glm::dvec3(c.scale), 2.0 * c.scale / (n - 1),
-                        sdf.value);
+        const plugin::SampledField field = sampleField(
+            glm::ivec3(n), c.offset - glm::dvec3(c.scale), 2.0 * c.scale / (n - 1), sdf.value);
         for (const bool exact : {true, false}) {
             const Extraction r = extract(field, exact ? &sdf : nullptr);
             EXPECT_TRUE(isMeshFinite(r.mesh));
@@ -803,17 +809,16 @@ TEST(DualContouringDegenerate, FeaturesThinnerThanACellStayFinite)
     const Box rotatedPlate{glm::dvec3(0.0), glm::dvec3(0.6, 0.5, 0.3 * h),
                            makeRotation(0.3, 0.5, 0.2)};
     const Box hidden{glm::dvec3(0.0, 0.0, 0.5 * h), glm::dvec3(0.6, 0.5, 0.2 * h), glm::dmat3(1.0)};
-    const Sdf rod = {[=](const glm::dvec3& p) {
-                         return std::max(std::sqrt(p.y * p.y + p.z * p.z) - 0.3 * h,
-                                         std::abs(p.x) - 0.6);
-                     },
-                     [=](const glm::dvec3& p) {
-                         const double radial = std::sqrt(p.y * p.y + p.z * p.z);
-                         if (radial - 0.3 * h > std::abs(p.x) - 0.6)
-                             return radial > 0.0 ? glm::dvec3(0.0, p.y / radial, p.z / radial)
-                                                 : glm::dvec3(0.0);
-                         return glm::dvec3(p.x < 0.0 ? -1.0 : 1.0, 0.0, 0.0);
-                     }};
+    const Sdf rod = {
+        [=](const glm::dvec3& p) {
+            return std::max(std::sqrt(p.y * p.y + p.z * p.z) - 0.3 * h, std::abs(p.x) - 0.6);
+        },
+        [=](const glm::dvec3& p) {
+            const double radial = std::sqrt(p.y * p.y + p.z * p.z);
+            if (radial - 0.3 * h > std::abs(p.x) - 0.6)
+                return radial > 0.0 ? glm::dvec3(0.0, p.y / radial, p.z / radial) : glm::dvec3(0.0);
+            return glm::dvec3(p.x < 0.0 ? -1.0 : 1.0, 0.0, 0.0);
+        }};
     const std::vector<Sdf> shapes = {plate.sdf(), rotatedPlate.sdf(), hidden.sdf(), rod};
     for (std::size_t i = 0; i < shapes.size(); ++i) {
         const plugin::SampledField field = sampleUnitCube(33, shapes[i]);
@@ -894,9 +899,8 @@ plugin::HermiteData makeHermite(const plugin::SampledField& field, const Sdf& sd
                     double hi = 1.0;
                     for (int k = 0; k < 40; ++k) {
                         const double mid = 0.5 * (lo + hi);
-                        const bool in =
-                            sdf.value(field.position(x, y, z) + mid * field.spacing * glm::dvec3(e)) <
-                            0.0;
+                        const bool in = sdf.value(field.position(x, y, z) +
+                                                  mid * field.spacing * glm::dvec3(e)) < 0.0;
                         (in == a ? lo : hi) = mid;
                     }
                     plugin::HermiteEdge edge;
@@ -935,9 +939,9 @@ TEST(DualContouringSources, HermiteDataComesFirstThenTheExactFieldThenTheSamples
                   1e-4 * field.spacing);
 
     EXPECT_EQ(extract(field, nullptr).counters.at("hermite_source"), 2.0);
-    EXPECT_EQ(extract(field, &sdf, {{"hermite", std::string("samples")}})
-                  .counters.at("hermite_source"),
-              2.0);
+    EXPECT_EQ(
+        extract(field, &sdf, {{"hermite", std::string("samples")}}).counters.at("hermite_source"),
+        2.0);
 
     // Edges the Hermite data lacks take the next source (here the exact field).
     const std::size_t total = hermite.edges.size();
@@ -988,8 +992,8 @@ TEST(DualContouringSplit, QuadsSplitAlongTheDiagonalWhoseNormalsAgree)
     const Extraction r = extract(field, &sdf);
     const auto normal = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
         const glm::dvec3 pa = r.mesh.positions[a];
-        const glm::dvec3 n = glm::cross(glm::dvec3(r.mesh.positions[b]) - pa,
-                                        glm::dvec3(r.mesh.positions[c]) - pa);
+        const glm::dvec3 n =
+            glm::cross(glm::dvec3(r.mesh.positions[b]) - pa, glm::dvec3(r.mesh.positions[c]) - pa);
         const double l = glm::length(n);
         return l > 0.0 ? n / l : glm::dvec3(0.0);
     };
@@ -999,16 +1003,15 @@ TEST(DualContouringSplit, QuadsSplitAlongTheDiagonalWhoseNormalsAgree)
         // Recover the quad cycle: the shared diagonal is the pair in both triangles.
         std::array<std::uint32_t, 4> cycle;
         if (t[0] == t[3] && t[2] == t[4])
-            cycle = {t[0], t[1], t[2], t[5]};  // diagonal 0-2: (0,1,2), (0,2,3)
+            cycle = {t[0], t[1], t[2], t[5]}; // diagonal 0-2: (0,1,2), (0,2,3)
         else
-            cycle = {t[0], t[1], t[4], t[2]};  // diagonal 1-3: (0,1,3), (1,2,3)
+            cycle = {t[0], t[1], t[4], t[2]}; // diagonal 1-3: (0,1,3), (1,2,3)
         const double chosen = glm::dot(normal(t[0], t[1], t[2]), normal(t[3], t[4], t[5]));
         const bool diagonal02 = t[0] == t[3];
-        const double other =
-            diagonal02 ? glm::dot(normal(cycle[0], cycle[1], cycle[3]),
-                                  normal(cycle[1], cycle[2], cycle[3]))
-                       : glm::dot(normal(cycle[0], cycle[1], cycle[2]),
-                                  normal(cycle[0], cycle[2], cycle[3]));
+        const double other = diagonal02 ? glm::dot(normal(cycle[0], cycle[1], cycle[3]),
+                                                   normal(cycle[1], cycle[2], cycle[3]))
+                                        : glm::dot(normal(cycle[0], cycle[1], cycle[2]),
+                                                   normal(cycle[0], cycle[2], cycle[3]));
         EXPECT_GE(chosen, other - 1e-6) << "quad " << q;
     }
 }
@@ -1083,9 +1086,9 @@ TEST(DualContouringMaterials, RelaxationStraightensTheMaterialStaircaseOnTheSurf
     for (const bool exact : {true, false}) {
         SCOPED_TRACE(exact ? "exact projection" : "QEF projection");
         const Extraction still = extract(field, exact ? &ground : nullptr, {}, &materials);
-        const Extraction relaxed = extract(field, exact ? &ground : nullptr,
-                                           {{"material_relaxation_iterations", std::int64_t(20)}},
-                                           &materials);
+        const Extraction relaxed =
+            extract(field, exact ? &ground : nullptr,
+                    {{"material_relaxation_iterations", std::int64_t(20)}}, &materials);
         ASSERT_EQ(still.mesh.vertexCount(), relaxed.mesh.vertexCount());
         EXPECT_EQ(still.mesh.triangleCount(), relaxed.mesh.triangleCount());
         // Boundary vertices, found independently: cells whose four crossed z edges (all interior
@@ -1129,8 +1132,8 @@ TEST(DualContouringMaterials, RelaxationStraightensTheMaterialStaircaseOnTheSurf
         }
         const double before = spread(still.mesh, boundary);
         const double after = spread(relaxed.mesh, boundary);
-        EXPECT_LT(after, 0.8 * before) << "spread " << before / h << " -> " << after / h
-                                       << " cells";
+        EXPECT_LT(after, 0.8 * before)
+            << "spread " << before / h << " -> " << after / h << " cells";
         EXPECT_GT(relaxed.counters.at("material_relaxation_max_shift"), 0.05);
     }
 }
@@ -1165,6 +1168,41 @@ TEST(DualContouringMaterials, RelaxedVerticesStayOnACurvedExactSurface)
         EXPECT_LT(std::abs(sdf.value(after)), 1e-5 * field.spacing) << "vertex " << v;
     }
     EXPECT_GT(moved, 0u);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Timing (disabled; run with --gtest_also_run_disabled_tests --gtest_filter='*Timing*')
+
+TEST(DualContouringTiming, DISABLED_SphereExtractionTimes)
+{
+    const Sdf sdf = makeSphere(glm::dvec3(0.013, -0.021, 0.008), 0.7);
+    for (const int n : {65, 129, 257}) {
+        const plugin::SampledField field = sampleUnitCube(n, sdf);
+        for (const bool exact : {false, true}) {
+            for (const std::string solver : {"svd", "schmitz"}) {
+                DualContouring technique(makeParams({{"solver", solver}}));
+                plugin::IsosurfaceInput input;
+                input.field = &field;
+                if (exact) {
+                    input.exactValue = sdf.value;
+                    input.exactGradient = sdf.gradient;
+                }
+                TriangleMesh mesh;
+                technique.extract(input, mesh); // warm-up
+                const auto start = std::chrono::steady_clock::now();
+                constexpr int kRuns = 3;
+                for (int k = 0; k < kRuns; ++k)
+                    technique.extract(input, mesh);
+                const double ms = std::chrono::duration<double, std::milli>(
+                                      std::chrono::steady_clock::now() - start)
+                                      .count() /
+                                  kRuns;
+                std::printf("n=%d %-7s %-7s %8.2f ms  %zu vertices %zu triangles\n", n,
+                            exact ? "exact" : "samples", solver.c_str(), ms, mesh.vertexCount(),
+                            mesh.triangleCount());
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

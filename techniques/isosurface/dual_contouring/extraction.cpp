@@ -57,8 +57,9 @@ glm::dvec3 axisVector(int axis)
 class Grid {
 public:
     Grid(const plugin::SampledField& field, double isoValue)
-        : mField(field), mIso(isoValue), mSize(field.samples),
-          mStride{1, std::size_t(field.samples.x), std::size_t(field.samples.x) * field.samples.y}
+        : mField(field), mIso(isoValue),
+          mSize(field.samples), mStride{1, std::size_t(field.samples.x),
+                                        std::size_t(field.samples.x) * field.samples.y}
     {
     }
 
@@ -72,7 +73,8 @@ public:
     }
     glm::ivec3 sampleOf(std::size_t i) const
     {
-        return glm::ivec3(int(i % mStride[1]), int((i / mStride[1]) % mSize.y), int(i / mStride[2]));
+        return glm::ivec3(int(i % mStride[1]), int((i / mStride[1]) % mSize.y),
+                          int(i / mStride[2]));
     }
     //! Value relative to the iso-value; f < iso exactly when relative < 0.
     double relative(std::size_t i) const { return double(mField.values[i]) - mIso; }
@@ -117,10 +119,10 @@ struct Crossing {
 
 //! The crossed edges, numbered in scan order (layer, row, sample, axis), and where to find them.
 struct EdgeTable {
-    std::vector<std::uint8_t> flags;     //!< per sample: kInsideBit | crossed-axis bits
-    std::vector<std::uint32_t> base;     //!< per sample: number of the first edge starting there
-    std::vector<std::uint64_t> edges;    //!< per edge: sample index * 3 + axis
-    std::vector<Crossing> crossings;     //!< per edge
+    std::vector<std::uint8_t> flags;  //!< per sample: kInsideBit | crossed-axis bits
+    std::vector<std::uint32_t> base;  //!< per sample: number of the first edge starting there
+    std::vector<std::uint64_t> edges; //!< per edge: sample index * 3 + axis
+    std::vector<Crossing> crossings;  //!< per edge
 
     //! Number of the crossed edge (sample, axis), or kNone when it is not crossed.
     std::uint32_t find(std::size_t sample, int axis) const
@@ -138,8 +140,9 @@ void validate(const plugin::IsosurfaceInput& input)
         throw std::invalid_argument("dual_contouring: IsosurfaceInput::field is null");
     const plugin::SampledField& field = *input.field;
     if (!(std::isfinite(field.spacing) && field.spacing > 0.0))
-        throw std::invalid_argument("dual_contouring: the field spacing must be finite and > 0, got " +
-                                    std::to_string(field.spacing));
+        throw std::invalid_argument(
+            "dual_contouring: the field spacing must be finite and > 0, got " +
+            std::to_string(field.spacing));
     if (!isFinite(field.origin))
         throw std::invalid_argument("dual_contouring: the field origin must be finite");
     if (field.samples.x < 0 || field.samples.y < 0 || field.samples.z < 0)
@@ -291,8 +294,8 @@ public:
         } else {
             glm::ivec3 s1 = s;
             ++s1[axis];
-            c.normal = normalizeOrZero((1.0 - t) * mGrid.sampleGradient(s) +
-                                       t * mGrid.sampleGradient(s1));
+            c.normal =
+                normalizeOrZero((1.0 - t) * mGrid.sampleGradient(s) + t * mGrid.sampleGradient(s1));
         }
         return c;
     }
@@ -324,7 +327,8 @@ private:
         const glm::dvec3 direction = axisVector(axis);
         for (int k = 0; k < mBisectionSteps; ++k) {
             const double mid = 0.5 * (a + b);
-            const double f = mInput.exactValue(mGrid.toWorld(start + mid * direction)) - mGrid.iso();
+            const double f =
+                mInput.exactValue(mGrid.toWorld(start + mid * direction)) - mGrid.iso();
             if (std::isnan(f))
                 break;
             if ((f < 0.0) == lowInside)
@@ -476,78 +480,79 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
     std::vector<std::uint8_t> noPlanes(count, 0);
     const auto& cellEdges = getCellEdgeOffsets();
 
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-        std::array<glm::dvec3, 12> points;
-        std::array<glm::dvec3, 12> normals;
-        for (std::size_t v = range.begin(); v != range.end(); ++v) {
-            const glm::ivec3 cell = vertices.cell[v];
-            int n = 0;
-            glm::dvec3 normalSum(0.0);
-            for (const CellEdgeOffset& e : cellEdges) {
-                const std::uint32_t id = table.find(grid.index(cell + e.offset), e.axis);
-                if (id == kNone)
-                    continue;
-                const Crossing& c = table.crossings[id];
-                points[n] = c.point - glm::dvec3(cell);
-                normals[n] = c.normal;
-                normalSum += c.normal;
-                ++n;
-            }
-            int skippedHere = 0;
-            const QefSystem qef = buildQef(std::span(points.data(), n),
-                                           std::span(normals.data(), n), &skippedHere);
-            skipped[v] = std::uint8_t(skippedHere);
-            QefSolution solution;
-            if (options.solver == QefSolver::Svd) {
-                solution = solveQefSvd(qef, options.svdThreshold);
-            } else {
-                const glm::dvec3 start = options.schmitzStart == SchmitzStart::MassPoint
-                                             ? qef.massPoint
-                                             : glm::dvec3(0.5);
-                solution = solveQefSchmitz(qef, start, options.schmitzIterations,
-                                           options.schmitzStep);
-            }
-            glm::dvec3 p = solution.position;
-            if (qef.planeCount == 0) {
-                noPlanes[v] = 1;
-                p = qef.massPoint;
-            }
-            if (!isFinite(p))
-                p = qef.massPoint;
-            if (!isInsideBox(p)) {
-                left[v] = 1;
-                switch (options.outsidePolicy) {
-                case OutsidePolicy::Clamp:
-                    p = glm::clamp(p, glm::dvec3(0.0), glm::dvec3(1.0));
-                    break;
-                case OutsidePolicy::MassPoint:
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, count),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            std::array<glm::dvec3, 12> points;
+            std::array<glm::dvec3, 12> normals;
+            for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                const glm::ivec3 cell = vertices.cell[v];
+                int n = 0;
+                glm::dvec3 normalSum(0.0);
+                for (const CellEdgeOffset& e : cellEdges) {
+                    const std::uint32_t id = table.find(grid.index(cell + e.offset), e.axis);
+                    if (id == kNone)
+                        continue;
+                    const Crossing& c = table.crossings[id];
+                    points[n] = c.point - glm::dvec3(cell);
+                    normals[n] = c.normal;
+                    normalSum += c.normal;
+                    ++n;
+                }
+                int skippedHere = 0;
+                const QefSystem qef = buildQef(std::span(points.data(), n),
+                                               std::span(normals.data(), n), &skippedHere);
+                skipped[v] = std::uint8_t(skippedHere);
+                QefSolution solution;
+                if (options.solver == QefSolver::Svd) {
+                    solution = solveQefSvd(qef, options.svdThreshold);
+                } else {
+                    const glm::dvec3 start = options.schmitzStart == SchmitzStart::MassPoint
+                                                 ? qef.massPoint
+                                                 : glm::dvec3(0.5);
+                    solution =
+                        solveQefSchmitz(qef, start, options.schmitzIterations, options.schmitzStep);
+                }
+                glm::dvec3 p = solution.position;
+                if (qef.planeCount == 0) {
+                    noPlanes[v] = 1;
                     p = qef.massPoint;
-                    break;
-                case OutsidePolicy::Keep:
-                    break;
+                }
+                if (!isFinite(p))
+                    p = qef.massPoint;
+                if (!isInsideBox(p)) {
+                    left[v] = 1;
+                    switch (options.outsidePolicy) {
+                    case OutsidePolicy::Clamp:
+                        p = glm::clamp(p, glm::dvec3(0.0), glm::dvec3(1.0));
+                        break;
+                    case OutsidePolicy::MassPoint:
+                        p = qef.massPoint;
+                        break;
+                    case OutsidePolicy::Keep:
+                        break;
+                    }
+                }
+                vertices.local[v] = p;
+                rank[v] = std::uint8_t(solution.rank);
+                if (keepQef)
+                    vertices.qef[v] = qef;
+                if (options.computeNormals) {
+                    glm::dvec3 normal = normalizeOrZero(normalSum);
+                    if (normal == glm::dvec3(0.0)) {
+                        // No usable crossing normal: the sampled field's gradient over the cell.
+                        glm::dvec3 gradient(0.0);
+                        for (int k = 0; k < 8; ++k)
+                            gradient += grid.sampleGradient(
+                                cell + glm::ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+                        normal = normalizeOrZero(gradient);
+                    }
+                    if (normal == glm::dvec3(0.0))
+                        normal = glm::dvec3(0.0, 0.0, 1.0);
+                    vertices.normal[v] = normal;
                 }
             }
-            vertices.local[v] = p;
-            rank[v] = std::uint8_t(solution.rank);
-            if (keepQef)
-                vertices.qef[v] = qef;
-            if (options.computeNormals) {
-                glm::dvec3 normal = normalizeOrZero(normalSum);
-                if (normal == glm::dvec3(0.0)) {
-                    // No usable crossing normal: the sampled field's gradient over the cell.
-                    glm::dvec3 gradient(0.0);
-                    for (int k = 0; k < 8; ++k)
-                        gradient += grid.sampleGradient(cell + glm::ivec3(k & 1, (k >> 1) & 1,
-                                                                          (k >> 2) & 1));
-                    normal = normalizeOrZero(gradient);
-                }
-                if (normal == glm::dvec3(0.0))
-                    normal = glm::dvec3(0.0, 0.0, 1.0);
-                vertices.normal[v] = normal;
-            }
-        }
-    });
+        });
     for (std::size_t v = 0; v < count; ++v) {
         ++stats.rank[std::min<int>(rank[v], 3)];
         stats.leftCell += left[v];
@@ -579,24 +584,26 @@ public:
         mBoundary.assign(count, 0);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
                           [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t v = range.begin(); v != range.end(); ++v)
-                mBoundary[v] = hasMixedQuads(mVertices.cell[v]) ? 1 : 0;
-        });
+                              for (std::size_t v = range.begin(); v != range.end(); ++v)
+                                  mBoundary[v] = hasMixedQuads(mVertices.cell[v]) ? 1 : 0;
+                          });
         mNeighbourStart.assign(count + 1, 0);
         std::vector<std::uint32_t> found(6 * count);
         std::vector<std::uint8_t> foundCount(count, 0);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
                           [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t v = range.begin(); v != range.end(); ++v) {
-                if (mBoundary[v])
-                    foundCount[v] = std::uint8_t(findBoundaryNeighbours(v, &found[6 * v]));
-            }
-        });
+                              for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                                  if (mBoundary[v])
+                                      foundCount[v] =
+                                          std::uint8_t(findBoundaryNeighbours(v, &found[6 * v]));
+                              }
+                          });
         for (std::size_t v = 0; v < count; ++v)
             mNeighbourStart[v + 1] = mNeighbourStart[v] + foundCount[v];
         mNeighbours.resize(mNeighbourStart[count]);
         for (std::size_t v = 0; v < count; ++v)
-            std::copy_n(found.begin() + 6 * v, foundCount[v], mNeighbours.begin() + mNeighbourStart[v]);
+            std::copy_n(found.begin() + 6 * v, foundCount[v],
+                        mNeighbours.begin() + mNeighbourStart[v]);
         std::size_t boundary = 0;
         for (std::uint8_t b : mBoundary)
             boundary += b;
@@ -611,39 +618,41 @@ public:
         const std::vector<glm::dvec3> initial = mVertices.local;
         std::vector<glm::dvec3> next = mVertices.local;
         for (int it = 0; it < iterations; ++it) {
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
-                              [&](const tbb::blocked_range<std::size_t>& range) {
-                for (std::size_t v = range.begin(); v != range.end(); ++v) {
-                    const std::uint32_t first = mNeighbourStart[v];
-                    const std::uint32_t last = mNeighbourStart[v + 1];
-                    if (!mBoundary[v] || first == last) {
-                        next[v] = mVertices.local[v];
-                        continue;
-                    }
-                    // Laplacian step toward the mean of the boundary neighbours, in the vertex's
-                    // cell frame.
-                    const glm::ivec3 cell = mVertices.cell[v];
-                    glm::dvec3 mean(0.0);
-                    for (std::uint32_t k = first; k < last; ++k) {
-                        const std::uint32_t u = mNeighbours[k];
-                        mean += mVertices.local[u] + glm::dvec3(mVertices.cell[u] - cell);
-                    }
-                    mean /= double(last - first);
-                    // "we make sure they don't move outside their DC cube": a step whose
-                    // projection leaves the cell is halved (up to kMaxStepHalvings times), else
-                    // the vertex stays, so relaxed vertices are on the surface and in their cell.
-                    const glm::dvec3 p = mVertices.local[v];
-                    double weight = mOptions.materialRelaxationWeight;
-                    next[v] = p;
-                    for (int k = 0; k <= kMaxStepHalvings; ++k, weight *= 0.5) {
-                        const glm::dvec3 target = project(v, p + weight * (mean - p));
-                        if (isFinite(target) && isInsideBox(target)) {
-                            next[v] = target;
-                            break;
+            tbb::parallel_for(
+                tbb::blocked_range<std::size_t>(0, count),
+                [&](const tbb::blocked_range<std::size_t>& range) {
+                    for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                        const std::uint32_t first = mNeighbourStart[v];
+                        const std::uint32_t last = mNeighbourStart[v + 1];
+                        if (!mBoundary[v] || first == last) {
+                            next[v] = mVertices.local[v];
+                            continue;
+                        }
+                        // Laplacian step toward the mean of the boundary neighbours, in the
+                        // vertex's cell frame.
+                        const glm::ivec3 cell = mVertices.cell[v];
+                        glm::dvec3 mean(0.0);
+                        for (std::uint32_t k = first; k < last; ++k) {
+                            const std::uint32_t u = mNeighbours[k];
+                            mean += mVertices.local[u] + glm::dvec3(mVertices.cell[u] - cell);
+                        }
+                        mean /= double(last - first);
+                        // "we make sure they don't move outside their DC cube": a step whose
+                        // projection leaves the cell is halved (up to kMaxStepHalvings times), else
+                        // the vertex stays, so relaxed vertices are on the surface and in their
+                        // cell.
+                        const glm::dvec3 p = mVertices.local[v];
+                        double weight = mOptions.materialRelaxationWeight;
+                        next[v] = p;
+                        for (int k = 0; k <= kMaxStepHalvings; ++k, weight *= 0.5) {
+                            const glm::dvec3 target = project(v, p + weight * (mean - p));
+                            if (isFinite(target) && isInsideBox(target)) {
+                                next[v] = target;
+                                break;
+                            }
                         }
                     }
-                }
-            });
+                });
             mVertices.local.swap(next);
         }
         double shift = 0.0;
@@ -794,16 +803,17 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     std::atomic<std::size_t> missing{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edgeCount),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-        std::size_t missingHere = 0;
-        for (std::size_t k = range.begin(); k != range.end(); ++k) {
-            const std::size_t sample = std::size_t(table.edges[k] / 3u);
-            const int axis = int(table.edges[k] % 3u);
-            bool edgeMissing = false;
-            table.crossings[k] = source.compute(grid.sampleOf(sample), axis, edgeMissing);
-            missingHere += edgeMissing;
-        }
-        missing += missingHere;
-    });
+                          std::size_t missingHere = 0;
+                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                              const std::size_t sample = std::size_t(table.edges[k] / 3u);
+                              const int axis = int(table.edges[k] % 3u);
+                              bool edgeMissing = false;
+                              table.crossings[k] =
+                                  source.compute(grid.sampleOf(sample), axis, edgeMissing);
+                              missingHere += edgeMissing;
+                          }
+                          missing += missingHere;
+                      });
     stats.hermiteMissing = missing.load();
 
     CellVertices vertices;
@@ -828,42 +838,42 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     std::vector<std::uint8_t> flipped(edgeCount, 0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edgeCount),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t k = range.begin(); k != range.end(); ++k) {
-            const std::size_t sample = std::size_t(table.edges[k] / 3u);
-            const int axis = int(table.edges[k] % 3u);
-            const glm::ivec3 s = grid.sampleOf(sample);
-            if (!isInteriorEdge(grid, s, axis))
-                continue;
-            const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
-            const bool lowInside = (table.flags[sample] & kInsideBit) != 0;
-            std::array<std::uint32_t, 4> q;
-            std::array<glm::dvec3, 4> p;
-            for (int c = 0; c < 4; ++c) {
-                const glm::ivec3 cell = cells[lowInside ? c : (4 - c) % 4];
-                q[c] = vertices.vertexOfCell[grid.cellIndex(cell)];
-                p[c] = glm::dvec3(cell - s) + vertices.local[q[c]];
-            }
-            hasQuad[k] = 1;
-            if (chooseDiagonal13(q, p)) {
-                flipped[k] = 1;
-                triangles[2 * k] = {q[0], q[1], q[3]};
-                triangles[2 * k + 1] = {q[1], q[2], q[3]};
-            } else {
-                triangles[2 * k] = {q[0], q[1], q[2]};
-                triangles[2 * k + 1] = {q[0], q[2], q[3]};
-            }
-        }
-    });
+                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                              const std::size_t sample = std::size_t(table.edges[k] / 3u);
+                              const int axis = int(table.edges[k] % 3u);
+                              const glm::ivec3 s = grid.sampleOf(sample);
+                              if (!isInteriorEdge(grid, s, axis))
+                                  continue;
+                              const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
+                              const bool lowInside = (table.flags[sample] & kInsideBit) != 0;
+                              std::array<std::uint32_t, 4> q;
+                              std::array<glm::dvec3, 4> p;
+                              for (int c = 0; c < 4; ++c) {
+                                  const glm::ivec3 cell = cells[lowInside ? c : (4 - c) % 4];
+                                  q[c] = vertices.vertexOfCell[grid.cellIndex(cell)];
+                                  p[c] = glm::dvec3(cell - s) + vertices.local[q[c]];
+                              }
+                              hasQuad[k] = 1;
+                              if (chooseDiagonal13(q, p)) {
+                                  flipped[k] = 1;
+                                  triangles[2 * k] = {q[0], q[1], q[3]};
+                                  triangles[2 * k + 1] = {q[1], q[2], q[3]};
+                              } else {
+                                  triangles[2 * k] = {q[0], q[1], q[2]};
+                                  triangles[2 * k + 1] = {q[0], q[2], q[3]};
+                              }
+                          }
+                      });
 
     TriangleMesh mesh;
     const std::size_t vertexCount = vertices.cell.size();
     mesh.positions.resize(vertexCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertexCount),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t v = range.begin(); v != range.end(); ++v)
-            mesh.positions[v] =
-                glm::vec3(grid.toWorld(glm::dvec3(vertices.cell[v]) + vertices.local[v]));
-    });
+                          for (std::size_t v = range.begin(); v != range.end(); ++v)
+                              mesh.positions[v] = glm::vec3(
+                                  grid.toWorld(glm::dvec3(vertices.cell[v]) + vertices.local[v]));
+                      });
     if (options.computeNormals) {
         mesh.normals.resize(vertexCount);
         for (std::size_t v = 0; v < vertexCount; ++v)

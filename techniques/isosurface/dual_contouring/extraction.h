@@ -40,14 +40,14 @@ enum class HermiteSource {
 
 struct ExtractionOptions {
     QefSolver solver = QefSolver::Svd;
-    double svdThreshold = 0.1;          //!< relative to the largest singular value, [0, 1]
-    int schmitzIterations = 20;         //!< >= 1
-    double schmitzStep = 1.0;           //!< times the mean plane force, (0, 2)
+    double svdThreshold = 0.1;  //!< relative to the largest singular value, [0, 1]
+    int schmitzIterations = 20; //!< >= 1
+    double schmitzStep = 1.0;   //!< times the mean plane force, (0, 2)
     SchmitzStart schmitzStart = SchmitzStart::MassPoint;
     OutsidePolicy outsidePolicy = OutsidePolicy::Clamp;
     HermiteMode hermite = HermiteMode::Auto;
-    double crossingPrecision = 1e-6;    //!< bisection interval on exactValue, cells, (0, 0.5]
-    int materialRelaxationIterations = 0; //!< >= 0
+    double crossingPrecision = 1e-6;       //!< bisection interval on exactValue, cells, (0, 0.5]
+    int materialRelaxationIterations = 0;  //!< >= 0
     double materialRelaxationWeight = 0.5; //!< fraction of the way to the neighbour mean, [0, 1]
     bool computeNormals = true;
 };
@@ -55,17 +55,17 @@ struct ExtractionOptions {
 //! What one call did; DualContouring::counters() reports it.
 struct ExtractionStats {
     HermiteSource source = HermiteSource::Samples;
-    std::size_t crossedEdges = 0;     //!< grid edges with a sign change
-    std::size_t hermiteMissing = 0;   //!< crossed edges absent from input.hermite (next source used)
-    std::size_t cells = 0;            //!< cells with a sign change = vertices
-    std::size_t quads = 0;            //!< crossed edges with four cells around them
+    std::size_t crossedEdges = 0;   //!< grid edges with a sign change
+    std::size_t hermiteMissing = 0; //!< crossed edges absent from input.hermite (next source used)
+    std::size_t cells = 0;          //!< cells with a sign change = vertices
+    std::size_t quads = 0;          //!< crossed edges with four cells around them
     std::size_t rank[4] = {0, 0, 0, 0}; //!< cells by QEF rank (SVD solver; Schmitz: 0 or 3)
-    std::size_t skippedNormals = 0;   //!< crossings whose normal was zero, NaN or infinite
+    std::size_t skippedNormals = 0;     //!< crossings whose normal was zero, NaN or infinite
     std::size_t cellsWithoutPlanes = 0; //!< cells placed at their mass point for lack of normals
-    std::size_t leftCell = 0;         //!< vertices outside their cell box before the policy
-    std::size_t flippedSplits = 0;    //!< quads split along the diagonal v1-v3
-    std::size_t boundaryVertices = 0; //!< material boundary vertices (when materials are given)
-    double maxRelaxationShift = 0.0;  //!< largest relaxation displacement, cells
+    std::size_t leftCell = 0;           //!< vertices outside their cell box before the policy
+    std::size_t flippedSplits = 0;      //!< quads split along the diagonal v1-v3
+    std::size_t boundaryVertices = 0;   //!< material boundary vertices (when materials are given)
+    double maxRelaxationShift = 0.0;    //!< largest relaxation displacement, cells
 };
 
 //! Replaces `out` with the dual contour of {f = isoValue}; f < isoValue is inside. Throws

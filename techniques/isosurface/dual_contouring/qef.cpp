@@ -102,7 +102,8 @@ SymmetricEigen computeSymmetricEigen(const glm::dmat3& m)
             if (std::abs(theta) > 1e150)
                 t = 0.5 / theta;
             else
-                t = (theta >= 0.0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+                t = (theta >= 0.0 ? 1.0 : -1.0) /
+                    (std::abs(theta) + std::sqrt(theta * theta + 1.0));
             const double c = 1.0 / std::sqrt(t * t + 1.0);
             const double s = t * c;
             a[p][p] -= t * apq;

@@ -4,8 +4,8 @@
 // QEF [Ju et al. 2002, eq. 1]: E(x) = sum_i (n_i . (x - p_i))^2 over the Hermite points p_i and
 // unit normals n_i of one cell. It is built relative to the mass point m (the mean of the p_i):
 // with y = x - m, E = |A y - b|^2, A's rows n_i, b_i = n_i . (p_i - m); the system kept is A^T A,
-// A^T b, b^T b. Solving near the mass point makes rank-deficient cells (flat or edge cells) pick the
-// minimiser closest to m [Lindstrom 2000; Schaefer & Warren 2002, "Dual Contouring: The Secret
+// A^T b, b^T b. Solving near the mass point makes rank-deficient cells (flat or edge cells) pick
+// the minimiser closest to m [Lindstrom 2000; Schaefer & Warren 2002, "Dual Contouring: The Secret
 // Sauce"].
 
 #include <glm/mat3x3.hpp>
@@ -19,12 +19,12 @@ namespace rtlab::isosurface::dc {
 
 //! A QEF relative to its mass point. Coordinates are whatever the caller uses (grid units here).
 struct QefSystem {
-    glm::dvec3 massPoint{0.0};  //!< mean of all points, with or without a usable normal
-    glm::dmat3 ata{0.0};        //!< A^T A (symmetric)
-    glm::dvec3 atb{0.0};        //!< A^T b, b relative to the mass point
-    double btb = 0.0;           //!< b^T b
-    int pointCount = 0;         //!< points given
-    int planeCount = 0;         //!< points whose normal was finite and non-zero (rows of A)
+    glm::dvec3 massPoint{0.0}; //!< mean of all points, with or without a usable normal
+    glm::dmat3 ata{0.0};       //!< A^T A (symmetric)
+    glm::dvec3 atb{0.0};       //!< A^T b, b relative to the mass point
+    double btb = 0.0;          //!< b^T b
+    int pointCount = 0;        //!< points given
+    int planeCount = 0;        //!< points whose normal was finite and non-zero (rows of A)
 
     //! E(x) at a point in the caller's coordinates.
     double evaluate(const glm::dvec3& x) const;
@@ -40,8 +40,8 @@ QefSystem buildQef(std::span<const glm::dvec3> points, std::span<const glm::dvec
 //! "Matrix Computations", sec. 8.5]: m = V diag(values) V^T, columns of V orthonormal.
 struct SymmetricEigen {
     glm::dvec3 values{0.0};
-    glm::dmat3 vectors{1.0};  //!< column k is the eigenvector of values[k]
-    int sweeps = 0;           //!< sweeps until the off-diagonal part vanished (<= kMaxJacobiSweeps)
+    glm::dmat3 vectors{1.0}; //!< column k is the eigenvector of values[k]
+    int sweeps = 0;          //!< sweeps until the off-diagonal part vanished (<= kMaxJacobiSweeps)
 };
 inline constexpr int kMaxJacobiSweeps = 32;
 SymmetricEigen computeSymmetricEigen(const glm::dmat3& m);
@@ -52,8 +52,8 @@ SymmetricEigen computeSymmetricEigen(const glm::dmat3& m);
 inline constexpr double kSingularFloor = 1e-6;
 
 struct QefSolution {
-    glm::dvec3 position{0.0};  //!< caller's coordinates
-    int rank = 0;              //!< singular values kept (0 when the cell has no plane)
+    glm::dvec3 position{0.0}; //!< caller's coordinates
+    int rank = 0;             //!< singular values kept (0 when the cell has no plane)
 };
 
 //! Minimiser of the QEF nearest to `reference` in the kept directions: the truncated
