@@ -5,16 +5,24 @@
 #include "core/json.h"
 #include "core/strings.h"
 #include "plugin/technique.h"
+#include "scene/camera_paths.h"
 #include "scene/procedural.h"
+#include "scene/scene_file.h"
 #include "scene/sdf_shapes.h"
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <filesystem>
 
 namespace rtlab::experiment {
 
 using config::YamlFile;
+
+bool RunConfig::wantsMetric(const std::string& metric) const
+{
+    return metrics.empty() || std::find(metrics.begin(), metrics.end(), metric) != metrics.end();
+}
 
 std::string RunConfig::toJson() const
 {
@@ -24,18 +32,30 @@ std::string RunConfig::toJson() const
                                           .add("technique", choice.technique)
                                           .addRaw("params", choice.params.toJson())
                                           .str());
-    return JsonObject()
-        .add("scene", scene)
-        .add("grid", grid)
-        .add("width", width)
-        .add("height", height)
-        .add("frames", frames)
-        .addRaw("reference", JsonObject()
-                                 .add("target_stderr", reference.targetStdErr)
-                                 .add("target_rel_stderr", reference.targetRelStdErr)
-                                 .add("max_samples", reference.maxSamples)
-                                 .add("seed", std::int64_t(reference.seed))
-                                 .str())
+    // Keys added after the first studies are written only when set, so that the hashes (and
+    // therefore the resumability) of existing results stay valid.
+    JsonObject referenceJson;
+    referenceJson.add("target_stderr", reference.targetStdErr)
+        .add("target_rel_stderr", reference.targetRelStdErr)
+        .add("max_samples", reference.maxSamples)
+        .add("seed", std::int64_t(reference.seed));
+    if (!reference.quantity.empty())
+        referenceJson.add("quantity", reference.quantity);
+    if (!reference.falloff.empty())
+        referenceJson.add("falloff", reference.falloff);
+    if (reference.radius > 0.0)
+        referenceJson.add("radius", reference.radius);
+    JsonObject json;
+    json.add("scene", scene).add("grid", grid).add("width", width).add("height", height).add("frames", frames);
+    if (!cameraPath.empty())
+        json.add("camera_path", cameraPath);
+    if (!metrics.empty()) {
+        std::string list;
+        for (const auto& m : metrics)
+            list += (list.empty() ? "" : ",") + m;
+        json.add("metrics", list);
+    }
+    return json.addRaw("reference", referenceJson.str())
         .addRaw("timing", JsonObject().add("warmup", timing.warmup).add("repeats", timing.repeats).str())
         .addRaw("techniques", techniquesJson.str())
         .str();
@@ -52,6 +72,8 @@ std::string RunConfig::id() const
     std::string s = std::filesystem::path(scene).stem().string() +
                     (screenSpace ? "-" + std::to_string(width) + "x" + std::to_string(height)
                                  : "-g" + std::to_string(grid));
+    if (!cameraPath.empty() && cameraPath != "scene")
+        s += "-" + cameraPath;
     for (const auto& [family, choice] : techniques)
         s += "-" + choice.technique;
     return s + "-" + hash().substr(0, 8);
@@ -64,6 +86,7 @@ constexpr const char* kTechniqueKey = "technique";
 struct Loader {
     const YamlFile& file;
     const plugin::Registry& registry;
+    mutable std::vector<std::pair<std::string, YAML::Node>> cameraPathNodes;  //!< non-built-in names, where
 
     const plugin::TechniqueEntry& findTechnique(const YAML::Node& where, const std::string& family,
                                                 const std::string& name) const
@@ -103,7 +126,9 @@ struct Loader {
 
     void readReference(const YAML::Node& node, RunConfig& run) const
     {
-        config::checkKeys(file, node, {"target_stderr", "target_rel_stderr", "max_samples", "seed"}, {}, "reference");
+        config::checkKeys(file, node,
+                          {"target_stderr", "target_rel_stderr", "max_samples", "seed", "quantity", "falloff", "radius"},
+                          {}, "reference");
         auto positive = [&](const char* key, double& out) {
             if (!node[key])
                 return;
@@ -117,6 +142,67 @@ struct Loader {
             run.reference.maxSamples = int(config::readInt(file, node["max_samples"], "reference.max_samples", 1, 1 << 24));
         if (node["seed"])
             run.reference.seed = std::uint64_t(config::readInt(file, node["seed"], "reference.seed", 0, INT64_MAX));
+        if (node["quantity"]) {
+            run.reference.quantity = config::readString(file, node["quantity"], "reference.quantity");
+            config::checkName(file, node["quantity"], run.reference.quantity, {"ao", "ao_uniform", "obscurance"},
+                              "ground-truth quantity");
+        }
+        if (node["falloff"]) {
+            run.reference.falloff = config::readString(file, node["falloff"], "reference.falloff");
+            config::checkName(file, node["falloff"], run.reference.falloff, {"linear", "smoothstep"},
+                              "obscurance falloff");
+        }
+        if (node["radius"]) {
+            run.reference.radius = config::readFloat(file, node["radius"], "reference.radius");
+            if (!(run.reference.radius > 0.0) || !std::isfinite(run.reference.radius))
+                file.fail(node["radius"], "reference.radius: expected a finite number > 0 (world units)");
+        }
+    }
+
+    void readCameraPath(const YAML::Node& node, RunConfig& run) const
+    {
+        run.cameraPath = config::readString(file, node, "camera_path");
+        if (!scene::isBuiltinCameraPathName(run.cameraPath))
+            cameraPathNodes.emplace_back(run.cameraPath, node);  // checked against the scene after expansion
+    }
+
+    void readMetrics(const YAML::Node& node, RunConfig& run) const
+    {
+        if (!node.IsSequence() || node.size() == 0)
+            file.fail(node, "metrics: expected a non-empty list of metric names, found " + config::describeNode(node));
+        std::vector<std::string> valid;
+        for (const auto& [family, choice] : run.techniques)
+            for (const auto& m : registry.findFamily(family)->metrics)
+                if (std::find(valid.begin(), valid.end(), m.name) == valid.end())
+                    valid.push_back(m.name);
+        run.metrics.clear();
+        for (const auto& item : node) {
+            const std::string name = config::readString(file, item, "metric");
+            config::checkName(file, item, name, valid, "metric of the run's families");
+            if (std::find(run.metrics.begin(), run.metrics.end(), name) != run.metrics.end())
+                file.fail(item, "metrics: '" + name + "' is listed twice");
+            run.metrics.push_back(name);
+        }
+    }
+
+    // Named camera paths that are not built in must exist in the run's scene.
+    void checkCameraPaths(const std::vector<RunConfig>& runs) const
+    {
+        std::map<std::string, std::vector<std::string>> namesByScene;
+        for (const auto& run : runs) {
+            if (run.cameraPath.empty() || scene::isBuiltinCameraPathName(run.cameraPath))
+                continue;
+            auto it = namesByScene.find(run.scene);
+            if (it == namesByScene.end()) {
+                std::vector<std::string> names = scene::getBuiltinCameraPathNames();
+                if (!scene::findAnalyticShape(run.scene))
+                    names = scene::getCameraPathNames(scene::loadScene(run.scene));
+                it = namesByScene.emplace(run.scene, names).first;
+            }
+            for (const auto& [name, node] : cameraPathNodes)
+                if (name == run.cameraPath)
+                    config::checkName(file, node, name, it->second, "camera path of scene '" + run.scene + "'");
+        }
     }
 
     void readGrid(const YAML::Node& node, RunConfig& run) const
@@ -157,7 +243,9 @@ struct Loader {
 
     RunConfig readBase(const YAML::Node& node) const
     {
-        config::checkKeys(file, node, {"scene", "grid", "resolution", "frames", "timing", "reference", "techniques"},
+        config::checkKeys(file, node,
+                          {"scene", "grid", "resolution", "frames", "camera_path", "metrics", "timing", "reference",
+                           "techniques"},
                           {"scene", "techniques"}, "base");
         RunConfig run;
         readScene(node["scene"], run);
@@ -172,6 +260,10 @@ struct Loader {
         if (node["timing"])
             readTiming(node["timing"], run);
         readTechniques(node["techniques"], run);
+        if (node["camera_path"])
+            readCameraPath(node["camera_path"], run);
+        if (node["metrics"])
+            readMetrics(node["metrics"], run);
         return run;
     }
 
@@ -191,9 +283,11 @@ struct Loader {
             run.frames = int(config::readInt(file, value, "frames", 1, 100000));
             return;
         }
+        if (key == "camera_path")
+            return readCameraPath(value, run);
         const auto dot = key.find('.');
         if (dot == std::string::npos)
-            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, resolution, frames, "
+            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, resolution, frames, camera_path, "
                                "<family>.technique, <family>.<parameter>, zip");
         const std::string family = key.substr(0, dot);
         const std::string field = key.substr(dot + 1);
@@ -369,6 +463,7 @@ Experiment parseExperiment(const std::string& text, const std::string& label,
         e.description = config::readString(file, root["description"], "description");
     e.base = loader.readBase(root["base"]);
     e.runs = loader.expand(root["sweep"], e.base, e.sweepKeys);
+    loader.checkCameraPaths(e.runs);
     return e;
 }
 

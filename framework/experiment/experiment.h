@@ -11,7 +11,12 @@
 //     grid: 48                          # SDF samples per axis (isosurface)
 //     resolution: [320, 180]            # image size (screen-space families)
 //     frames: 1                         # frames of the scene's animation, from frame 0
-//     reference: {target_stderr: 0.01, target_rel_stderr: 0.02, max_samples: 1024, seed: 0}
+//     camera_path: scene                # scene (its own), static, orbit, dolly, strafe, or a
+//                                       # path the scene names (scene/camera_paths.h)
+//     metrics: [error, masks]           # what the families measure (default: all they declare)
+//     reference: {target_stderr: 0.01, target_rel_stderr: 0.02, max_samples: 1024, seed: 0,
+//                 quantity: ao, radius: 0.5}  # quantity/radius/falloff override the technique's
+//                                             # declaration (default: exactly what it declares)
 //     timing: {warmup: 1, repeats: 5}
 //     techniques:
 //       isosurface: {technique: marching_cubes, params: {vertex_placement: linear}}
@@ -47,6 +52,12 @@ struct ReferenceOptions {
     double targetRelStdErr = 0.02;  //!< relative part of the stopping rule
     int maxSamples = 1024;          //!< per pixel
     std::uint64_t seed = 0;
+    //! Ground-truth quantity override ("ao", "ao_uniform", "obscurance"); "" = the quantity the
+    //! technique declares. An override measures a technique against a quantity it does not claim
+    //! (rows then say reference.matches_technique = false).
+    std::string quantity;
+    std::string falloff;  //!< "linear", "smoothstep"; "" = the technique's
+    double radius = 0.0;  //!< world units; 0 = the technique's
 };
 
 //! One fully expanded run.
@@ -56,6 +67,8 @@ struct RunConfig {
     int width = 320;               //!< image size in pixels (screen-space families)
     int height = 180;
     int frames = 1;                //!< frames 0..frames-1 of the scene's animation
+    std::string cameraPath;        //!< "" = the scene's own (scene/camera_paths.h)
+    std::vector<std::string> metrics;  //!< metric names of the run's families; empty = all
     metrics::TimingOptions timing;
     ReferenceOptions reference;
     std::map<std::string, TechniqueChoice> techniques;  //!< family -> choice
@@ -64,6 +77,8 @@ struct RunConfig {
     std::string id() const;
     //! Canonical JSON of everything that determines the result (used for resume).
     std::string toJson() const;
+    //! True when `metric` is to be computed (metrics empty, or it is listed).
+    bool wantsMetric(const std::string& metric) const;
     //! Hash of toJson(): a run whose hash is already in the results table is not recomputed.
     std::string hash() const;
 };

@@ -1,10 +1,18 @@
-// The occlusion family in experiments. Per frame of the run's scene:
-//   gbuffer    rasterise the frame on Vulkan (timed: GPU timestamps and CPU wall time)
-//   occlusion  the technique on the G-buffer in view space (timed the same way)
-//   reference  the Embree ground truth of exactly the quantity the technique declares, from the
-//              same G-buffer (and of the bent normal and cone for the bent-cone errors)
-//   metrics    image errors over surface pixels, and inside the artifact masks
-// and one row per frame, with the images written beside it.
+// The occlusion family in experiments. Each frame of the run is a frame graph
+// (pipeline/frame_graph.h), culled before it runs:
+//   sdf_remesh         mesh the scene's SDF models (needs sdf_models; reused while no edit starts)
+//   character_pose     the characters' capsules at this frame (needs characters)
+//   assemble_geometry  the frame's triangles
+//   scene_upload       to the GPU (reused while the geometry is unchanged)
+//   gbuffer            rasterise on Vulkan (timed: GPU and CPU)
+//   view_inputs        view-space depth and normals, the technique's input
+//   occlusion          the technique (timed the same way)
+//   reference          Embree ground truth of exactly the quantity the technique declares (or the
+//                      run's override), from the same G-buffer; reference_bent: the bent cone
+//   metric.*           one pass per metric the run asks for (RunConfig::metrics); a ground truth
+//                      that no requested metric reads is not computed
+//   images             technique, reference, error and noise floor as EXR
+// and one row per frame, with each pass recorded as run or skipped and why.
 
 #include "experiment/runner.h"
 
@@ -14,9 +22,11 @@
 #include "gpu/context.h"
 #include "metrics/image_metrics.h"
 #include "metrics/timing.h"
+#include "pipeline/frame_graph.h"
 #include "plugin/occlusion.h"
 #include "reference/reference.h"
 #include "render/gbuffer_pass.h"
+#include "scene/camera_paths.h"
 #include "scene/scene_file.h"
 #include "scene/sdf_shapes.h"
 
@@ -24,7 +34,9 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/mat3x3.hpp>
 
+#include <chrono>
 #include <cmath>
+#include <optional>
 #include <filesystem>
 
 namespace rtlab::experiment {
@@ -42,6 +54,13 @@ reference::ReferenceSettings makeReferenceSettings(const plugin::OcclusionDefini
     s.falloff = d.falloff == plugin::OcclusionFalloff::Smoothstep ? reference::Falloff::Smoothstep
                                                                   : reference::Falloff::Linear;
     s.radius = d.radius;
+    // The run may measure against another quantity than the one declared (an ablation).
+    if (!run.reference.quantity.empty())
+        s.quantity = reference::parseQuantity(run.reference.quantity);
+    if (!run.reference.falloff.empty())
+        s.falloff = reference::parseFalloff(run.reference.falloff);
+    if (run.reference.radius > 0.0)
+        s.radius = run.reference.radius;
     s.targetStdErr = run.reference.targetStdErr;
     s.targetRelStdErr = run.reference.targetRelStdErr;
     s.maxSamples = run.reference.maxSamples;
@@ -80,14 +99,12 @@ double computeMaskedMean(const Image<std::uint8_t>& mask, F f)
 void addErrorColumns(ResultRow& row, const std::string& prefix, const Image<float>& test, const Image<float>& ref,
                      const Image<std::uint8_t>& mask, bool full)
 {
-    metrics::ImageErrorOptions options;
-    options.withSsim = full;
-    options.withFlip = full;
-    const auto e = metrics::computeImageErrors(test, ref, options, mask);
+    const auto e = metrics::computeImageErrors(test, ref, metrics::ImageErrorOptions{.withSsim = false, .withFlip = false},
+                                               mask);
     row.set(prefix + ".rmse", e.rmse).set(prefix + ".mean_signed_error", e.meanSignedError);
     row.set(prefix + ".pixels", std::int64_t(e.pixels));
     if (full) {
-        row.set(prefix + ".psnr", e.psnr).set(prefix + ".ssim", e.ssim).set(prefix + ".flip", e.flip);
+        row.set(prefix + ".psnr", e.psnr);
         row.set(prefix + ".rel_mse", e.relMse).set(prefix + ".non_finite_pixels", std::int64_t(e.nonFinitePixels));
     }
 }
@@ -108,10 +125,12 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
     if (scene::findAnalyticShape(run.scene))
         throw Error("scene '" + run.scene + "' is an analytic shape for isosurface studies; the occlusion family "
                     "needs a scene with geometry and a camera (e.g. ao_testbed, tomorrow_town, or a .yaml file)");
-    const scene::Scene scene = scene::loadScene(run.scene);
-    if (run.frames > scene.frameCount)
+    scene::Scene scene = scene::loadScene(run.scene);
+    if (run.frames > scene.frameCount && (run.cameraPath.empty() || run.cameraPath == "scene"))
         throw Error("the run asks for " + std::to_string(run.frames) + " frames but scene '" + scene.name + "' has " +
-                    std::to_string(scene.frameCount));
+                    std::to_string(scene.frameCount) + " (choose a camera_path such as orbit to move the camera "
+                    "over more frames)");
+    scene::selectCameraPath(scene, run.cameraPath, run.frames);
     const TechniqueChoice& choice = run.techniques.at(family);
     const plugin::TechniqueEntry* entry = context.registry().findTechnique(family, choice.technique);
     auto technique = entry->create(choice.params);
@@ -119,159 +138,250 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
     if (!occlusion)
         throw Error("technique '" + choice.technique + "' does not implement the occlusion interface");
     const plugin::OcclusionDefinition definition = occlusion->definition();
+    const reference::ReferenceSettings settings = makeReferenceSettings(definition, run);
+    const reference::ReferenceSettings declared = makeReferenceSettings(definition, RunConfig{});
+    const bool matches = settings.quantity == declared.quantity && settings.radius == declared.radius &&
+                         (settings.quantity != reference::Quantity::Obscurance || settings.falloff == declared.falloff);
 
     ResultRow base = common;
     const config::ParamSet effective = technique->effectiveParams();
     for (const auto& [name, value] : effective.values())
         base.set("param." + name, config::formatValue(value));
+    const scene::FeatureSet features = scene.computeFeatures();
     base.set("quantity", std::string(getQuantityColumnName(definition.quantity)))
         .set("radius", definition.radius)
-        .set("scene_features", scene.computeFeatures().toString());
+        .set("reference.quantity", std::string(reference::getQuantityName(settings.quantity)))
+        .set("reference.radius", settings.radius)
+        .set("reference.matches_technique", matches)
+        .set("camera_path", run.cameraPath.empty() ? std::string("scene") : run.cameraPath)
+        .set("scene_features", features.toString());
     base.set("gpu_time_source", std::string(toString(chooseGpuTimeSource(context.getGpu().getDeviceInfo()))));
+
+    // Which outputs the run keeps: one per requested metric, and the images.
+    std::vector<std::string> outputs = {"images"};
+    for (const auto& m : context.registry().findFamily(family)->metrics)
+        if (run.wantsMetric(m.name) && m.name != "screen_space_split" && m.name != "flicker")
+            outputs.push_back("metric." + m.name);
 
     gpu::Context& gpu = context.getGpu();
     render::GBufferPass gbufferPass(gpu);
     std::vector<ResultRow> rows;
+    // State carried between frames: what the graph may reuse.
+    std::vector<scene::SdfMesh> sdfMeshes;
+    std::optional<std::uint64_t> meshedEditKey;
+    int meshedFrame = -1;
     std::string uploadedHash;
+    int uploadedFrame = -1;
     for (int frame = 0; frame < run.frames; ++frame) {
         ResultRow row = base;
         row.set("frame", std::int64_t(frame));
-        const scene::RenderScene renderScene = scene.buildRenderScene(frame);
-        PassLog passes;
-        const std::string sceneHash = renderScene.computeContentHash();
-        if (sceneHash != uploadedHash) {
-            gbufferPass.setScene(renderScene);
-            uploadedHash = sceneHash;
-            passes.add("scene_upload");
-        } else {
-            passes.skip("scene_upload", "geometry unchanged since frame " + std::to_string(frame - 1) +
-                                            " (no edits or moving characters in between)");
-        }
         const scene::Camera camera = scene.getCameraAt(frame);
 
-        // Pass 1: the G-buffer.
-        gpu.takeRunLog();
-        const auto gbufferReport = metrics::measure(run.timing, [&] {
-            gbufferPass.draw(camera, run.width, run.height);
-            return collectGpuPassTimes(gpu);
-        });
-        addTimingColumns(row, "gbuffer", gbufferReport);
-        passes.add("gbuffer");
-        const scene::GBuffer g = gbufferPass.readBack();
-
-        // View-space inputs.
-        const glm::mat3 toView(g.view);
-        Image<glm::vec3> viewNormal(g.width, g.height, glm::vec3(0.0f));
-        Image<std::uint8_t> surface(g.width, g.height, 0);
-        for (std::size_t i = 0; i < viewNormal.pixels.size(); ++i)
-            if (g.materialId.pixels[i] != scene::kNoMaterial) {
-                viewNormal.pixels[i] = glm::normalize(toView * g.normal.pixels[i]);
-                surface.pixels[i] = 1;
-            }
+        scene::RenderScene renderScene;
+        std::vector<scene::PosedCapsule> capsules;
+        scene::GBuffer g;
+        Image<glm::vec3> viewNormal;
+        Image<std::uint8_t> surface;
         plugin::OcclusionInput input;
-        input.linearDepth = &g.depth;
-        input.normal = &viewNormal;
-        input.projection = g.projection;
-        input.view = g.view;
-        input.frameIndex = frame;
-        input.gpu = &gpu;
-
-        // Pass 2: the technique.
         plugin::OcclusionOutput out;
-        gpu.takeRunLog();
-        const auto report = metrics::measure(run.timing, [&] {
-            occlusion->compute(input, out);
-            return collectGpuPassTimes(gpu);
-        });
-        addTimingColumns(row, "occlusion", report);
-        passes.add("occlusion");
-        if (out.ambient.width != g.width || out.ambient.height != g.height)
-            throw Error("technique '" + choice.technique + "' returned an ambient image of " +
-                        std::to_string(out.ambient.width) + "x" + std::to_string(out.ambient.height) + " for a " +
-                        std::to_string(g.width) + "x" + std::to_string(g.height) + " G-buffer");
+        reference::ReferenceResult truth, bent;
+        auto timeCpu = [&](const std::string& pass, auto&& work) {
+            const auto start = std::chrono::steady_clock::now();
+            work();
+            row.set(pass + ".cpu_ms",
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+        };
 
-        // Pass 3: the ground truth of the declared quantity, and of the bent normal and cone.
-        const reference::ReferenceSettings settings = makeReferenceSettings(definition, run);
-        const reference::ReferenceResult truth = reference::computeReference(renderScene, g, settings);
-        if (truth.stats.fromCache)
-            passes.skip("reference", "read from the reference cache (same scene, G-buffer and settings)");
-        else
-            passes.add("reference");
-        const bool hasBent = out.bentNormal.size() == viewNormal.size();
-        const bool hasAperture = out.coneAperture.size() == viewNormal.size();
-        reference::ReferenceResult bent;
-        if (hasBent || hasAperture) {
+        pipeline::FrameGraph graph;
+        graph.addExternal("scene");
+        if (!occlusion->outputsBentCone())
+            graph.addExternal("technique_bent_cone", false,
+                              "technique '" + choice.technique + "' outputs no bent normal or cone");
+        graph.addPass({.name = "sdf_remesh", .reads = {"scene"}, .writes = {"sdf_meshes"},
+                       .needs = {scene::SceneFeature::SdfModels}},
+                      [&] {
+                          const std::uint64_t key = scene.getEditStateKey(frame);
+                          if (meshedEditKey && *meshedEditKey == key)
+                              return pipeline::PassOutcome::skipped("no edit starts after frame " +
+                                                                    std::to_string(meshedFrame) +
+                                                                    ": its SDF meshes are reused");
+                          timeCpu("sdf_remesh", [&] { sdfMeshes = scene.meshSdfModels(frame); });
+                          meshedEditKey = key;
+                          meshedFrame = frame;
+                          return pipeline::PassOutcome{};
+                      });
+        graph.addPass({.name = "character_pose", .reads = {"scene"}, .writes = {"capsules"},
+                       .needs = {scene::SceneFeature::Characters}},
+                      [&] {
+                          capsules = scene.poseCharacters(frame);
+                          return pipeline::PassOutcome{};
+                      });
+        graph.addPass({.name = "assemble_geometry", .reads = {"scene"}, .optionalReads = {"sdf_meshes", "capsules"},
+                       .writes = {"geometry"}},
+                      [&] {
+                          renderScene = scene.assembleRenderScene(sdfMeshes, capsules, frame);
+                          return pipeline::PassOutcome{};
+                      });
+        graph.addPass({.name = "scene_upload", .reads = {"geometry"}, .writes = {"gpu_scene"}}, [&] {
+            const std::string sceneHash = renderScene.computeContentHash();
+            if (sceneHash == uploadedHash)
+                return pipeline::PassOutcome::skipped("geometry unchanged since frame " + std::to_string(uploadedFrame));
+            timeCpu("scene_upload", [&] { gbufferPass.setScene(renderScene); });
+            uploadedHash = sceneHash;
+            uploadedFrame = frame;
+            return pipeline::PassOutcome{};
+        });
+        graph.addPass({.name = "gbuffer", .reads = {"gpu_scene"}, .writes = {"gbuffer"}}, [&] {
+            gpu.takeRunLog();
+            const auto report = metrics::measure(run.timing, [&] {
+                gbufferPass.draw(camera, run.width, run.height);
+                return collectGpuPassTimes(gpu);
+            });
+            addTimingColumns(row, "gbuffer", report);
+            g = gbufferPass.readBack();
+            return pipeline::PassOutcome{};
+        });
+        graph.addPass({.name = "view_inputs", .reads = {"gbuffer"}, .writes = {"view_gbuffer"}}, [&] {
+            const glm::mat3 toView(g.view);
+            viewNormal = Image<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
+            surface = Image<std::uint8_t>(g.width, g.height, 0);
+            for (std::size_t i = 0; i < viewNormal.pixels.size(); ++i)
+                if (g.materialId.pixels[i] != scene::kNoMaterial) {
+                    viewNormal.pixels[i] = glm::normalize(toView * g.normal.pixels[i]);
+                    surface.pixels[i] = 1;
+                }
+            input.linearDepth = &g.depth;
+            input.normal = &viewNormal;
+            input.projection = g.projection;
+            input.view = g.view;
+            input.frameIndex = frame;
+            input.gpu = &gpu;
+            return pipeline::PassOutcome{};
+        });
+        std::vector<std::string> techniqueWrites = {"technique_ambient"};
+        if (occlusion->outputsBentCone())
+            techniqueWrites.push_back("technique_bent_cone");
+        graph.addPass({.name = "occlusion", .reads = {"view_gbuffer"}, .writes = techniqueWrites}, [&] {
+            gpu.takeRunLog();
+            const auto report = metrics::measure(run.timing, [&] {
+                occlusion->compute(input, out);
+                return collectGpuPassTimes(gpu);
+            });
+            addTimingColumns(row, "occlusion", report);
+            for (const auto& [name, value] : technique->counters())
+                row.set("counter." + name, value);
+            if (out.ambient.width != g.width || out.ambient.height != g.height)
+                throw Error("technique '" + choice.technique + "' returned an ambient image of " +
+                            std::to_string(out.ambient.width) + "x" + std::to_string(out.ambient.height) + " for a " +
+                            std::to_string(g.width) + "x" + std::to_string(g.height) + " G-buffer");
+            return pipeline::PassOutcome{};
+        });
+        const std::string fromCache = "read from the reference cache (same scene, G-buffer and settings)";
+        graph.addPass({.name = "reference", .reads = {"geometry", "gbuffer"}, .writes = {"ground_truth"}}, [&] {
+            truth = reference::computeReference(renderScene, g, settings);
+            row.set("reference.seconds", truth.stats.seconds)
+                .set("reference.from_cache", truth.stats.fromCache)
+                .set("reference.samples_mean", truth.stats.meanSamples)
+                .set("reference.stderr_mean", computeMaskedMean(surface, [&](std::size_t i) {
+                         return double(truth.occlusionStdErr.pixels[i]);
+                     }))
+                .set("reference.stderr_max", truth.stats.maxStdErr);
+            return truth.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache) : pipeline::PassOutcome{};
+        });
+        graph.addPass({.name = "reference_bent", .reads = {"geometry", "gbuffer"}, .writes = {"ground_truth_bent"}}, [&] {
             reference::ReferenceSettings bentSettings = settings;
             bentSettings.quantity = reference::Quantity::Bent;
             if (!std::isfinite(bentSettings.radius) || bentSettings.radius <= 0.0)
                 bentSettings.radius = std::numeric_limits<double>::infinity();
             bent = reference::computeReference(renderScene, g, bentSettings);
-            if (bent.stats.fromCache)
-                passes.skip("reference_bent", "read from the reference cache (same scene, G-buffer and settings)");
-            else
-                passes.add("reference_bent");
-        } else {
-            passes.skip("reference_bent", "the technique outputs no bent normal or cone");
-        }
-        row.set("reference.seconds", truth.stats.seconds)
-            .set("reference.from_cache", truth.stats.fromCache)
-            .set("reference.samples_mean", truth.stats.meanSamples)
-            .set("reference.stderr_mean",
-                 computeMaskedMean(surface, [&](std::size_t i) { return double(truth.occlusionStdErr.pixels[i]); }))
-            .set("reference.stderr_max", truth.stats.maxStdErr);
+            return bent.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache) : pipeline::PassOutcome{};
+        });
 
-        // Metrics over surface pixels, and inside the artifact masks.
-        addErrorColumns(row, "ao", out.ambient, truth.occlusion, surface, true);
-        const auto edges = intersectMasks(metrics::makeDepthEdgeMask(g.depth, 2, 0.1), surface);
-        const auto border = intersectMasks(metrics::makeBorderMask(g.width, g.height, 8), surface);
-        const auto thin = intersectMasks(metrics::makeThinStructureMask(surface, 2), surface);
-        addErrorColumns(row, "ao_depth_edges", out.ambient, truth.occlusion, edges, false);
-        addErrorColumns(row, "ao_border", out.ambient, truth.occlusion, border, false);
-        addErrorColumns(row, "ao_thin", out.ambient, truth.occlusion, thin, false);
-
-        const glm::mat3 toWorld = glm::transpose(toView);
-        row.set("bent.angle_error_deg",
-                hasBent ? computeMaskedMean(surface,
-                                            [&](std::size_t i) {
-                                                const glm::vec3 t = out.bentNormal.pixels[i];
-                                                const glm::vec3 r = bent.bentNormal.pixels[i];
-                                                if (glm::dot(t, t) == 0.0f || glm::dot(r, r) == 0.0f)
-                                                    return std::nan("");
-                                                const float c = glm::dot(glm::normalize(toWorld * t),
-                                                                         glm::normalize(r));
-                                                return double(glm::degrees(std::acos(std::clamp(c, -1.0f, 1.0f))));
-                                            })
-                        : std::nan(""));
-        row.set("cone.aperture_error_deg",
-                hasAperture ? computeMaskedMean(surface,
+        // Metrics: one pass each, so that a run that does not ask for one does not pay for it
+        // (nor for a ground truth only it reads).
+        auto metricPass = [&](const std::string& name, std::vector<std::string> reads, auto&& compute) {
+            graph.addPass({.name = "metric." + name, .reads = std::move(reads), .writes = {"metric." + name}}, [&, compute] {
+                compute();
+                return pipeline::PassOutcome{};
+            });
+        };
+        metricPass("error", {"technique_ambient", "ground_truth", "view_gbuffer"},
+                   [&] { addErrorColumns(row, "ao", out.ambient, truth.occlusion, surface, true); });
+        metricPass("ssim", {"technique_ambient", "ground_truth", "view_gbuffer"}, [&] {
+            row.set("ao.ssim", metrics::computeImageErrors(out.ambient, truth.occlusion,
+                                                           {.withSsim = true, .withFlip = false}, surface)
+                                   .ssim);
+        });
+        metricPass("flip", {"technique_ambient", "ground_truth", "view_gbuffer"}, [&] {
+            row.set("ao.flip", metrics::computeImageErrors(out.ambient, truth.occlusion,
+                                                           {.withSsim = false, .withFlip = true}, surface)
+                                   .flip);
+        });
+        metricPass("masks", {"technique_ambient", "ground_truth", "view_gbuffer"}, [&] {
+            const auto edges = intersectMasks(metrics::makeDepthEdgeMask(g.depth, 2, 0.1), surface);
+            const auto border = intersectMasks(metrics::makeBorderMask(g.width, g.height, 8), surface);
+            const auto thin = intersectMasks(metrics::makeThinStructureMask(surface, 2), surface);
+            addErrorColumns(row, "ao_depth_edges", out.ambient, truth.occlusion, edges, false);
+            addErrorColumns(row, "ao_border", out.ambient, truth.occlusion, border, false);
+            addErrorColumns(row, "ao_thin", out.ambient, truth.occlusion, thin, false);
+        });
+        metricPass("bent_cone", {"technique_bent_cone", "ground_truth_bent", "view_gbuffer"}, [&] {
+            const glm::mat3 toWorld = glm::transpose(glm::mat3(g.view));
+            const bool hasBent = out.bentNormal.size() == viewNormal.size();
+            const bool hasAperture = out.coneAperture.size() == viewNormal.size();
+            row.set("bent.angle_error_deg",
+                    hasBent ? computeMaskedMean(surface,
                                                 [&](std::size_t i) {
-                                                    return double(glm::degrees(
-                                                        out.coneAperture.pixels[i] - bent.aperture.pixels[i]));
+                                                    const glm::vec3 t = out.bentNormal.pixels[i];
+                                                    const glm::vec3 r = bent.bentNormal.pixels[i];
+                                                    if (glm::dot(t, t) == 0.0f || glm::dot(r, r) == 0.0f)
+                                                        return std::nan("");
+                                                    const float c = glm::dot(glm::normalize(toWorld * t),
+                                                                             glm::normalize(r));
+                                                    return double(glm::degrees(std::acos(std::clamp(c, -1.0f, 1.0f))));
                                                 })
                             : std::nan(""));
-        row.set("cone.aperture_abs_error_deg",
-                hasAperture ? computeMaskedMean(surface,
-                                                [&](std::size_t i) {
-                                                    return double(glm::degrees(std::abs(
-                                                        out.coneAperture.pixels[i] - bent.aperture.pixels[i])));
-                                                })
-                            : std::nan(""));
-        row.set("cone_visibility.count", std::int64_t(out.coneVisibility.size()));
-        passes.write(row);
-
+            row.set("cone.aperture_error_deg",
+                    hasAperture ? computeMaskedMean(surface,
+                                                    [&](std::size_t i) {
+                                                        return double(glm::degrees(out.coneAperture.pixels[i] -
+                                                                                   bent.aperture.pixels[i]));
+                                                    })
+                                : std::nan(""));
+            row.set("cone.aperture_abs_error_deg",
+                    hasAperture ? computeMaskedMean(surface,
+                                                    [&](std::size_t i) {
+                                                        return double(glm::degrees(std::abs(
+                                                            out.coneAperture.pixels[i] - bent.aperture.pixels[i])));
+                                                    })
+                                : std::nan(""));
+            row.set("cone_visibility.count", std::int64_t(out.coneVisibility.size()));
+        });
         // Images: numbers in EXR (the report makes the PNGs).
-        const std::string dir = context.runDirectory() + "/frame" + std::to_string(frame);
-        std::filesystem::create_directories(dir);
-        Image<float> error(g.width, g.height, 0.0f);
-        for (std::size_t i = 0; i < error.pixels.size(); ++i)
-            error.pixels[i] = surface.pixels[i] ? out.ambient.pixels[i] - truth.occlusion.pixels[i] : 0.0f;
-        writeExr(out.ambient, dir + "/technique.exr");
-        writeExr(truth.occlusion, dir + "/reference.exr");
-        writeExr(truth.occlusionStdErr, dir + "/reference_stderr.exr");
-        writeExr(error, dir + "/error.exr");
-        row.set("image.technique", dir + "/technique.exr")
-            .set("image.reference", dir + "/reference.exr")
-            .set("image.error", dir + "/error.exr");
+        graph.addPass({.name = "images", .reads = {"technique_ambient", "ground_truth", "view_gbuffer"},
+                       .writes = {"images"}},
+                      [&] {
+                          const std::string dir = context.runDirectory() + "/frame" + std::to_string(frame);
+                          std::filesystem::create_directories(dir);
+                          Image<float> error(g.width, g.height, 0.0f);
+                          for (std::size_t i = 0; i < error.pixels.size(); ++i)
+                              error.pixels[i] =
+                                  surface.pixels[i] ? out.ambient.pixels[i] - truth.occlusion.pixels[i] : 0.0f;
+                          writeExr(out.ambient, dir + "/technique.exr");
+                          writeExr(truth.occlusion, dir + "/reference.exr");
+                          writeExr(truth.occlusionStdErr, dir + "/reference_stderr.exr");
+                          writeExr(error, dir + "/error.exr");
+                          row.set("image.technique", dir + "/technique.exr")
+                              .set("image.reference", dir + "/reference.exr")
+                              .set("image.error", dir + "/error.exr");
+                          return pipeline::PassOutcome{};
+                      });
+
+        const auto records = graph.execute(features, outputs);
+        PassLog passes;
+        for (const auto& r : records)
+            r.ran ? passes.add(r.name) : passes.skip(r.name, r.reason);
+        passes.write(row);
         rows.push_back(std::move(row));
     }
     return rows;

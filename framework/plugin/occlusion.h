@@ -68,6 +68,9 @@ public:
     //! The quantity and radius this instance estimates (depends on its parameters).
     virtual OcclusionDefinition definition() const = 0;
     virtual void compute(const OcclusionInput& input, OcclusionOutput& out) = 0;
+    //! Whether compute() fills bentNormal and coneAperture. The frame graph skips the ray-traced
+    //! bent-cone ground truth for techniques that do not (nothing would read it).
+    virtual bool outputsBentCone() const { return true; }
 };
 
 } // namespace rtlab::plugin

@@ -48,6 +48,12 @@ struct TechniqueEntry {
     std::function<std::unique_ptr<Technique>(const config::ParamSet&)> create;
 };
 
+//! A metric (group) a family's driver can compute; experiments choose them with `metrics:`.
+struct MetricInfo {
+    std::string name;  //!< snake_case, as written in experiment files
+    std::string doc;   //!< one line: what it measures and its columns
+};
+
 //! A technique family: one interface, interchangeable plugins, one ground-truth definition.
 struct FamilyInfo {
     std::string name;         //!< "occlusion", "isosurface", "voxel_gi", ...
@@ -55,6 +61,7 @@ struct FamilyInfo {
     std::string input;        //!< what every technique of the family consumes
     std::string output;       //!< what it produces
     std::string groundTruth;  //!< what it is compared with
+    std::vector<MetricInfo> metrics;  //!< what its driver can measure (all by default)
 };
 
 class Registry {

@@ -162,7 +162,43 @@ void computeMissingNormals(const MeshInstance& mesh, std::vector<glm::vec3>& nor
 
 } // namespace
 
+std::vector<SdfMesh> Scene::meshSdfModels(int frame) const
+{
+    std::vector<SdfMesh> out;
+    out.reserve(sdfModels.size());
+    for (const auto& model : sdfModels)
+        out.push_back(meshSdfModel(model, {.resolution = model.resolution, .frame = frame}));
+    return out;
+}
+
+std::vector<PosedCapsule> Scene::poseCharacters(int frame) const
+{
+    std::vector<PosedCapsule> out;
+    const float time = getFrameTime(frame);
+    for (const auto& character : characters)
+        for (const auto& capsule : character.getCapsulesAt(time))
+            out.push_back({capsule, character.material, character.name});
+    return out;
+}
+
+std::uint64_t Scene::getEditStateKey(int frame) const
+{
+    std::uint64_t key = 0;
+    for (const auto& model : sdfModels)
+        for (const auto& edit : model.edits)
+            key += edit.frame <= frame ? 1 : 0;
+    return key;
+}
+
 RenderScene Scene::buildRenderScene(int frame) const
+{
+    const std::vector<SdfMesh> sdf = meshSdfModels(frame);
+    const std::vector<PosedCapsule> capsules = poseCharacters(frame);
+    return assembleRenderScene(sdf, capsules, frame);
+}
+
+RenderScene Scene::assembleRenderScene(const std::vector<SdfMesh>& sdfMeshes, const std::vector<PosedCapsule>& capsules,
+                                       int frame) const
 {
     RenderScene out;
     out.materials = materials;
@@ -194,20 +230,19 @@ RenderScene Scene::buildRenderScene(int frame) const
             out.triangleMaterial.push_back(
                 checkMaterial(t < mesh.triangleMaterial.size() ? mesh.triangleMaterial[t] : 0, "mesh '" + mesh.name + "'"));
     }
-    for (const auto& model : sdfModels) {
-        const SdfMesh m = meshSdfModel(model, {.resolution = model.resolution, .frame = frame});
+    for (std::size_t k = 0; k < sdfMeshes.size(); ++k) {
+        const SdfMesh& m = sdfMeshes[k];
+        const std::string owner = "SDF model '" + (k < sdfModels.size() ? sdfModels[k].name : std::string("?")) + "'";
         const auto base = std::uint32_t(out.positions.size());
         out.positions.insert(out.positions.end(), m.mesh.positions.begin(), m.mesh.positions.end());
         out.normals.insert(out.normals.end(), m.mesh.normals.begin(), m.mesh.normals.end());
         for (auto i : m.mesh.indices)
             out.indices.push_back(base + i);
         for (auto mat : m.triangleMaterial)
-            out.triangleMaterial.push_back(checkMaterial(mat, "SDF model '" + model.name + "'"));
+            out.triangleMaterial.push_back(checkMaterial(mat, owner));
     }
-    const float time = getFrameTime(frame);
-    for (const auto& character : characters)
-        for (const auto& capsule : character.getCapsulesAt(time))
-            appendCapsule(out, capsule, checkMaterial(character.material, "character '" + character.name + "'"));
+    for (const auto& c : capsules)
+        appendCapsule(out, c.capsule, checkMaterial(c.material, "character '" + c.character + "'"));
 
     if (out.indices.empty())
         throw Error("scene '" + name + "' has no triangles at frame " + std::to_string(frame) +

@@ -7,10 +7,12 @@
 #include "scene/camera.h"
 #include "scene/csg.h"
 #include "scene/render_scene.h"
+#include "scene/sdf_mesher.h"
 
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -47,6 +49,13 @@ struct Character {
 
     //! The capsules in world space at `time`.
     std::vector<Capsule> getCapsulesAt(float time) const;
+};
+
+//! A character's capsule at one frame.
+struct PosedCapsule {
+    Capsule capsule;
+    std::uint32_t material = 0;
+    std::string character;  //!< name, for messages
 };
 
 //! What a scene contains; passes declare which features they need.
@@ -86,6 +95,8 @@ struct Scene {
     std::vector<Character> characters;
     Camera camera;         //!< the canonical camera
     CameraPath cameraPath; //!< may be empty (then the canonical camera is used)
+    //! More paths by name, chosen by an experiment's camera_path (scene/camera_paths.h).
+    std::map<std::string, CameraPath> namedCameraPaths;
     int frameCount = 1;    //!< frames in the scene's animation (edits, characters, camera)
     float frameRate = 30.0f;
 
@@ -96,6 +107,18 @@ struct Scene {
     //! Flattens frame `frame` into triangles: meshes, meshed SDF models (edits up to the frame),
     //! tessellated character capsules. Throws rtlab::Error when the result has no triangles.
     RenderScene buildRenderScene(int frame = 0) const;
+
+    // The parts of buildRenderScene, for frame pipelines that rebuild only what changed.
+    //! Every SDF model meshed with the edits up to `frame` (one per model, in order).
+    std::vector<SdfMesh> meshSdfModels(int frame) const;
+    //! Every character's capsules at `frame`.
+    std::vector<PosedCapsule> poseCharacters(int frame) const;
+    //! Changes exactly when the set of applied edits changes (the number of edits started by
+    //! `frame`): two frames with the same key mesh to the same SDF meshes.
+    std::uint64_t getEditStateKey(int frame) const;
+    //! Joins the static meshes with the given parts (as buildRenderScene does).
+    RenderScene assembleRenderScene(const std::vector<SdfMesh>& sdfMeshes, const std::vector<PosedCapsule>& capsules,
+                                    int frame) const;
 };
 
 } // namespace rtlab::scene

@@ -1,5 +1,7 @@
 #include "scene/scene_file.h"
 
+#include "scene/camera_paths.h"
+
 #include "config/yaml_file.h"
 #include "core/error.h"
 #include "core/strings.h"
@@ -291,6 +293,25 @@ struct Parser {
         }
     }
 
+    CameraPath readCameraPath(const YAML::Node& node, const std::string& what) const
+    {
+        if (!node.IsSequence() || node.size() == 0)
+            file.fail(node, what + ": expected a list of keyframes {time, position, target, ...}, found " +
+                                config::describeNode(node));
+        std::vector<CameraKeyframe> keys;
+        Camera previous = scene.camera;
+        for (const auto& k : node) {
+            CameraKeyframe key;
+            key.camera = readCamera(k, previous, true);
+            key.time = float(config::readFloat(file, k["time"], "time"));
+            if (!keys.empty() && key.time <= keys.back().time)
+                file.fail(k["time"], what + ": times must increase");
+            previous = key.camera;
+            keys.push_back(key);
+        }
+        return CameraPath(keys);
+    }
+
     Camera readCamera(const YAML::Node& c, Camera camera, bool keyframe) const
     {
         std::vector<std::string> keys = {"position", "target", "up", "fov", "near", "far"};
@@ -329,7 +350,7 @@ Scene parseSceneFile(const std::string& text, const std::string& label)
     const YAML::Node& root = file.root();
     config::checkKeys(file, root,
                       {"scene", "base", "materials", "meshes", "sdf_models", "point_lights", "sky", "characters",
-                       "camera", "camera_path", "frames", "frame_rate"},
+                       "camera", "camera_path", "camera_paths", "frames", "frame_rate"},
                       {"scene"}, "scene file");
     Parser p{file, std::filesystem::path(label).parent_path(), {}, {}};
     if (root["base"]) {
@@ -359,21 +380,20 @@ Scene parseSceneFile(const std::string& text, const std::string& label)
         p.readCharacters(root["characters"]);
     if (root["camera"])
         p.scene.camera = p.readCamera(root["camera"], p.scene.camera, false);
-    if (root["camera_path"]) {
-        if (!root["camera_path"].IsSequence())
-            file.fail(root["camera_path"], "camera_path: expected a list of keyframes {time, position, target, ...}");
-        std::vector<CameraKeyframe> keys;
-        Camera previous = p.scene.camera;
-        for (const auto& k : root["camera_path"]) {
-            CameraKeyframe key;
-            key.camera = p.readCamera(k, previous, true);
-            key.time = float(config::readFloat(file, k["time"], "time"));
-            if (!keys.empty() && key.time <= keys.back().time)
-                file.fail(k["time"], "camera_path: times must increase");
-            previous = key.camera;
-            keys.push_back(key);
+    if (root["camera_path"])
+        p.scene.cameraPath = p.readCameraPath(root["camera_path"], "camera_path");
+    if (root["camera_paths"]) {
+        const YAML::Node& paths = root["camera_paths"];
+        if (!paths.IsMap())
+            file.fail(paths, "camera_paths: expected a mapping from a path name to a list of keyframes, found " +
+                                 config::describeNode(paths));
+        for (const auto& kv : paths) {
+            const std::string name = kv.first.Scalar();
+            if (isBuiltinCameraPathName(name))
+                file.fail(kv.first, "camera_paths: '" + name + "' is a built-in camera path (" +
+                                        joinList(getBuiltinCameraPathNames()) + "); choose another name");
+            p.scene.namedCameraPaths[name] = p.readCameraPath(kv.second, "camera_paths." + name);
         }
-        p.scene.cameraPath = CameraPath(keys);
     }
     if (root["frames"])
         p.scene.frameCount = int(config::readInt(file, root["frames"], "frames", 1, 100000));

@@ -30,6 +30,10 @@
 //   camera_path:
 //     - {time: 0, position: [0, 1, 4], target: [0, 1, 0]}
 //     - {time: 1, position: [2, 1, 4], target: [0, 1, 0]}
+//   camera_paths:                       # more named paths; experiments pick one with camera_path
+//     low_pass:
+//       - {time: 0, position: [0, 0.3, 3], target: [0, 0.3, 0]}
+//       - {time: 1, position: [1, 0.3, 3], target: [0, 0.3, 0]}
 //   frames: 8
 //   frame_rate: 30
 

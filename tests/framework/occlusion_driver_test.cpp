@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -129,11 +130,85 @@ TEST(OcclusionDriver, RecordsSkippedPassesAndWhy)
                                             .queryVulkanForManifest = false});
     const auto rows = experiment::loadResults((dir / "out").string());
     ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
-    EXPECT_EQ(rows[0].at("passes").find("scene_upload:run;gbuffer:run;occlusion:run"), 0u) << rows[0].at("passes");
+    const std::string& first = rows[0].at("passes");
+    EXPECT_NE(first.find("character_pose:skipped(the scene has no characters)"), std::string::npos) << first;
+    EXPECT_NE(first.find("assemble_geometry:run;scene_upload:run;gbuffer:run;view_inputs:run;occlusion:run"),
+              std::string::npos)
+        << first;
     EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped(geometry unchanged since frame 0"), std::string::npos)
         << rows[1].at("passes");
     EXPECT_NE(rows[1].at("passes").find("reference:skipped(read from the reference cache"), std::string::npos)
         << rows[1].at("passes");
-    EXPECT_EQ(rows[1].at("passes_skipped"), "3");  // scene upload and both references
+    EXPECT_NE(rows[1].at("passes").find("reference_bent:skipped(read from the reference cache"), std::string::npos)
+        << rows[1].at("passes");
     EXPECT_GT(experiment::getNumber(rows[0], "memory.peak_rss_mb"), 1.0);
+}
+
+TEST(OcclusionDriver, ComputesOnlyTheMetricsTheRunAsksForAndTheGroundTruthTheyRead)
+{
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<Unoccluded>(registry, "occlusion", "unoccluded");
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_metrics";
+    std::filesystem::remove_all(dir);
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: ao_testbed
+  resolution: [24, 16]
+  metrics: [error]
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.05, max_samples: 16}
+  techniques: {occlusion: {technique: unoccluded}}
+)",
+                                               (dir / "metrics.yaml").string(), registry);
+    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true,
+                                            .queryVulkanForManifest = false});
+    const auto rows = experiment::loadResults(dir.string());
+    ASSERT_EQ(rows.size(), 1u);
+    ASSERT_EQ(rows[0].at("status"), "ok") << rows[0].at("error");
+    const std::string& passes = rows[0].at("passes");
+    EXPECT_NE(passes.find("reference_bent:skipped(no consumer"), std::string::npos) << passes;
+    EXPECT_NE(passes.find("metric.ssim:skipped(no consumer"), std::string::npos) << passes;
+    EXPECT_NE(passes.find("metric.error:run"), std::string::npos) << passes;
+    EXPECT_TRUE(std::isfinite(experiment::getNumber(rows[0], "ao.rmse")));
+    EXPECT_EQ(rows[0].count("ao.ssim"), 0u) << "a metric the run did not ask for has no column";
+    EXPECT_EQ(rows[0].count("bent.angle_error_deg"), 0u);
+}
+
+TEST(OcclusionDriver, MeasuresAgainstTheOverriddenQuantityAndSaysSo)
+{
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<Unoccluded>(registry, "occlusion", "unoccluded");
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_override";
+    std::filesystem::remove_all(dir);
+    // A fresh reference cache, so that "computed, not read from the cache" is what this run did.
+    const char* previousCache = std::getenv("RTLAB_CACHE_DIR");
+    const std::string savedCache = previousCache ? previousCache : "";
+    setenv("RTLAB_CACHE_DIR", (dir / "cache").c_str(), 1);
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: ao_testbed
+  resolution: [24, 16]
+  frames: 2
+  camera_path: orbit
+  metrics: [error]
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.05, max_samples: 16, quantity: ao_uniform, radius: 0.25}
+  techniques: {occlusion: {technique: unoccluded}}
+)",
+                                               (dir / "override.yaml").string(), registry);
+    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true,
+                                            .queryVulkanForManifest = false});
+    const auto rows = experiment::loadResults(dir.string());
+    ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
+    EXPECT_EQ(rows[0].at("reference.quantity"), "ao_uniform");
+    EXPECT_DOUBLE_EQ(experiment::getNumber(rows[0], "reference.radius"), 0.25);
+    EXPECT_EQ(rows[0].at("reference.matches_technique"), "false");
+    EXPECT_EQ(rows[0].at("camera_path"), "orbit");
+    // The orbit moves the camera, not the geometry: frame 1 reuses the upload but draws anew,
+    // and its ground truth is not a cache hit (the G-buffer changed).
+    EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped"), std::string::npos) << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("gbuffer:run"), std::string::npos) << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("reference:run"), std::string::npos) << rows[1].at("passes");
+    if (previousCache)
+        setenv("RTLAB_CACHE_DIR", savedCache.c_str(), 1);
+    else
+        unsetenv("RTLAB_CACHE_DIR");
 }

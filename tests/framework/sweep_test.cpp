@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <set>
 
 using namespace rtlab;
@@ -166,4 +168,116 @@ sweep:
     EXPECT_EQ(exact, 6);  // only the second variant sets it
     EXPECT_EQ(e.sweepKeys, (std::vector<std::string>{"scene", "isosurface.resolution", "isosurface.scale",
                                                      "isosurface.mode"}));
+}
+
+TEST(Sweep, CameraPathMetricsAndGroundTruthOverrideAreBaseKeysAndCameraPathAnAxis)
+{
+    const auto registry = test::makeTestRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: ao_testbed
+  frames: 4
+  camera_path: orbit
+  metrics: [deviation, chamfer]
+  reference: {quantity: obscurance, falloff: smoothstep, radius: 0.5}
+  techniques: {isosurface: {technique: fake_mesher}}
+sweep:
+  camera_path: [static, orbit, dolly]
+)",
+                                               "sweep.yaml", registry);
+    ASSERT_EQ(e.runs.size(), 3u);
+    EXPECT_EQ(e.base.cameraPath, "orbit");
+    EXPECT_EQ(e.runs[0].cameraPath, "static");
+    EXPECT_EQ(e.runs[2].cameraPath, "dolly");
+    EXPECT_EQ(e.base.metrics, (std::vector<std::string>{"deviation", "chamfer"}));
+    EXPECT_TRUE(e.base.wantsMetric("chamfer"));
+    EXPECT_FALSE(e.base.wantsMetric("topology"));
+    EXPECT_EQ(e.base.reference.quantity, "obscurance");
+    EXPECT_EQ(e.base.reference.falloff, "smoothstep");
+    EXPECT_DOUBLE_EQ(e.base.reference.radius, 0.5);
+    EXPECT_NE(e.runs[0].hash(), e.runs[1].hash()) << "the camera path is part of what a run is";
+    EXPECT_NE(e.runs[0].id().find("static"), std::string::npos) << e.runs[0].id();
+}
+
+TEST(Sweep, KeysAddedLaterLeaveTheHashOfRunsThatDoNotUseThemUnchanged)
+{
+    // Results written before camera_path, metrics and the ground-truth override existed must
+    // still be recognised as complete: the canonical JSON only mentions those keys when set.
+    experiment::RunConfig run;
+    run.scene = "sphere";
+    const std::string json = run.toJson();
+    EXPECT_EQ(json.find("camera_path"), std::string::npos) << json;
+    EXPECT_EQ(json.find("metrics"), std::string::npos) << json;
+    EXPECT_EQ(json.find("quantity"), std::string::npos) << json;
+}
+
+TEST(Sweep, BadCameraPathMetricOrQuantityNamesTheLineAndTheValidNames)
+{
+    const std::string unknownPath = errorOf(R"(base:
+  scene: ao_testbed
+  camera_path: orbitt
+  techniques: {isosurface: {technique: fake_mesher}}
+)");
+    EXPECT_NE(unknownPath.find("sweep.yaml:3:16"), std::string::npos) << unknownPath;
+    EXPECT_NE(unknownPath.find("orbit"), std::string::npos) << unknownPath;
+    const std::string unknownMetric = errorOf(R"(base:
+  scene: sphere
+  metrics: [chamfer, rmse]
+  techniques: {isosurface: {technique: fake_mesher}}
+)");
+    EXPECT_NE(unknownMetric.find("sweep.yaml:3:22"), std::string::npos) << unknownMetric;
+    EXPECT_NE(unknownMetric.find("deviation"), std::string::npos) << "lists the valid metrics: " << unknownMetric;
+    const std::string twice = errorOf(R"(base:
+  scene: sphere
+  metrics: [chamfer, chamfer]
+  techniques: {isosurface: {technique: fake_mesher}}
+)");
+    EXPECT_NE(twice.find("listed twice"), std::string::npos) << twice;
+    const std::string quantity = errorOf(R"(base:
+  scene: sphere
+  reference: {quantity: irradiance}
+  techniques: {isosurface: {technique: fake_mesher}}
+)");
+    EXPECT_NE(quantity.find("sweep.yaml:3:25"), std::string::npos) << quantity;
+    EXPECT_NE(quantity.find("ao_uniform"), std::string::npos) << quantity;
+    const std::string radius = errorOf(R"(base:
+  scene: sphere
+  reference: {radius: -1}
+  techniques: {isosurface: {technique: fake_mesher}}
+)");
+    EXPECT_NE(radius.find("reference.radius"), std::string::npos) << radius;
+}
+
+TEST(Sweep, ANamedCameraPathMustBeOneOfTheScenes)
+{
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_sweep_camera_paths";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "room.yaml") << R"(scene: room
+base: ao_testbed
+frames: 3
+camera_paths:
+  low_pass:
+    - {time: 0, position: [0, 0.3, 3], target: [0, 0.3, 0]}
+    - {time: 1, position: [1, 0.3, 3], target: [0, 0.3, 0]}
+)";
+    const auto registry = test::makeTestRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: room.yaml
+  camera_path: low_pass
+  techniques: {isosurface: {technique: fake_mesher}}
+)",
+                                               (dir / "ok.yaml").string(), registry);
+    EXPECT_EQ(e.runs.at(0).cameraPath, "low_pass");
+    try {
+        experiment::parseExperiment(R"(base:
+  scene: room.yaml
+  camera_path: high_pass
+  techniques: {isosurface: {technique: fake_mesher}}
+)",
+                                    (dir / "bad.yaml").string(), registry);
+        ADD_FAILURE() << "an unknown named path was accepted";
+    } catch (const InputError& error) {
+        const std::string message = error.what();
+        EXPECT_NE(message.find("bad.yaml:3:16"), std::string::npos) << message;
+        EXPECT_NE(message.find("low_pass"), std::string::npos) << message;
+    }
 }

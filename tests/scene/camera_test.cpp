@@ -2,8 +2,16 @@
 
 #include "scene/camera.h"
 
+#include "core/error.h"
+#include "scene/camera_paths.h"
+#include "scene/procedural.h"
+#include "scene/scene_file.h"
+
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
 
 using namespace rtlab::scene;
 
@@ -77,3 +85,101 @@ TEST(CameraPath, UnsortedKeysAndStillCamera)
     EXPECT_FLOAT_EQ(path.keyframes().front().time, 0.0f);
     EXPECT_FALSE(path.moves());
 }
+
+// ---- camera paths chosen by name ----
+
+namespace rtlab::scene {
+namespace {
+
+TEST(CameraPaths, GeneratedPathsStartAtTheCanonicalCameraAndMoveAsDocumented)
+{
+    Scene base = makeProceduralScene("ao_testbed");
+    const Camera c = base.camera;
+    const float distance = glm::length(c.position - c.target);
+    const int frames = 9;
+    {
+        Scene s = base;
+        selectCameraPath(s, "orbit", frames);
+        EXPECT_EQ(s.frameCount, std::max(base.frameCount, frames));
+        const Camera first = s.getCameraAt(0), last = s.getCameraAt(frames - 1);
+        EXPECT_LT(glm::length(first.position - c.position), 1e-4f * distance);
+        // 45 degrees about the up axis through the target, at the same distance.
+        EXPECT_NEAR(glm::length(last.position - c.target), distance, 1e-3f * distance);
+        // The angle of the turn, seen from above (the offsets projected on the plane normal to up).
+        const glm::vec3 up = glm::normalize(c.up);
+        auto flat = [&](glm::vec3 v) { return glm::normalize(v - glm::dot(v, up) * up); };
+        const glm::vec3 a = flat(c.position - c.target), b = flat(last.position - c.target);
+        EXPECT_NEAR(glm::degrees(std::acos(std::clamp(glm::dot(a, b), -1.0f, 1.0f))), 45.0f, 0.05f);
+    }
+    {
+        Scene s = base;
+        selectCameraPath(s, "dolly", frames);
+        EXPECT_NEAR(glm::length(s.getCameraAt(frames - 1).position - c.target), 0.7f * distance, 1e-3f * distance);
+    }
+    {
+        Scene s = base;
+        selectCameraPath(s, "strafe", frames);
+        const Camera first = s.getCameraAt(0), last = s.getCameraAt(frames - 1);
+        EXPECT_NEAR(glm::length(last.position - first.position), 0.2f * distance, 1e-3f * distance);
+        EXPECT_NEAR(glm::length((last.target - first.target) - (last.position - first.position)), 0.0f,
+                    1e-4f * distance)
+            << "camera and target move together";
+    }
+    {
+        Scene s = base;
+        selectCameraPath(s, "static", frames);
+        EXPECT_TRUE(s.cameraPath.empty());
+        EXPECT_EQ(s.getCameraAt(frames - 1).position, c.position);
+    }
+}
+
+TEST(CameraPaths, TheScenesOwnPathIsTheDefaultAndUnknownNamesAreErrorsListingTheValidOnes)
+{
+    Scene town = makeProceduralScene("tomorrow_town");
+    const Camera before = town.getCameraAt(3);
+    selectCameraPath(town, "", 2);
+    EXPECT_EQ(town.getCameraAt(3).position, before.position);
+    selectCameraPath(town, "scene", 2);
+    EXPECT_EQ(town.getCameraAt(3).position, before.position);
+    try {
+        selectCameraPath(town, "orbiit", 2);
+        ADD_FAILURE() << "unknown path accepted";
+    } catch (const Error& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("did you mean orbit"), std::string::npos) << message;
+        EXPECT_NE(message.find("strafe"), std::string::npos) << message;
+    }
+}
+
+TEST(CameraPaths, SceneFilesDeclareNamedPathsButNotUnderBuiltInNames)
+{
+    const Scene s = parseSceneFile(R"(scene: room
+base: ao_testbed
+camera_paths:
+  low_pass:
+    - {time: 0, position: [0, 0.3, 3], target: [0, 0.3, 0]}
+    - {time: 1, position: [1, 0.3, 3], target: [0, 0.3, 0]}
+)",
+                                   "room.yaml");
+    ASSERT_EQ(s.namedCameraPaths.count("low_pass"), 1u);
+    Scene chosen = s;
+    selectCameraPath(chosen, "low_pass", 31);
+    EXPECT_NEAR(chosen.getCameraAt(30).position.x, 1.0f, 1e-5f);
+    try {
+        parseSceneFile(R"(scene: room
+base: ao_testbed
+camera_paths:
+  orbit:
+    - {time: 0, position: [0, 0.3, 3], target: [0, 0.3, 0]}
+)",
+                       "room.yaml");
+        ADD_FAILURE() << "a path named like a built-in was accepted";
+    } catch (const InputError& e) {
+        const std::string message = e.what();
+        EXPECT_NE(message.find("room.yaml:4:3"), std::string::npos) << message;
+        EXPECT_NE(message.find("built-in"), std::string::npos) << message;
+    }
+}
+
+} // namespace
+} // namespace rtlab::scene
