@@ -24,7 +24,9 @@
 #include "metrics/timing.h"
 #include "pipeline/frame_graph.h"
 #include "plugin/occlusion.h"
+#include "metrics/temporal_metrics.h"
 #include "reference/reference.h"
+#include "reference/screen_space_reference.h"
 #include "render/gbuffer_pass.h"
 #include "scene/camera_paths.h"
 #include "scene/scene_file.h"
@@ -34,6 +36,7 @@
 #include <glm/gtc/constants.hpp>
 #include <glm/mat3x3.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -160,7 +163,7 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
     // Which outputs the run keeps: one per requested metric, and the images.
     std::vector<std::string> outputs = {"images"};
     for (const auto& m : context.registry().findFamily(family)->metrics)
-        if (run.wantsMetric(m.name) && m.name != "screen_space_split" && m.name != "flicker")
+        if (run.wantsMetric(m.name))
             outputs.push_back("metric." + m.name);
 
     gpu::Context& gpu = context.getGpu();
@@ -172,6 +175,12 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
     int meshedFrame = -1;
     std::string uploadedHash;
     int uploadedFrame = -1;
+    // The previous frame's images, for the flicker metric.
+    struct PreviousFrame {
+        Image<float> technique, reference, referenceStdErr, depth;
+        glm::mat4 projection{1.0f}, view{1.0f};
+    };
+    std::optional<PreviousFrame> previous;
     for (int frame = 0; frame < run.frames; ++frame) {
         ResultRow row = base;
         row.set("frame", std::int64_t(frame));
@@ -185,6 +194,7 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
         plugin::OcclusionInput input;
         plugin::OcclusionOutput out;
         reference::ReferenceResult truth, bent;
+        reference::ScreenSpaceResult screenTruth;
         auto timeCpu = [&](const std::string& pass, auto&& work) {
             const auto start = std::chrono::steady_clock::now();
             work();
@@ -194,6 +204,8 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
 
         pipeline::FrameGraph graph;
         graph.addExternal("scene");
+        graph.addExternal("previous_frame", previous.has_value(),
+                          frame == 0 ? "first frame of the run" : "the previous frame has no ground truth");
         if (!occlusion->outputsBentCone())
             graph.addExternal("technique_bent_cone", false,
                               "technique '" + choice.technique + "' outputs no bent normal or cone");
@@ -297,6 +309,16 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
             return bent.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache) : pipeline::PassOutcome{};
         });
 
+        graph.addPass({.name = "screen_space_reference", .reads = {"view_gbuffer"}, .writes = {"ground_truth_screen"}},
+                      [&] {
+                          // The same quantity, seed and stopping rule, traced against the depth
+                          // buffer as a height field (reference/screen_space_reference.h).
+                          reference::ScreenSpaceView view{&g.depth, &viewNormal, g.projection, g.view};
+                          timeCpu("screen_space_reference",
+                                  [&] { screenTruth = reference::computeScreenSpaceReference(view, settings); });
+                          return pipeline::PassOutcome{};
+                      });
+
         // Metrics: one pass each, so that a run that does not ask for one does not pay for it
         // (nor for a ground truth only it reads).
         auto metricPass = [&](const std::string& name, std::vector<std::string> reads, auto&& compute) {
@@ -357,6 +379,38 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
                                 : std::nan(""));
             row.set("cone_visibility.count", std::int64_t(out.coneVisibility.size()));
         });
+        metricPass("screen_space_split", {"technique_ambient", "ground_truth", "ground_truth_screen", "view_gbuffer"},
+                   [&] {
+                       // technique vs rays on the depth buffer: the estimator's own error;
+                       // rays on the depth buffer vs the full scene: what screen space cannot see.
+                       addErrorColumns(row, "ao_vs_screen_truth", out.ambient, screenTruth.reference.occlusion,
+                                       surface, false);
+                       addErrorColumns(row, "screen_truth", screenTruth.reference.occlusion, truth.occlusion, surface,
+                                       false);
+                       row.set("screen_truth.off_screen_share", screenTruth.meanOffScreenShare)
+                           .set("screen_truth.samples_mean", screenTruth.reference.stats.meanSamples);
+                   });
+        metricPass("flicker", {"technique_ambient", "ground_truth", "view_gbuffer", "previous_frame"}, [&] {
+            const metrics::TemporalFrame before{.technique = &previous->technique,
+                                                .reference = &previous->reference,
+                                                .linearDepth = &previous->depth,
+                                                .projection = previous->projection,
+                                                .view = previous->view,
+                                                .referenceStdErr = &previous->referenceStdErr};
+            const metrics::TemporalFrame now{.technique = &out.ambient,
+                                             .reference = &truth.occlusion,
+                                             .linearDepth = &g.depth,
+                                             .projection = g.projection,
+                                             .view = g.view,
+                                             .referenceStdErr = &truth.occlusionStdErr,
+                                             .mask = &surface};
+            const metrics::TemporalChange change = metrics::computeTemporalChange(before, now);
+            row.set("flicker.rms", change.flickerRms)
+                .set("flicker.technique_change_rms", change.techniqueChangeRms)
+                .set("flicker.reference_change_rms", change.referenceChangeRms)
+                .set("flicker.reference_noise_floor_rms", change.referenceNoiseFloorRms)
+                .set("flicker.used_share", change.usedShare);
+        });
         // Images: numbers in EXR (the report makes the PNGs).
         graph.addPass({.name = "images", .reads = {"technique_ambient", "ground_truth", "view_gbuffer"},
                        .writes = {"images"}},
@@ -378,6 +432,14 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
                       });
 
         const auto records = graph.execute(features, outputs);
+        const auto ran = [&](const std::string& name) {
+            return std::any_of(records.begin(), records.end(), [&](const auto& r) { return r.name == name && r.ran; });
+        };
+        const bool haveTruth = truth.occlusion.size() == g.depth.size() && !g.depth.pixels.empty();
+        if (ran("occlusion") && haveTruth)
+            previous = PreviousFrame{out.ambient, truth.occlusion, truth.occlusionStdErr, g.depth, g.projection, g.view};
+        else
+            previous.reset();
         PassLog passes;
         for (const auto& r : records)
             r.ran ? passes.add(r.name) : passes.skip(r.name, r.reason);

@@ -188,7 +188,7 @@ TEST(OcclusionDriver, MeasuresAgainstTheOverriddenQuantityAndSaysSo)
   resolution: [24, 16]
   frames: 2
   camera_path: orbit
-  metrics: [error]
+  metrics: [error, flicker, screen_space_split]
   timing: {warmup: 0, repeats: 1}
   reference: {target_stderr: 0.05, max_samples: 16, quantity: ao_uniform, radius: 0.25}
   techniques: {occlusion: {technique: unoccluded}}
@@ -207,6 +207,17 @@ TEST(OcclusionDriver, MeasuresAgainstTheOverriddenQuantityAndSaysSo)
     EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped"), std::string::npos) << rows[1].at("passes");
     EXPECT_NE(rows[1].at("passes").find("gbuffer:run"), std::string::npos) << rows[1].at("passes");
     EXPECT_NE(rows[1].at("passes").find("reference:run"), std::string::npos) << rows[1].at("passes");
+    // Flicker needs a previous frame; the screen-space split runs on every frame.
+    EXPECT_NE(rows[0].at("passes").find(
+                  "metric.flicker:skipped(input 'previous_frame' is not available: first frame of the run)"),
+              std::string::npos)
+        << rows[0].at("passes");
+    EXPECT_TRUE(std::isfinite(experiment::getNumber(rows[1], "flicker.rms")));
+    EXPECT_GT(experiment::getNumber(rows[1], "flicker.used_share"), 0.5) << "a 45-degree orbit about the target keeps most pixels in view";
+    for (const auto& row : rows) {
+        EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "screen_truth.rmse")));
+        EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "ao_vs_screen_truth.rmse")));
+    }
     if (previousCache)
         setenv("RTLAB_CACHE_DIR", savedCache.c_str(), 1);
     else
