@@ -26,23 +26,90 @@ bool isUnitRotation(const glm::dquat& q)
     return std::abs(n - 1.0) <= 1e-9;
 }
 
-// Interval arithmetic on rho (k0 - 1), rho = k0 / k1 (see the header).
-Interval boundEllipsoid(const scene::CsgEdit& edit, const glm::dvec3& c, const glm::dvec3& half,
-                        double margin)
+// The box in the primitive's frame: the local axis-aligned box around the rotated world box, as
+// per-axis ranges of |q_i| (minAbs, maxAbs). Conservative for rotated primitives.
+struct LocalRange {
+    glm::dvec3 minAbs, maxAbs;
+};
+
+LocalRange getLocalRange(const scene::CsgEdit& edit, const glm::dvec3& c, const glm::dvec3& half)
 {
-    const glm::dvec3 s = edit.size;
-    if (!(s.x > 0.0 && s.y > 0.0 && s.z > 0.0) || !std::isfinite(s.x + s.y + s.z))
-        return makeUnbounded();
     const glm::dmat3 toLocal = glm::mat3_cast(glm::inverse(edit.rotation));
     const glm::dvec3 lc = toLocal * (c - edit.center);
     const glm::dvec3 le = glm::abs(toLocal[0]) * half.x + glm::abs(toLocal[1]) * half.y +
                           glm::abs(toLocal[2]) * half.z;
-    glm::dvec3 minAbs, maxAbs;
+    LocalRange r;
     for (int i = 0; i < 3; ++i) {
         const double lo = lc[i] - le[i], hi = lc[i] + le[i];
-        minAbs[i] = (lo <= 0.0 && hi >= 0.0) ? 0.0 : std::min(std::abs(lo), std::abs(hi));
-        maxAbs[i] = std::max(std::abs(lo), std::abs(hi));
+        r.minAbs[i] = (lo <= 0.0 && hi >= 0.0) ? 0.0 : std::min(std::abs(lo), std::abs(hi));
+        r.maxAbs[i] = std::max(std::abs(lo), std::abs(hi));
     }
+    return r;
+}
+
+double boxDistance(const glm::dvec3& q, const glm::dvec3& halfExtents)
+{
+    const glm::dvec3 d = q - halfExtents;
+    return glm::length(glm::max(d, 0.0)) + std::min(std::max(d.x, std::max(d.y, d.z)), 0.0);
+}
+
+double cylinderDistance(double radial, double y, double radius, double halfHeight)
+{
+    const glm::dvec2 d(radial - radius, y - halfHeight);
+    return std::min(std::max(d.x, d.y), 0.0) + glm::length(glm::max(d, 0.0));
+}
+
+double capsuleDistance(double radial, double y, double radius, double halfLength)
+{
+    return std::sqrt(radial * radial + std::max(y - halfLength, 0.0) * std::max(y - halfLength, 0.0)) - radius;
+}
+
+// Interval arithmetic in the primitive's frame for the shapes whose value is non-decreasing in
+// each |q_i| (box, rounded box), in the radial distance and |y| (cylinder, capsule), or in |y|
+// and |radial - major| (torus): the range over the box is spanned by the extreme |q_i|. Returns
+// false for the cone (Lipschitz only).
+bool boundInLocalFrame(const scene::CsgEdit& edit, const LocalRange& r, Interval& out)
+{
+    const glm::dvec3 s = edit.size;
+    const double radialLo = glm::length(glm::dvec2(r.minAbs.x, r.minAbs.z));
+    const double radialHi = glm::length(glm::dvec2(r.maxAbs.x, r.maxAbs.z));
+    switch (edit.shape) {
+    case scene::CsgShape::Box:
+        out = {boxDistance(r.minAbs, s), boxDistance(r.maxAbs, s)};
+        return true;
+    case scene::CsgShape::RoundedBox:
+        out = {boxDistance(r.minAbs, s - glm::dvec3(edit.rounding)) - edit.rounding,
+               boxDistance(r.maxAbs, s - glm::dvec3(edit.rounding)) - edit.rounding};
+        return true;
+    case scene::CsgShape::Cylinder:
+        out = {cylinderDistance(radialLo, r.minAbs.y, s.x, s.y), cylinderDistance(radialHi, r.maxAbs.y, s.x, s.y)};
+        return true;
+    case scene::CsgShape::Capsule:
+        out = {capsuleDistance(radialLo, r.minAbs.y, s.x, s.y), capsuleDistance(radialHi, r.maxAbs.y, s.x, s.y)};
+        return true;
+    case scene::CsgShape::Torus: {
+        const double ringLo = (radialLo <= s.x && radialHi >= s.x)
+                                  ? 0.0
+                                  : std::min(std::abs(radialLo - s.x), std::abs(radialHi - s.x));
+        const double ringHi = std::max(std::abs(radialLo - s.x), std::abs(radialHi - s.x));
+        out = {std::sqrt(ringLo * ringLo + r.minAbs.y * r.minAbs.y) - s.y,
+               std::sqrt(ringHi * ringHi + r.maxAbs.y * r.maxAbs.y) - s.y};
+        return true;
+    }
+    case scene::CsgShape::Sphere:
+        out = {glm::length(r.minAbs) - s.x, glm::length(r.maxAbs) - s.x};
+        return true;
+    default: return false;
+    }
+}
+
+// Interval arithmetic on rho (k0 - 1), rho = k0 / k1 (see the header).
+Interval boundEllipsoid(const scene::CsgEdit& edit, const LocalRange& range, double margin)
+{
+    const glm::dvec3 s = edit.size;
+    if (!(s.x > 0.0 && s.y > 0.0 && s.z > 0.0))
+        return makeUnbounded();
+    const glm::dvec3 minAbs = range.minAbs, maxAbs = range.maxAbs;
     const double k0Lo = glm::length(minAbs / s), k0Hi = glm::length(maxAbs / s);
     const double k1Lo = glm::length(minAbs / (s * s)), k1Hi = glm::length(maxAbs / (s * s));
     const double sMin = std::min({s.x, s.y, s.z}), sMax = std::max({s.x, s.y, s.z});
@@ -76,14 +143,25 @@ Interval boundPrimitive(const scene::CsgEdit& edit, const glm::dvec3& boxLo, con
         return makeUnbounded();
     const glm::dvec3 c = 0.5 * (boxLo + boxHi);
     const glm::dvec3 half = 0.5 * (boxHi - boxLo);
+    const LocalRange range = getLocalRange(edit, c, half);
     if (edit.shape == scene::CsgShape::Ellipsoid)
-        return boundEllipsoid(edit, c, half, margin);
-    // Exact distances are 1-Lipschitz: |s(p) - s(c)| <= |p - c| <= |half|.
+        return boundEllipsoid(edit, range, margin);
+    // Exact distances are 1-Lipschitz: |s(p) - s(c)| <= |p - c| <= |half|. In the L2 norm a cell
+    // is bounded by the ball of its half-diagonal; [Evans 2015] uses max-norm distances so that a
+    // cell is exactly a ball. The interval in the primitive's frame recovers most of that gap
+    // where the primitive is aligned with the grid, and the two are intersected.
     const double radius = glm::length(half);
     const double v = edit.evaluatePrimitive(c);
     if (!std::isfinite(v) || !std::isfinite(radius))
         return makeUnbounded();
-    return {v - radius - margin, v + radius + margin};
+    Interval r{v - radius, v + radius};
+    Interval local;
+    if (boundInLocalFrame(edit, range, local) && local.lo <= local.hi) {
+        // Rounding of the local evaluation is relative to the coordinates, which `margin` covers.
+        r.lo = std::max(r.lo, local.lo);
+        r.hi = std::min(r.hi, local.hi);
+    }
+    return {r.lo - margin, r.hi + margin};
 }
 
 } // namespace rtlab::sdf

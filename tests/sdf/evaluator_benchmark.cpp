@@ -5,7 +5,8 @@
 //   build/tests/sdf/sdf_evaluator_benchmark [--benchmark_filter=<regex>] [threads]
 // Counters: samples_per_s (grid samples per wall-clock second), culling_rate (1 - primitive
 // evaluations / brute force's, bound evaluations included), evals (primitive evaluations per run),
-// in_band (samples with |d| <= band), edges (Hermite edges, where computed).
+// in_band (samples with |d| <= band), edges (Hermite edges, where computed), emptyN / fullN (cells
+// of level N, 0 = coarsest, proven outside / inside the band).
 
 #include "sdf/evaluator.h"
 
@@ -44,6 +45,11 @@ void runEvaluator(benchmark::State& state, const scene::SdfModel& model, int res
     state.counters["samples"] = double(stats.samples);
     if (hermite)
         state.counters["edges"] = double(stats.hermiteEdges);
+    // Cells proven outside (empty) or inside (full) the band, per level (0 = coarsest).
+    for (std::size_t l = 0; l < stats.cellsEmpty.size(); ++l) {
+        state.counters["empty" + std::to_string(l)] = double(stats.cellsEmpty[l]);
+        state.counters["full" + std::to_string(l)] = double(stats.cellsFull[l]);
+    }
 }
 
 } // namespace
