@@ -25,8 +25,10 @@
 //
 // Culling (per cell, a forward pass over the parent's pruned list with interval bounds):
 //   - Each primitive's value over the cell is bounded by sdf/primitive_bounds.h: the 1-Lipschitz
-//     bound s(centre) +- half-diagonal for exact distances, interval arithmetic for the ellipsoid
-//     (whose value is only a distance bound, so Lipschitz culling would not be safe).
+//     bound s(centre) +- half-diagonal for exact distances, intersected with interval arithmetic
+//     in the primitive's frame (box, rounded box, cylinder, capsule, torus, sphere), and interval
+//     arithmetic alone for the ellipsoid (whose value is only a distance bound, not 1-Lipschitz,
+//     so Lipschitz culling would not be safe; primitive_bounds.h gives the derivation).
 //     The talk evaluates max-norm distances so that a cell is a max-norm ball; with the exact L2
 //     distances of scene/csg.h the cell is bounded by the ball of its half-diagonal instead.
 //   - With D the interval of the field before an edit and S the primitive's, an edit is dropped

@@ -3,7 +3,11 @@
 // evaluator (sdf/evaluator.h) culls with.
 //
 // Every shape except the ellipsoid evaluates an exact Euclidean distance, which is 1-Lipschitz:
-// over a box of centre c and half-diagonal r the value lies in [s(c) - r, s(c) + r]. The ellipsoid
+// over a box of centre c and half-diagonal r the value lies in [s(c) - r, s(c) + r]. For the box,
+// rounded box, cylinder, capsule, torus and sphere this is intersected with interval arithmetic in
+// the primitive's frame: their value is non-decreasing in each |q_i| (or in the radial distance
+// and |y|; for the torus in |radial - major| and |y|), so the ends of the box's local extent
+// bound it. The cone has the Lipschitz bound only. The ellipsoid
 // evaluates the first-order bound k0 (k0 - 1) / k1 [Quilez 2008] (k0 = |q / size|,
 // k1 = |q / size^2|, q in the ellipsoid's frame), which is not 1-Lipschitz; it is bounded by
 // interval arithmetic instead: writing it as rho (k0 - 1) with rho = k0 / k1, rho always lies in
