@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rtlab::scene {
@@ -59,6 +60,11 @@ struct SdfModel {
     glm::dvec3 boundsMin{-1.0};  //!< region the model lives in, world units
     glm::dvec3 boundsMax{1.0};
     int resolution = 96;         //!< samples along the longest side when meshed for rendering
+    //! The model's sharp feature curves as straight segments (world units; curved features as
+    //! fine polylines), for the edge metrics of isosurface studies. Meaningful when featuresKnown:
+    //! then it is the complete list (empty for a smooth model).
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> featureEdges;
+    bool featuresKnown = false;
 
     //! Field after every edit whose frame <= `frame` (negative inside). An empty list is +inf.
     double evaluate(const glm::dvec3& p, int frame = 1 << 30) const;

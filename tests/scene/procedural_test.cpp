@@ -6,6 +6,8 @@
 #include "scene/sdf_mesher.h"
 
 #include <glm/geometric.hpp>
+#include <algorithm>
+#include <cmath>
 #include <gtest/gtest.h>
 
 using namespace rtlab::scene;
@@ -108,4 +110,29 @@ TEST(ProceduralScenes, CsgGalleryShapesAreClosedMeshes)
     }
     EXPECT_EQ(names, (std::vector<std::string>{"cube", "rotated_cube", "cylinder", "box_minus_sphere", "thin_wall",
                                                "soft_spheres", "torus", "chamfered_cube"}));
+}
+
+TEST(ProceduralScenes, CsgGalleryFeatureCurvesLieOnTheSurfaceAtCreases)
+{
+    // Every declared feature segment lies on the zero set. Circles are polylines of 512 chords,
+    // which sag by r (1 - cos(pi / 512)) <= 1.13e-5 for the largest circle (r < 0.6), hence the
+    // tolerance of 1.2e-5 at chord midpoints; endpoints are exact up to rounding.
+    const Scene s = makeProceduralScene("csg_gallery");
+    int withFeatures = 0;
+    for (const auto& m : s.sdfModels) {
+        ASSERT_TRUE(m.featuresKnown) << m.name;
+        if (m.featureEdges.empty())
+            continue;
+        ++withFeatures;
+        for (const auto& [a, b] : m.featureEdges) {
+            EXPECT_LT(std::abs(m.evaluate(a)), 1e-9) << m.name;
+            EXPECT_LT(std::abs(m.evaluate(b)), 1e-9) << m.name;
+            const glm::dvec3 mid = 0.5 * (a + b);
+            EXPECT_LT(std::abs(m.evaluate(mid)), 1.2e-5) << m.name;
+        }
+    }
+    EXPECT_EQ(withFeatures, 6) << "cube, rotated_cube, cylinder, box_minus_sphere, thin_wall, chamfered_cube";
+    const auto& chamfered = *std::find_if(s.sdfModels.begin(), s.sdfModels.end(),
+                                          [](const SdfModel& m) { return m.name == "chamfered_cube"; });
+    EXPECT_EQ(chamfered.featureEdges.size(), 48u);
 }
