@@ -110,6 +110,18 @@ struct Loader {
                                     " and in the working folder)");
             return;
         }
+        // An SDF model of a procedural scene, for the isosurface family: "csg_gallery/torus".
+        if (const auto slash = run.scene.find('/'); slash != std::string::npos) {
+            const std::string parent = run.scene.substr(0, slash);
+            config::checkName(file, node, parent, scene::getProceduralSceneNames(), "procedural scene");
+            std::vector<std::string> models;
+            for (const auto& m : scene::makeProceduralScene(parent).sdfModels)
+                models.push_back(m.name);
+            if (models.empty())
+                file.fail(node, "scene '" + parent + "' has no SDF models to name after '/'");
+            config::checkName(file, node, run.scene.substr(slash + 1), models, "SDF model of '" + parent + "'");
+            return;
+        }
         std::vector<std::string> names = scene::analyticShapeNames();
         for (const auto& n : scene::getProceduralSceneNames())
             names.push_back(n);

@@ -12,6 +12,9 @@
 #include <filesystem>
 #include <map>
 #include <set>
+#include <sstream>
+#include <cstdio>
+#include <cstring>
 
 namespace rtlab::report::detail {
 
@@ -85,6 +88,131 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
     figures.plots.push_back(scatterPath);
     figures.captions.push_back("Run time against error on " + group.title +
                                ". Each technique's Pareto front is the staircase; faded points are dominated.");
+
+    // 1b. The same for each further error column the study has.
+    for (const auto& [column, label] : columns.extraErrors) {
+        plot::ScatterSpec extra = scatter;
+        extra.title = group.title + ": time against " + label.substr(0, label.find(" ("));
+        extra.yLabel = label;
+        bool any = false;
+        std::size_t k = 0;
+        for (const auto& [technique, runs] : byTechnique) {
+            plot::Series& s = extra.series[k++];
+            for (std::size_t i = 0; i < runs.size(); ++i) {
+                s.y[i] = runs[i]->get(column);
+                any = any || std::isfinite(s.y[i]);
+            }
+        }
+        if (!any)
+            continue;
+        const std::string path = plots + "/time_vs_" + makeFileName(column) + "_" + stem;
+        plot::writeScatter(extra, path);
+        figures.plots.push_back(path);
+        figures.captions.push_back("Run time against " + label + " on " + group.title + ", Pareto front per technique.");
+    }
+
+    // 1c. Convergence (grid sweeps): error against cell size on log-log axes, and the order p of
+    //     error ~ h^p fitted by least squares on the logarithms of the per-cell-size means.
+    if (std::find(group.varyingParams.begin(), group.varyingParams.end(), "grid") != group.varyingParams.end()) {
+        plot::LineSpec line;
+        line.title = group.title + ": convergence under grid refinement";
+        line.xLabel = "cell size h (world units)";
+        line.yLabel = columns.errorLabel;
+        line.xScale = plot::AxisScale::Log;
+        line.yScale = plot::AxisScale::Log;
+        line.colors = colors;
+        std::string orders;
+        for (const auto& [technique, runs] : byTechnique) {
+            std::map<double, std::pair<double, int>> byCell;
+            for (const RunSummary* run : runs) {
+                const double h = run->get("cell_size"), e = run->get(columns.error);
+                if (h > 0.0 && e > 0.0 && std::isfinite(e)) {
+                    byCell[h].first += e;
+                    byCell[h].second += 1;
+                }
+            }
+            if (byCell.size() < 2)
+                continue;
+            plot::Series s;
+            double sx = 0, sy = 0, sxx = 0, sxy = 0;
+            for (const auto& [h, sum] : byCell) {
+                const double e = sum.first / sum.second;
+                s.x.push_back(h);
+                s.y.push_back(e);
+                const double lx = std::log(h), ly = std::log(e);
+                sx += lx;
+                sy += ly;
+                sxx += lx * lx;
+                sxy += lx * ly;
+            }
+            const double n = double(byCell.size());
+            const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+            char text[64];
+            std::snprintf(text, sizeof text, " (order %.2f)", order);
+            s.label = technique + text;
+            orders += (orders.empty() ? "" : ", ") + technique + " " + std::string(text + 8, text + std::strlen(text) - 1);
+            plot::Color c = line.colors.getColor(technique);
+            line.colors.setColor(s.label, c);
+            line.series.push_back(std::move(s));
+        }
+        if (!line.series.empty()) {
+            const std::string path = plots + "/convergence_" + stem;
+            plot::writeLineChart(line, path);
+            figures.plots.push_back(path);
+            figures.captions.push_back("Convergence on " + group.title + ": mean " + columns.error +
+                                       " against cell size, log-log; fitted order p of error ~ h^p: " + orders + ".");
+        }
+    }
+
+    // 1d. Triangle-angle histograms (meshes): share of the interior angles per 10-degree bin, summed
+    //     over the technique's runs at the finest grid of the group.
+    if (group.family == "isosurface") {
+        plot::LineSpec line;
+        line.title = group.title + ": triangle angles";
+        line.xLabel = "interior angle (degrees, bin centre)";
+        line.yLabel = "share of angles";
+        line.xScale = plot::AxisScale::Linear;
+        line.yScale = plot::AxisScale::Linear;
+        line.colors = colors;
+        double finest = 0;
+        for (const auto& run : group.runs)
+            finest = std::max(finest, run.get("grid"));
+        for (const auto& [technique, runs] : byTechnique) {
+            std::vector<double> counts;
+            for (const RunSummary* run : runs) {
+                auto it = run->text.find("angle.histogram_10deg");
+                if (it == run->text.end() || run->get("grid") != finest)
+                    continue;
+                std::istringstream in(it->second);
+                double c;
+                for (std::size_t i = 0; in >> c; ++i) {
+                    if (counts.size() <= i)
+                        counts.resize(i + 1, 0.0);
+                    counts[i] += c;
+                }
+            }
+            double total = 0;
+            for (double c : counts)
+                total += c;
+            if (total <= 0)
+                continue;
+            plot::Series s{technique};
+            const double width = 180.0 / double(counts.size());
+            for (std::size_t i = 0; i < counts.size(); ++i) {
+                s.x.push_back((double(i) + 0.5) * width);
+                s.y.push_back(counts[i] / total);
+            }
+            line.series.push_back(std::move(s));
+        }
+        if (!line.series.empty()) {
+            const std::string path = plots + "/angles_" + stem;
+            plot::writeLineChart(line, path);
+            figures.plots.push_back(path);
+            figures.captions.push_back("Triangle interior angles on " + group.title + " at the finest grid (" +
+                                       std::to_string(int(finest)) + " samples per axis): share per 10-degree bin. "
+                                       "Slivers pile up near 0 and 180.");
+        }
+    }
 
     // 2. Error against each swept numeric parameter: the mean error over the runs with that value.
     for (const auto& param : group.varyingParams) {

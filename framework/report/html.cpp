@@ -89,12 +89,28 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
         });
         h << "<h3>Runs, most accurate first</h3>\n<div class=\"scroll\"><table><tr><th>run</th><th>technique</th>"
              "<th>parameters</th><th>"
-          << escapeHtml(columns.cost) << "</th><th>" << escapeHtml(columns.error) << "</th><th>frames</th></tr>\n";
-        for (const RunSummary* r : runs)
+          << escapeHtml(columns.cost) << "</th><th>" << escapeHtml(columns.error) << "</th>";
+        // Further columns, those the study has.
+        std::vector<std::string> extra;
+        for (const auto& c : columns.tableColumns)
+            if (std::any_of(runs.begin(), runs.end(),
+                            [&](const RunSummary* r) { return r->number.count(c) || r->text.count(c); }))
+                extra.push_back(c);
+        for (const auto& c : extra)
+            h << "<th>" << escapeHtml(c) << "</th>";
+        h << "<th>frames</th></tr>\n";
+        for (const RunSummary* r : runs) {
             h << "<tr><td>" << escapeHtml(r->runId) << "</td><td>" << escapeHtml(r->technique) << "</td><td>"
               << escapeHtml(describeRun(*r, g.varyingParams)) << "</td><td>" << formatNumber(r->get(columns.cost))
-              << "</td><td>" << formatNumber(r->get(columns.error)) << "</td><td>" << r->frames.size()
-              << "</td></tr>\n";
+              << "</td><td>" << formatNumber(r->get(columns.error)) << "</td>";
+            for (const auto& c : extra) {
+                auto text = r->text.find(c);
+                h << "<td>" << (r->number.count(c) ? formatNumber(r->get(c))
+                                                   : escapeHtml(text == r->text.end() ? "" : text->second))
+                  << "</td>";
+            }
+            h << "<td>" << r->frames.size() << "</td></tr>\n";
+        }
         h << "</table></div>\n";
     }
     h << "<h2>Manifest</h2>\n<pre>" << escapeHtml(manifestJson.substr(0, 20000)) << "</pre>\n</body></html>\n";

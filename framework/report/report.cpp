@@ -14,11 +14,28 @@ namespace rtlab::report {
 FamilyColumns getFamilyColumns(const std::string& family)
 {
     if (family == "occlusion")
-        return {"occlusion.gpu_ms", "GPU time of the technique (ms, median)", "ao.rmse",
-                "RMSE against ground truth (AO / obscurance, unitless)", {"gbuffer.gpu_ms", "occlusion.gpu_ms"}};
+        return {"occlusion.gpu_ms",
+                "GPU time of the technique (ms, median)",
+                "ao.rmse",
+                "RMSE against ground truth (AO / obscurance, unitless)",
+                {"gbuffer.gpu_ms", "occlusion.gpu_ms"},
+                {{"bent.angle_error_deg", "bent-normal angle error (degrees, mean)"},
+                 {"ao_vs_screen_truth.rmse", "RMSE against the screen-space ground truth (unitless)"},
+                 {"flicker.rms", "flicker: RMS frame-to-frame change of the error (unitless)"}},
+                {"ao.mean_signed_error", "ao.ssim", "ao.flip", "ao_depth_edges.rmse", "ao_thin.rmse", "ao_border.rmse",
+                 "bent.angle_error_deg", "cone.aperture_abs_error_deg", "screen_truth.rmse",
+                 "ao_vs_screen_truth.rmse", "flicker.rms"}};
     if (family == "isosurface")
-        return {"extract.cpu_ms", "CPU time of the extraction (ms, median)", "rms_deviation",
-                "RMS distance to the true surface (world units)", {"sample_field.cpu_ms", "extract.cpu_ms"}};
+        return {"extract.cpu_ms",
+                "CPU time of the extraction (ms, median)",
+                "chamfer.mean",
+                "Chamfer distance to the true surface (mean, world units)",
+                {"evaluate_field.cpu_ms", "extract.cpu_ms"},
+                {{"hausdorff", "Hausdorff distance to the true surface (world units)"},
+                 {"edge.chamfer", "edge-Chamfer distance to the sharp features (world units)"}},
+                {"grid", "hausdorff", "rms_deviation", "edge.chamfer", "edge.f1", "watertight", "boundary_edges",
+                 "non_manifold_edges", "self_intersections", "angle.min_deg", "angle.sliver_fraction",
+                 "counter.vertices_left_cell_share", "extract.mcells_per_s", "evaluator.culling_rate"}};
     throw Error("no report columns for family '" + family + "'");
 }
 

@@ -4,6 +4,10 @@
 //
 //   <dir>/plots/time_vs_error_<scene>.png|pdf   run time against error, Pareto front per technique
 //   <dir>/plots/error_vs_<param>_<scene>.png|pdf error against each swept numeric parameter
+//   <dir>/plots/time_vs_<error>_<scene>.png|pdf  the same for each further error column
+//   <dir>/plots/convergence_<scene>.png|pdf     error against cell size with the fitted order
+//                                               (isosurface studies sweeping the grid)
+//   <dir>/plots/angles_<scene>.png|pdf          triangle-angle histogram per technique (isosurface)
 //   <dir>/plots/pass_times_<scene>.png|pdf      stacked per-pass time of the front runs
 //   <dir>/plots/images_<scene>.png|pdf          reference | each technique's best run | error maps,
 //                                               with zoomed crops (screen-space families)
@@ -11,6 +15,7 @@
 //   <dir>/report.html                           one page: plots, image grids, tables, manifest
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace rtlab::report {
@@ -22,6 +27,10 @@ struct FamilyColumns {
     std::string error;      //!< e.g. "ao.rmse"
     std::string errorLabel;
     std::vector<std::string> passes;  //!< per-pass time columns, stacked in this order
+    //! More error columns, each with its own time-against-error plot when the study has it.
+    std::vector<std::pair<std::string, std::string>> extraErrors;  //!< (column, axis label)
+    //! Further columns of the report's run tables (topology counts, masked errors, ...).
+    std::vector<std::string> tableColumns;
 };
 
 //! The columns of a family ("occlusion", "isosurface", ...); throws rtlab::Error for a family
