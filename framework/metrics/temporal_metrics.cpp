@@ -76,8 +76,8 @@ void checkImage(const Image<T>* image, int w, int h, const char* frame, const ch
         image->pixels.size() != std::size_t(w) * std::size_t(h))
         throw Error(std::string("temporal metrics: the ") + frame + " frame's " + name +
                     " image is " + std::to_string(image->width) + "x" +
-                    std::to_string(image->height) + " but its depth is " + std::to_string(w) +
-                    "x" + std::to_string(h));
+                    std::to_string(image->height) + " but its depth is " + std::to_string(w) + "x" +
+                    std::to_string(h));
 }
 
 void checkFrame(const TemporalFrame& f, const char* which)
@@ -171,9 +171,8 @@ ChangeSums accumulate(const TemporalFrame& previous, const TemporalFrame& curren
             }
             const std::size_t j = std::size_t(py) * std::size_t(pw) + std::size_t(px);
             const float previousDepth = previous.linearDepth->pixels[j];
-            if (!hasSurface(previousDepth) ||
-                std::abs(double(previousDepth) - expectedDepth) >
-                    options.depthTolerance * expectedDepth) {
+            if (!hasSurface(previousDepth) || std::abs(double(previousDepth) - expectedDepth) >
+                                                  options.depthTolerance * expectedDepth) {
                 ++sums.disoccluded;
                 continue;
             }

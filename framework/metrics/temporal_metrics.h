@@ -56,9 +56,9 @@ struct TemporalChange {
     double techniqueChangeRms = 0.0; //!< NaN when no pixel is used
     double referenceChangeRms = 0.0;
     double flickerRms = 0.0;
-    double techniqueChangeMean = 0.0; //!< signed mean of T_t - T'
+    double techniqueChangeMean = 0.0;    //!< signed mean of T_t - T'
     double referenceNoiseFloorRms = 0.0; //!< NaN unless both frames carry referenceStdErr
-    std::int64_t candidatePixels = 0; //!< pixels of frame t with a surface (inside the mask)
+    std::int64_t candidatePixels = 0;    //!< pixels of frame t with a surface (inside the mask)
     std::int64_t usedPixels = 0;
     std::int64_t offScreenPixels = 0;
     std::int64_t disoccludedPixels = 0;

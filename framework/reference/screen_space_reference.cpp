@@ -146,9 +146,8 @@ private:
     }
 
     //! The first occluded point over pixel (ix, iy) between sigma = a and b, as sigma.
-    std::optional<double> intersectPixel(int ix, int iy, double a, double b,
-                                         const glm::dvec2& p0, const glm::dvec2& pd, double w0,
-                                         double wd) const;
+    std::optional<double> intersectPixel(int ix, int iy, double a, double b, const glm::dvec2& p0,
+                                         const glm::dvec2& pd, double w0, double wd) const;
 
     int mWidth;
     int mHeight;
@@ -173,7 +172,9 @@ HeightField::HeightField(const ScreenSpaceView& view, const ScreenSpaceOptions& 
         w[i] = std::isfinite(d) && d > 0.0 ? 1.0 / d : 0.0;
         mMaxInverseDepth = std::max(mMaxInverseDepth, w[i]);
     }
-    auto at = [&](int x, int y) { return w[std::size_t(y) * std::size_t(mWidth) + std::size_t(x)]; };
+    auto at = [&](int x, int y) {
+        return w[std::size_t(y) * std::size_t(mWidth) + std::size_t(x)];
+    };
     const glm::ivec2 size(mWidth, mHeight);
     mFacets.resize(count);
     for (int y = 0; y < mHeight; ++y) {
@@ -189,8 +190,8 @@ HeightField::HeightField(const ScreenSpaceView& view, const ScreenSpaceOptions& 
             const glm::dvec3 n(view.normal->pixels[i]);
             const glm::dvec3 p = getPoint(x, y, 1.0 / f.w);
             const double k = glm::dot(n, p);
-            const bool hasNormal = std::isfinite(k) && std::abs(k) > 1e-9 * glm::length(p) &&
-                                   glm::dot(n, n) > 0.0;
+            const bool hasNormal =
+                std::isfinite(k) && std::abs(k) > 1e-9 * glm::length(p) && glm::dot(n, n) > 0.0;
             for (int axis = 0; axis < 2; ++axis) {
                 // One-sided differences of w toward the neighbours with a surface. On a plane
                 // both equal the plane's slope exactly (w is affine in screen space); across a
@@ -209,7 +210,8 @@ HeightField::HeightField(const ScreenSpaceView& view, const ScreenSpaceOptions& 
                 }
                 double slope = 0.0;
                 if (hasNormal) {
-                    const double normalSlope = 2.0 * n[axis] / (double(size[axis]) * mScale[axis] * k);
+                    const double normalSlope =
+                        2.0 * n[axis] / (double(size[axis]) * mScale[axis] * k);
                     // The difference closest to the normal's plane, unless even that one jumps
                     // by more than a tenth of the pixel's own w (a silhouette): then the plane.
                     slope = normalSlope;
@@ -415,8 +417,7 @@ double computeApertureUniform(double a)
 
 //! The bent channels (V w, V, V_u) to the outputs of reference.h, standard errors by the delta
 //! method on the mean vector.
-void storeBent(ReferenceResult& r, std::size_t i, const PixelEstimate& e,
-               const glm::dvec3& normal)
+void storeBent(ReferenceResult& r, std::size_t i, const PixelEstimate& e, const glm::dvec3& normal)
 {
     const glm::dvec3 m(e.mean[0], e.mean[1], e.mean[2]);
     const double length = glm::length(m);
@@ -548,8 +549,8 @@ ScreenSpaceResult computeScreenSpaceReference(const ScreenSpaceView& view,
                     value[1] = visible * w.y;
                     value[2] = visible * w.z;
                     value[3] = visible;
-                    const glm::dvec3 wu = frame.toWorld(
-                        sampleUniformHemisphere(sequence.get2D(index, kPairUniform)));
+                    const glm::dvec3 wu =
+                        frame.toWorld(sampleUniformHemisphere(sequence.get2D(index, kPairUniform)));
                     value[4] = trace(wu).occluded ? 0.0 : 1.0;
                     return 2;
                 }

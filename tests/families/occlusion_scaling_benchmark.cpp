@@ -58,9 +58,9 @@ std::optional<std::pair<float, glm::vec3>> hitScene(const glm::vec3& d)
         if (t > 0.0f && (!best || t < best->first))
             best = std::pair{t, den > 0.0f ? -n : n};
     };
-    plane({0, -1, 0}, {0, 1, 0});  // floor
-    plane({0, 0, -8}, {0, 0, 1});  // back wall
-    plane({-3, 0, 0}, {1, 0, 0});  // side wall
+    plane({0, -1, 0}, {0, 1, 0}); // floor
+    plane({0, 0, -8}, {0, 0, 1}); // back wall
+    plane({-3, 0, 0}, {1, 0, 0}); // side wall
     const glm::vec3 centre(0.8f, -0.4f, -4.0f);
     const float radius = 0.6f;
     const float b = glm::dot(d, centre);
@@ -134,7 +134,8 @@ Fit fitExponents(const std::vector<Run>& runs)
     for (const Run& r : runs) {
         if (!(r.timeMs > 0.0) || !std::isfinite(r.timeMs))
             continue;
-        x.push_back({1.0, std::log(double(r.width) * r.height), std::log(double(std::max<std::int64_t>(1, r.knobValue)))});
+        x.push_back({1.0, std::log(double(r.width) * r.height),
+                     std::log(double(std::max<std::int64_t>(1, r.knobValue)))});
         y.push_back(std::log(r.timeMs));
     }
     bool knobVaries = false;
@@ -228,7 +229,8 @@ std::optional<Options> parseOptions(int argc, char** argv)
 }
 
 //! The technique's direction / sample knob and the three values to time.
-std::pair<std::string, std::vector<std::int64_t>> chooseKnob(const config::ParamSchema& schema, bool quick)
+std::pair<std::string, std::vector<std::int64_t>> chooseKnob(const config::ParamSchema& schema,
+                                                             bool quick)
 {
     for (const char* name : {"slices", "directions", "samples"}) {
         const config::ParamSpec* spec = schema.find(name);
@@ -237,7 +239,8 @@ std::pair<std::string, std::vector<std::int64_t>> chooseKnob(const config::Param
         const std::int64_t d = std::get<std::int64_t>(spec->defaultValue);
         std::vector<std::int64_t> values;
         for (std::int64_t v : {d / 2, d, d * 2})
-            values.push_back(std::clamp<std::int64_t>(v, std::int64_t(spec->min), std::int64_t(spec->max)));
+            values.push_back(
+                std::clamp<std::int64_t>(v, std::int64_t(spec->min), std::int64_t(spec->max)));
         if (quick)
             values.pop_back();
         values.erase(std::unique(values.begin(), values.end()), values.end());
@@ -261,8 +264,9 @@ int main(int argc, char** argv)
     std::unique_ptr<gpu::Context> gpu;
     if (!options.cpu)
         gpu = std::make_unique<gpu::Context>();
-    const char* source = options.cpu ? "CPU wall time of the C++ path"
-                                     : experiment::toString(experiment::chooseGpuTimeSource(gpu->getDeviceInfo()));
+    const char* source =
+        options.cpu ? "CPU wall time of the C++ path"
+                    : experiment::toString(experiment::chooseGpuTimeSource(gpu->getDeviceInfo()));
     std::printf("device: %s\ntime: %s, median of %d (warm-up %d, first use excluded)\n",
                 options.cpu ? "CPU (plain C++ path)" : gpu->getDeviceInfo().name.c_str(), source,
                 options.repeats, options.warmup);
@@ -324,9 +328,10 @@ int main(int argc, char** argv)
                     run.timeMs = report.cpuMs.median;
                     run.iqrMs = report.cpuMs.iqr();
                 }
-                std::printf("%-14s %-11s %5lld %5dx%-5d %12.3f %10.3f %12.3f\n", run.technique.c_str(),
-                            knob.empty() ? "-" : knob.c_str(), (long long)value, run.width, run.height,
-                            run.timeMs, run.iqrMs, run.firstUseMs);
+                std::printf("%-14s %-11s %5lld %5dx%-5d %12.3f %10.3f %12.3f\n",
+                            run.technique.c_str(), knob.empty() ? "-" : knob.c_str(),
+                            (long long)value, run.width, run.height, run.timeMs, run.iqrMs,
+                            run.firstUseMs);
                 std::fflush(stdout);
                 techniqueRuns.push_back(run);
             }
@@ -336,14 +341,16 @@ int main(int argc, char** argv)
     }
 
     std::printf("\nleast squares log(time) = a + b log(pixels) + c log(knob):\n");
-    std::printf("%-14s %-11s %12s %14s %8s\n", "technique", "knob", "b (pixels)", "c (knob)", "R^2");
+    std::printf("%-14s %-11s %12s %14s %8s\n", "technique", "knob", "b (pixels)", "c (knob)",
+                "R^2");
     for (const auto& [name, fit] : fits) {
         std::string knob;
         for (const Run& r : runs)
             if (r.technique == name)
                 knob = r.knob;
-        std::printf("%-14s %-11s %12.3f %14.3f %8.4f\n", name.c_str(), knob.empty() ? "-" : knob.c_str(),
-                    fit.pixelExponent, fit.knobExponent, fit.rSquared);
+        std::printf("%-14s %-11s %12.3f %14.3f %8.4f\n", name.c_str(),
+                    knob.empty() ? "-" : knob.c_str(), fit.pixelExponent, fit.knobExponent,
+                    fit.rSquared);
     }
 
     if (!options.csv.empty()) {
@@ -352,17 +359,19 @@ int main(int argc, char** argv)
             std::fprintf(stderr, "cannot write %s\n", options.csv.c_str());
             return 1;
         }
-        csv << "technique,knob,knob_value,width,height,pixels,time_ms,iqr_ms,cpu_median_ms,first_use_ms,"
+        csv << "technique,knob,knob_value,width,height,pixels,time_ms,iqr_ms,cpu_median_ms,first_"
+               "use_ms,"
                "time_source,exponent_pixels,exponent_knob,r_squared\n";
         for (const Run& r : runs) {
             Fit fit;
             for (const auto& [name, f] : fits)
                 if (name == r.technique)
                     fit = f;
-            csv << r.technique << ',' << r.knob << ',' << r.knobValue << ',' << r.width << ',' << r.height << ','
-                << std::int64_t(r.width) * r.height << ',' << r.timeMs << ',' << r.iqrMs << ',' << r.cpuMedianMs
-                << ',' << r.firstUseMs << ",\"" << source << "\"," << fit.pixelExponent << ','
-                << fit.knobExponent << ',' << fit.rSquared << '\n';
+            csv << r.technique << ',' << r.knob << ',' << r.knobValue << ',' << r.width << ','
+                << r.height << ',' << std::int64_t(r.width) * r.height << ',' << r.timeMs << ','
+                << r.iqrMs << ',' << r.cpuMedianMs << ',' << r.firstUseMs << ",\"" << source
+                << "\"," << fit.pixelExponent << ',' << fit.knobExponent << ',' << fit.rSquared
+                << '\n';
         }
         std::printf("\nwrote %s\n", options.csv.c_str());
     }

@@ -9,9 +9,9 @@
 #include "scene/camera.h"
 
 #include <glm/geometric.hpp>
-#include <glm/trigonometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+#include <glm/trigonometric.hpp>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -148,9 +148,8 @@ TEST(TemporalMetrics, AlternatingNoiseFlickersByTwiceItsAmplitude)
         s = (rng() & 1u) ? 1.0f : -1.0f;
     std::vector<FrameImages> frames;
     for (int t = 0; t < 5; ++t)
-        frames.push_back(render(camera, 40, 30, hitFloorAndWall, pattern, [&](int x, int y) {
-            return (t % 2 ? -e : e) * sign.at(x, y);
-        }));
+        frames.push_back(render(camera, 40, 30, hitFloorAndWall, pattern,
+                                [&](int x, int y) { return (t % 2 ? -e : e) * sign.at(x, y); }));
     std::vector<metrics::TemporalFrame> path;
     for (const auto& f : frames)
         path.push_back(f.getFrame());
@@ -173,7 +172,8 @@ TEST(TemporalMetrics, AlternatingNoiseFlickersByTwiceItsAmplitude)
                                 64, 40, hitFloorAndWall, pattern,
                                 [&](int, int) { return t % 2 ? -e : e; }));
     for (int t = 1; t < 3; ++t) {
-        const auto c = metrics::computeTemporalChange(moving[t - 1].getFrame(), moving[t].getFrame());
+        const auto c =
+            metrics::computeTemporalChange(moving[t - 1].getFrame(), moving[t].getFrame());
         EXPECT_NEAR(c.flickerRms, 2.0 * e, 1e-6);
         EXPECT_GT(c.referenceChangeRms, 1e-3) << "nearest fetch of a varying pattern";
         EXPECT_GT(c.usedShare, 0.8);
@@ -196,7 +196,8 @@ TEST(TemporalMetrics, CorrectlyReprojectedTranslationIsZero)
     };
     const auto a = render(makeCamera({0, 0, 0}, {0, 0, -1}), w, h, plane, pattern, noError);
     const glm::vec3 shift(-3.0f * pixel, 0, 0); // the image content moves right by 3 pixels
-    const auto b = render(makeCamera(shift, shift + glm::vec3(0, 0, -1)), w, h, plane, pattern, noError);
+    const auto b =
+        render(makeCamera(shift, shift + glm::vec3(0, 0, -1)), w, h, plane, pattern, noError);
     const auto c = metrics::computeTemporalChange(a.getFrame(), b.getFrame());
     EXPECT_EQ(c.candidatePixels, w * h);
     EXPECT_EQ(c.offScreenPixels, 3 * h);
@@ -208,7 +209,8 @@ TEST(TemporalMetrics, CorrectlyReprojectedTranslationIsZero)
 
     // A constant image under a general move (translation and turn) over the floor and wall.
     auto constant = [](const glm::vec3&, int) { return 0.7f; };
-    const auto p = render(makeCamera({0, 1.5f, 2}, {0, 0.5f, -3}), 64, 40, hitFloorAndWall, constant, noError);
+    const auto p =
+        render(makeCamera({0, 1.5f, 2}, {0, 0.5f, -3}), 64, 40, hitFloorAndWall, constant, noError);
     const auto q = render(makeCamera({0.4f, 1.6f, 1.5f}, {0.3f, 0.4f, -3}), 64, 40, hitFloorAndWall,
                           constant, noError);
     const auto general = metrics::computeTemporalChange(p.getFrame(), q.getFrame());

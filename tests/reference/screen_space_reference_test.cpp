@@ -81,7 +81,8 @@ ViewImages makeAnalyticView(int w, int h, float fovDegrees,
     const float sy = v.projection[1][1];
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            const glm::vec2 ndc(2.0f * (x + 0.5f) / float(w) - 1.0f, 2.0f * (y + 0.5f) / float(h) - 1.0f);
+            const glm::vec2 ndc(2.0f * (x + 0.5f) / float(w) - 1.0f,
+                                2.0f * (y + 0.5f) / float(h) - 1.0f);
             const glm::vec3 dir = glm::normalize(glm::vec3(ndc.x / sx, ndc.y / sy, -1.0f));
             const auto [t, n] = hit(dir);
             if (t > 0.0f && std::isfinite(t)) {
@@ -136,7 +137,8 @@ struct Corner {
                                gbuffer.normal.pixels[i].y > 0.99f;
             const double c = getDistanceToWall(i);
             const bool chosen = floor && c >= 0.1 && c <= 0.9 &&
-                                std::abs(gbuffer.position.pixels[i].z) <= 0.5f && (kept++ % stride) == 0;
+                                std::abs(gbuffer.position.pixels[i].z) <= 0.5f &&
+                                (kept++ % stride) == 0;
             if (!chosen)
                 v.normal.pixels[i] = glm::vec3(0.0f);
         }
@@ -211,11 +213,13 @@ TEST(ScreenSpaceReference, OpenPlanesAreUnoccluded)
     // A plane facing the camera, and a floor seen from above (no horizon in the image): w = 1/z
     // is affine in screen space on a plane, so the reconstruction is exact and no ray may be
     // occluded, whatever the radius.
-    const ViewImages facing = makeAnalyticView(
-        40, 30, 50.0f, [](const glm::vec3& d) { return hitPlane(d, {0, 0, -3}, {0, 0, 1}); });
+    const ViewImages facing = makeAnalyticView(40, 30, 50.0f, [](const glm::vec3& d) {
+        return hitPlane(d, {0, 0, -3}, {0, 0, 1});
+    });
     const glm::vec3 floorNormal = glm::normalize(glm::vec3(0.0f, 1.0f, 0.6f));
-    const ViewImages floor = makeAnalyticView(
-        40, 30, 50.0f, [&](const glm::vec3& d) { return hitPlane(d, {0, 0, -4}, floorNormal); });
+    const ViewImages floor = makeAnalyticView(40, 30, 50.0f, [&](const glm::vec3& d) {
+        return hitPlane(d, {0, 0, -4}, floorNormal);
+    });
     for (const ViewImages* v : {&facing, &floor})
         for (Quantity q : {Quantity::Ao, Quantity::AoUniform, Quantity::Obscurance, Quantity::Bent})
             for (double radius : {0.5, 3.0, kInf}) {
@@ -224,7 +228,8 @@ TEST(ScreenSpaceReference, OpenPlanesAreUnoccluded)
                 const auto r =
                     computeScreenSpaceReference(v->getView(), makeFixedSettings(q, radius, 128));
                 const std::string what = std::string(getQuantityName(q)) + " radius " +
-                                         std::to_string(radius) + (v == &facing ? " facing" : " floor");
+                                         std::to_string(radius) +
+                                         (v == &facing ? " facing" : " floor");
                 expectValid(r, v->getView(), what);
                 EXPECT_EQ(r.reference.stats.surfacePixels, 40 * 30) << what;
                 for (std::size_t i = 0; i < r.reference.occlusion.pixels.size(); ++i)
@@ -258,7 +263,8 @@ TEST(ScreenSpaceReference, CornerMatchesTheClosedForms)
     const std::vector<Check> checks = {
         {Quantity::Ao, Falloff::Linear, "ao",
          [](double c) { return 1.0 - (std::acos(c) - c * std::sqrt(1.0 - c * c)) / kPiD; }},
-        {Quantity::AoUniform, Falloff::Linear, "ao_uniform", [](double c) { return 0.5 * (1.0 + c); }},
+        {Quantity::AoUniform, Falloff::Linear, "ao_uniform",
+         [](double c) { return 0.5 * (1.0 + c); }},
         {Quantity::Obscurance, Falloff::Smoothstep, "obscurance smoothstep",
          [](double c) { return integrateObscuranceWall(Falloff::Smoothstep, c); }},
         {Quantity::Obscurance, Falloff::Linear, "obscurance linear",
@@ -312,7 +318,8 @@ TEST(ScreenSpaceReference, CornerBentConeMatchesEmbreeWithTheSameSamples)
         if (embree.sampleCount.pixels[i] == 0 || screen.offScreenShare.pixels[i] > 0.0f)
             continue;
         ASSERT_EQ(screen.reference.sampleCount.pixels[i], 256u);
-        const double ao = std::abs(screen.reference.occlusion.pixels[i] - embree.occlusion.pixels[i]);
+        const double ao =
+            std::abs(screen.reference.occlusion.pixels[i] - embree.occlusion.pixels[i]);
         const double angle = std::acos(std::min(
             1.0f, glm::dot(screen.reference.bentNormal.pixels[i], embree.bentNormal.pixels[i])));
         worstAo = std::max(worstAo, ao);
@@ -339,7 +346,8 @@ TEST(ScreenSpaceReference, MonotoneInRadiusAndOneAtRadiusZero)
             if (q == Quantity::Obscurance && !std::isfinite(radius))
                 continue;
             const auto r = computeScreenSpaceReference(view, makeFixedSettings(q, radius));
-            const std::string what = std::string(getQuantityName(q)) + " radius " + std::to_string(radius);
+            const std::string what =
+                std::string(getQuantityName(q)) + " radius " + std::to_string(radius);
             expectValid(r, view, what);
             for (std::size_t i = 0; i < previous.size(); ++i) {
                 const float a = r.reference.occlusion.pixels[i];
@@ -407,14 +415,16 @@ TEST(ScreenSpaceReference, FiniteAndInRangeOnHardInputs)
     cases.emplace_back("all_sky", makeAnalyticView(16, 12, 60.0f, [](const glm::vec3&) {
                            return std::pair{-1.0f, glm::vec3(0.0f)};
                        }));
-    cases.emplace_back("grazing", makeAnalyticView(40, 30, 60.0f, [](const glm::vec3& d) {
-                           return hitPlane(d, {0, -0.05f, 0}, glm::normalize(glm::vec3(0, 1, 0.02f)));
-                       }));
-    cases.emplace_back("extreme_depths", makeAnalyticView(32, 24, 60.0f, [](const glm::vec3& d) {
-                           if (d.x < 0.0f)
-                               return hitPlane(d, {0, 0, -1e-3f}, {0, 0, 1});
-                           return hitPlane(d, {0, -1e4f, -1e5f}, glm::normalize(glm::vec3(0, 1, 1)));
-                       }));
+    cases.emplace_back(
+        "grazing", makeAnalyticView(40, 30, 60.0f, [](const glm::vec3& d) {
+            return hitPlane(d, {0, -0.05f, 0}, glm::normalize(glm::vec3(0, 1, 0.02f)));
+        }));
+    cases.emplace_back(
+        "extreme_depths", makeAnalyticView(32, 24, 60.0f, [](const glm::vec3& d) {
+            if (d.x < 0.0f)
+                return hitPlane(d, {0, 0, -1e-3f}, {0, 0, 1});
+            return hitPlane(d, {0, -1e4f, -1e5f}, glm::normalize(glm::vec3(0, 1, 1)));
+        }));
     {
         ViewImages v = Corner(32, 24).images;
         for (std::size_t i = 0; i < v.normal.pixels.size(); i += 3)
@@ -441,10 +451,11 @@ TEST(ScreenSpaceReference, FiniteAndInRangeOnHardInputs)
                 for (double thickness : {kInf, 0.1}) {
                     ScreenSpaceOptions options;
                     options.thickness = thickness;
-                    const auto r =
-                        computeScreenSpaceReference(v.getView(), makeFixedSettings(q, radius, 16), options);
+                    const auto r = computeScreenSpaceReference(
+                        v.getView(), makeFixedSettings(q, radius, 16), options);
                     expectValid(r, v.getView(),
-                                name + " " + getQuantityName(q) + " radius " + std::to_string(radius));
+                                name + " " + getQuantityName(q) + " radius " +
+                                    std::to_string(radius));
                 }
             }
 }
@@ -465,7 +476,8 @@ TEST(ScreenSpaceReference, SameImagesForAnyThreadCount)
         const auto all = computeScreenSpaceReference(corner.images.getView(), s);
         for (const auto* other : {&four, &all}) {
             EXPECT_EQ(one.reference.occlusion.pixels, other->reference.occlusion.pixels);
-            EXPECT_EQ(one.reference.occlusionStdErr.pixels, other->reference.occlusionStdErr.pixels);
+            EXPECT_EQ(one.reference.occlusionStdErr.pixels,
+                      other->reference.occlusionStdErr.pixels);
             EXPECT_EQ(one.reference.sampleCount.pixels, other->reference.sampleCount.pixels);
             EXPECT_EQ(one.reference.bentNormal.pixels, other->reference.bentNormal.pixels);
             EXPECT_EQ(one.offScreenShare.pixels, other->offScreenShare.pixels);
@@ -479,12 +491,15 @@ TEST(ScreenSpaceReference, RejectsBadInput)
 {
     const Corner corner(8, 6);
     ScreenSpaceView view = corner.images.getView();
-    EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Direct, 1.0)), Error);
+    EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Direct, 1.0)),
+                 Error);
     EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Ao, -1.0)), Error);
-    EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Obscurance, kInf)), Error);
+    EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Obscurance, kInf)),
+                 Error);
     ScreenSpaceOptions thin;
     thin.thickness = 0.0;
-    EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Ao, 1.0), thin), Error);
+    EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Ao, 1.0), thin),
+                 Error);
     const Image<glm::vec3> small(4, 6, glm::vec3(0.0f));
     view.normal = &small;
     EXPECT_THROW(computeScreenSpaceReference(view, makeFixedSettings(Quantity::Ao, 1.0)), Error);
