@@ -268,6 +268,8 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
             input.view = g.view;
             input.frameIndex = frame;
             input.gpu = &gpu;
+            input.scene = &renderScene;  // for ray-traced baselines only (plugin/occlusion.h)
+            input.gbuffer = &g;
             return pipeline::PassOutcome{};
         });
         std::vector<std::string> techniqueWrites = {"technique_ambient"};
@@ -280,6 +282,11 @@ std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::strin
                 return collectGpuPassTimes(gpu);
             });
             addTimingColumns(row, "occlusion", report);
+            // The technique's time for the equal-time charts: its GPU passes when it ran any,
+            // else its CPU wall time (ray-traced baselines); the row says which.
+            const bool onGpu = !report.gpuMs.empty();
+            row.set("technique_ms", onGpu ? report.gpuTotalMedianMs() : report.cpuMs.median)
+                .set("technique_time_source", std::string(onGpu ? "gpu" : "cpu"));
             for (const auto& [name, value] : technique->counters())
                 row.set("counter." + name, value);
             if (out.ambient.width != g.width || out.ambient.height != g.height)

@@ -15,6 +15,10 @@
 namespace rtlab::gpu {
 class Context;
 }
+namespace rtlab::scene {
+struct RenderScene;
+struct GBuffer;
+}
 
 namespace rtlab::plugin {
 
@@ -49,6 +53,11 @@ struct OcclusionInput {
     //! GPU work goes through gpu::Context::run with labelled dispatches; the harness reads their
     //! timestamps from the context's run log, so a technique never reports its own time.
     gpu::Context* gpu = nullptr;
+    //! The frame's triangles and its world-space G-buffer, for ray-traced baselines
+    //! (occlusion/raytraced_ao) only: a screen-space technique must not read them, or it is no
+    //! longer screen space. May be null (family suites, synthetic inputs).
+    const scene::RenderScene* scene = nullptr;
+    const scene::GBuffer* gbuffer = nullptr;
 };
 
 struct OcclusionOutput {

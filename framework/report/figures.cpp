@@ -252,7 +252,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
     // 3. Per-pass time of each technique's Pareto-front runs, stacked.
     plot::StackedBarSpec bars;
     bars.title = group.title + ": time per pass of the Pareto-front runs";
-    bars.yLabel = group.family == "isosurface" ? "CPU time (ms, median)" : "GPU time (ms, median)";
+    bars.yLabel = group.family == "isosurface" ? "CPU time (ms, median)" : "time (ms, median; GPU, CPU for ray tracing)";
     bars.passes = columns.passes;
     for (const auto& [technique, runs] : byTechnique) {
         std::vector<double> x, y;
