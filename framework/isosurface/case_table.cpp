@@ -1,4 +1,4 @@
-#include "case_table.h"
+#include "isosurface/case_table.h"
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-namespace rtlab::isosurface::mc {
+namespace rtlab::isosurface::tables {
 namespace {
 
 //! The two axes other than `axis`, in increasing order: they span the faces normal to `axis` and
@@ -41,7 +41,7 @@ int findEdge(const std::array<CellEdge, kEdgeCount>& edges, int cornerA, int cor
             (edges[e].start == cornerB && edges[e].end == cornerA))
             return e;
     }
-    throw std::logic_error("marching_cubes: corners " + std::to_string(cornerA) + " and " +
+    throw std::logic_error("isosurface tables: corners " + std::to_string(cornerA) + " and " +
                            std::to_string(cornerB) + " share no cell edge");
 }
 
@@ -105,7 +105,7 @@ std::pair<int, int> orientSegment(unsigned cube, const CellFace& face, int p, in
 void appendTriangle(CellTriangulation& cell, int a, int b, int c)
 {
     if (cell.triangleCount == kMaxCellTriangles)
-        throw std::logic_error("marching_cubes: more than 12 triangles in a cell");
+        throw std::logic_error("isosurface tables: more than 12 triangles in a cell");
     const int t = cell.triangleCount++;
     cell.vertices[3 * t + 0] = static_cast<std::uint8_t>(a);
     cell.vertices[3 * t + 1] = static_cast<std::uint8_t>(b);
@@ -178,7 +178,7 @@ void triangulateLoop(const std::vector<int>& loop,
 
     // No admissible triangulation on the edge vertices: fan around a vertex inside the cell.
     if (cell.extraCount == kMaxCellExtras)
-        throw std::logic_error("marching_cubes: too many interior vertices in a cell");
+        throw std::logic_error("isosurface tables: too many interior vertices in a cell");
     const int extra = cell.extraCount++;
     std::uint16_t mask = 0;
     for (const int e : loop)
@@ -210,6 +210,53 @@ bool isFaceAmbiguous(unsigned cube, int face)
            in0 != isInside(cube, corners[3]);
 }
 
+int findFaceSegment(unsigned cube, int face, bool joined, int edge)
+{
+    if (!isFaceAmbiguous(cube, face))
+        return -1;
+    const CellFace& f = getCellFaces()[face];
+    int segment = 0;
+    for (int k = 0; k < 4; ++k) {
+        // Same cut as triangulateCell: joined faces cut off their outside corners.
+        if (isInside(cube, f.corners[k]) == joined)
+            continue;
+        if (f.edges[(k + 3) % 4] == edge || f.edges[k] == edge)
+            return segment;
+        ++segment;
+    }
+    return -1;
+}
+
+unsigned decideJoinedFaces(unsigned cube, const std::array<double, kCornerCount>& values,
+                           AmbiguityRule rule)
+{
+    unsigned joined = 0;
+    for (int f = 0; f < kFaceCount; ++f) {
+        if (!isFaceAmbiguous(cube, f) || rule == AmbiguityRule::SeparateInside)
+            continue;
+        if (rule == AmbiguityRule::JoinInside) {
+            joined |= 1u << f;
+            continue;
+        }
+        const auto& corners = getCellFaces()[f].corners;
+        double v[4];
+        for (int k = 0; k < 4; ++k)
+            v[k] = values[corners[k]];
+        const bool firstInside = isInside(cube, corners[0]);
+        const double insideProduct = firstInside ? v[0] * v[2] : v[1] * v[3];
+        const double outsideProduct = firstInside ? v[1] * v[3] : v[0] * v[2];
+        // [Nielson & Hamann 1991] asymptotic decider: the bilinear interpolant on the face has
+        // its saddle value (ac - bd) / (a + c - b - d) (a, c diagonal). With a, c the inside
+        // pair the denominator is negative, so the saddle is inside, and the inside corners
+        // connected through it, exactly when ac > bd. A saddle exactly on the iso-value is
+        // outside, as samples on it are. Both cells sharing the face compute the same two
+        // products from the same four values, so they always agree: the mesh stays closed.
+        if (insideProduct > outsideProduct)
+            joined |= 1u << f;
+    }
+    return joined;
+}
+
 CellTriangulation triangulateCell(unsigned cube, unsigned joinedFaces)
 {
     // 1. Per face, segments between the crossed edges, as a successor map over cell edges; and
@@ -220,7 +267,7 @@ CellTriangulation triangulateCell(unsigned cube, unsigned joinedFaces)
     const auto addSegment = [&](const CellFace& face, int p, int q) {
         const auto [from, to] = orientSegment(cube, face, p, q);
         if (next[from] != -1)
-            throw std::logic_error("marching_cubes: case " + std::to_string(cube) + ": edge " +
+            throw std::logic_error("isosurface tables: case " + std::to_string(cube) + ": edge " +
                                    std::to_string(from) + " starts two segments");
         next[from] = to;
     };
@@ -266,6 +313,7 @@ CellTriangulation triangulateCell(unsigned cube, unsigned joinedFaces)
     //    each loop. [Lorensen & Cline 1987]: the surface in a cell is a set of polygons with
     //    vertices on the crossed edges, triangulated once per case.
     CellTriangulation result;
+    result.edgeLoop.fill(-1);
     std::array<bool, kEdgeCount> visited{};
     int chained = 0;
     for (int start = 0; start < kEdgeCount; ++start) {
@@ -274,21 +322,55 @@ CellTriangulation triangulateCell(unsigned cube, unsigned joinedFaces)
         std::vector<int> loop;
         for (int e = start; !visited[e]; e = next[e]) {
             if (next[e] == -1)
-                throw std::logic_error("marching_cubes: case " + std::to_string(cube) +
+                throw std::logic_error("isosurface tables: case " + std::to_string(cube) +
                                        ": open chain of segments");
             visited[e] = true;
             loop.push_back(e);
         }
         if (next[loop.back()] != start || loop.size() < 3)
-            throw std::logic_error("marching_cubes: case " + std::to_string(cube) +
+            throw std::logic_error("isosurface tables: case " + std::to_string(cube) +
                                    ": segments do not close into a loop");
         triangulateLoop(loop, forbidden, result);
         chained += int(loop.size());
+        if (result.loopCount == kMaxCellLoops)
+            throw std::logic_error("isosurface tables: case " + std::to_string(cube) +
+                                   ": more than four loops");
+        std::uint16_t mask = 0;
+        for (const int e : loop)
+            mask |= std::uint16_t(1u << e);
+        result.loops[result.loopCount++] = mask;
     }
     if (chained != crossedCount)
-        throw std::logic_error("marching_cubes: case " + std::to_string(cube) +
+        throw std::logic_error("isosurface tables: case " + std::to_string(cube) +
                                ": not every crossed edge is on a loop");
+
+    // 3. Patches: which loop each crossed edge is on, and the ambiguous faces whose two segments
+    //    one loop holds.
+    for (int l = 0; l < result.loopCount; ++l) {
+        for (int e = 0; e < kEdgeCount; ++e) {
+            if ((result.loops[l] >> e) & 1u)
+                result.edgeLoop[e] = std::int8_t(l);
+        }
+        for (int f = 0; f < kFaceCount; ++f) {
+            unsigned faceMask = 0;
+            for (const int e : getCellFaces()[f].edges)
+                faceMask |= 1u << e;
+            if (isFaceAmbiguous(cube, f) && (result.loops[l] & faceMask) == faceMask)
+                result.doubledFaces |= std::uint8_t(1u << f);
+        }
+    }
     return result;
+}
+
+unsigned CaseTable::packDecisions(unsigned ambiguous, unsigned joinedFaces)
+{
+    unsigned decisions = 0;
+    int bit = 0;
+    for (int f = 0; f < kFaceCount; ++f) {
+        if ((ambiguous >> f) & 1u)
+            decisions |= ((joinedFaces >> f) & 1u) << bit++;
+    }
+    return decisions;
 }
 
 const CaseTable& CaseTable::getInstance()
@@ -321,4 +403,4 @@ CaseTable::CaseTable()
     }
 }
 
-} // namespace rtlab::isosurface::mc
+} // namespace rtlab::isosurface::tables

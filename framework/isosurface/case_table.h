@@ -1,5 +1,7 @@
 #pragma once
 // Cell geometry and the marching cubes case table, generated at first use from the corner signs.
+// Shared by the isosurface techniques: marching_cubes triangulates the table's loops, and
+// dual_contouring gives each loop (surface patch of a cell) its own vertex.
 //
 // Conventions shared by the table and the extractor:
 //   corner c  : offset (c & 1, (c >> 1) & 1, (c >> 2) & 1) from the cell's lowest sample
@@ -12,7 +14,7 @@
 #include <cstdint>
 #include <vector>
 
-namespace rtlab::isosurface::mc {
+namespace rtlab::isosurface::tables {
 
 inline constexpr int kCornerCount = 8;
 inline constexpr int kEdgeCount = 12;
@@ -22,6 +24,8 @@ inline constexpr int kFaceCount = 6;
 inline constexpr int kMaxCellExtras = 4;
 //! A loop of L edges gives L - 2 triangles, or L around an interior vertex; loops share no edge.
 inline constexpr int kMaxCellTriangles = 12;
+//! Loops (surface patches) of a cell: four separated corners give the most.
+inline constexpr int kMaxCellLoops = 4;
 //! Vertex ids in a CellTriangulation: 0..11 are cell edges, kExtraVertex + j the j-th interior
 //! vertex of the cell.
 inline constexpr int kExtraVertex = kEdgeCount;
@@ -51,14 +55,50 @@ constexpr int getCornerBit(int corner, int axis)
 //! A face is ambiguous when its inside corners are diagonal (two inside, two outside, alternating).
 bool isFaceAmbiguous(unsigned cube, int face);
 
+//! The face across which a cell's neighbour sees face `face`: same axis, other side.
+constexpr int getOppositeFace(int face)
+{
+    return face ^ 1;
+}
+
+enum class AmbiguityRule {
+    Asymptotic,     //!< per face, the bilinear interpolant's saddle value decides
+    SeparateInside, //!< inside corners of an ambiguous face are never connected across it
+    JoinInside,     //!< inside corners of an ambiguous face are always connected across it
+};
+
+//! The ambiguous faces of `cube` whose inside corners are connected across the face (bit f set),
+//! decided by `rule` from the corner values relative to the iso-value (`values[c]` < 0 exactly
+//! when corner c is inside). The decision on a face depends on that face's four values alone, so
+//! both cells sharing it decide the same.
+unsigned decideJoinedFaces(unsigned cube, const std::array<double, kCornerCount>& values,
+                           AmbiguityRule rule);
+
+//! Which of the two segments of ambiguous face `face` holds cell edge `edge` (0 or 1; -1 when the
+//! edge is not on the face or the face is not ambiguous), with the face's inside corners joined
+//! across it when `joined` is set. Segments cut one corner each off the face (the outside
+//! corners when joined, else the inside ones) and are numbered in the face's corner order.
+int findFaceSegment(unsigned cube, int face, bool joined, int edge);
+
 //! The triangles of one cell, counter-clockwise seen from the outside (positive) side. Vertices
 //! are the crossed edges (one vertex per edge) and, for loops that cannot be triangulated on their
 //! edge vertices alone, one interior vertex per such loop, placed at the loop's centroid.
+//!
+//! The loops themselves are kept too: each is one surface patch of the cell, the polygon whose
+//! vertices are its crossed edges.
 struct CellTriangulation {
     int triangleCount = 0;
     int extraCount = 0;                                     //!< interior vertices
     std::array<std::uint16_t, kMaxCellExtras> extraLoops{}; //!< cell edge mask of each one's loop
     std::array<std::uint8_t, 3 * kMaxCellTriangles> vertices{}; //!< three per triangle
+    int loopCount = 0;
+    //! Cell edge mask of each loop, ordered by the loop's smallest edge id.
+    std::array<std::uint16_t, kMaxCellLoops> loops{};
+    //! Per cell edge, the loop it lies on; -1 for edges that are not crossed.
+    std::array<std::int8_t, kEdgeCount> edgeLoop{};
+    //! Bit f set when face f is ambiguous and one loop holds both of its segments (all four of
+    //! its edges): the patch crosses the face twice.
+    std::uint8_t doubledFaces = 0;
 };
 
 //! Builds the triangulation of a cell from its inside corners (`cube`) and, for each face f whose
@@ -87,7 +127,23 @@ public:
     {
         return mEntries[mFirstEntry[cube] + decisions];
     }
+    //! The entry of `cube` whose ambiguous faces are joined exactly where `joinedFaces` (a face
+    //! mask, as triangulateCell takes it) has a bit; bits of other faces are ignored.
+    const CellTriangulation& findJoined(unsigned cube, unsigned joinedFaces) const
+    {
+        return mEntries[entryIndex(cube, joinedFaces)];
+    }
+    //! Position of findJoined(cube, joinedFaces) among all entries (see entry()).
+    std::size_t entryIndex(unsigned cube, unsigned joinedFaces) const
+    {
+        return mFirstEntry[cube] + packDecisions(ambiguousFaces(cube), joinedFaces);
+    }
+    const CellTriangulation& entry(std::size_t index) const { return mEntries[index]; }
     std::size_t entryCount() const { return mEntries.size(); }
+
+    //! The compact decision bits of find() from a face mask: bit k is the bit of the k-th face
+    //! set in `ambiguous`.
+    static unsigned packDecisions(unsigned ambiguous, unsigned joinedFaces);
 
 private:
     CaseTable();
@@ -97,4 +153,4 @@ private:
     std::vector<CellTriangulation> mEntries;
 };
 
-} // namespace rtlab::isosurface::mc
+} // namespace rtlab::isosurface::tables

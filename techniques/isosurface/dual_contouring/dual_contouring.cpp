@@ -11,6 +11,7 @@
 namespace rtlab::isosurface {
 namespace {
 
+const std::vector<std::string> kVertexChoices = {"per_component", "per_cell"};
 const std::vector<std::string> kSolverChoices = {"svd", "schmitz"};
 const std::vector<std::string> kStartChoices = {"mass_point", "cell_center"};
 const std::vector<std::string> kPolicyChoices = {"clamp", "mass_point", "keep"};
@@ -62,12 +63,15 @@ int getIntIn(const config::ParamSet& params, const std::string& name, std::int64
 plugin::TechniqueInfo DualContouring::describe()
 {
     plugin::TechniqueInfo info;
-    info.summary = "dual contouring on the uniform grid: one QEF vertex per cell (truncated SVD "
-                   "about the mass point, or the Schmitz particle iteration), one quad per "
-                   "crossed edge, optional material boundary relaxation, TBB";
+    info.summary = "dual contouring on the uniform grid: one QEF vertex per surface patch of a "
+                   "cell (marching cubes loops; 2-manifold on closed surfaces) or per cell "
+                   "(truncated SVD about the mass point, or the Schmitz particle iteration), one "
+                   "quad per crossed edge, optional material boundary relaxation, TBB";
     info.reference = "Ju, Losasso, Schaefer & Warren 2002, Dual Contouring of Hermite Data "
-                     "(SIGGRAPH); Schmitz, Dietrich & Comba 2009, Efficient and High Quality "
-                     "Contouring of Isosurfaces on Uniform Grids (SIBGRAPI)";
+                     "(SIGGRAPH); Nielson 2004, Dual Marching Cubes (IEEE Visualization); "
+                     "Schaefer, Ju & Warren 2007, Manifold Dual Contouring (IEEE TVCG); "
+                     "Schmitz, Dietrich & Comba 2009, Efficient and High Quality Contouring of "
+                     "Isosurfaces on Uniform Grids (SIBGRAPI)";
     info.seed = "000_3da000e866ebc485.txt (The Tomorrow Children: dual contouring of the Layered "
                 "Depth Cube landscape, Schmitz solver, elastic relaxation of material "
                 "transitions)";
@@ -77,6 +81,9 @@ plugin::TechniqueInfo DualContouring::describe()
 config::ParamSchema DualContouring::declareParams()
 {
     config::ParamSchema schema;
+    schema.addEnum("vertices", "per_component", kVertexChoices,
+                   "one vertex per surface patch of a cell (marching cubes loops, 2-manifold on "
+                   "closed surfaces), or one per cell (classic dual contouring)");
     schema.addEnum("solver", "svd", kSolverChoices,
                    "QEF solver: truncated SVD about the mass point, or the Schmitz et al. 2009 "
                    "particle iteration");
@@ -108,6 +115,9 @@ config::ParamSchema DualContouring::declareParams()
 
 DualContouring::DualContouring(const config::ParamSet& params)
 {
+    mOptions.vertices = findChoice("vertices", params.getString("vertices"), kVertexChoices) == 0
+                            ? dc::VertexMode::PerComponent
+                            : dc::VertexMode::PerCell;
     mOptions.solver = findChoice("solver", params.getString("solver"), kSolverChoices) == 0
                           ? dc::QefSolver::Svd
                           : dc::QefSolver::Schmitz;
@@ -137,6 +147,8 @@ DualContouring::DualContouring(const config::ParamSet& params)
 config::ParamSet DualContouring::effectiveParams() const
 {
     config::ParamSet params;
+    params.set("vertices",
+               kVertexChoices[mOptions.vertices == dc::VertexMode::PerComponent ? 0 : 1]);
     params.set("solver", kSolverChoices[mOptions.solver == dc::QefSolver::Svd ? 0 : 1]);
     params.set("svd_threshold", mOptions.svdThreshold);
     params.set("schmitz_iterations", std::int64_t(mOptions.schmitzIterations));
@@ -156,7 +168,6 @@ config::ParamSet DualContouring::effectiveParams() const
 std::vector<std::pair<std::string, double>> DualContouring::counters() const
 {
     const dc::ExtractionStats& s = mStats;
-    const double cells = double(s.cells);
     const auto share = [&](std::size_t count, std::size_t of) {
         return of == 0 ? 0.0 : double(count) / double(of);
     };
@@ -165,7 +176,10 @@ std::vector<std::pair<std::string, double>> DualContouring::counters() const
         {"hermite_edges_missing", double(s.hermiteMissing)},
         {"qef_solver", mOptions.solver == dc::QefSolver::Svd ? 0.0 : 1.0},
         {"crossed_edges", double(s.crossedEdges)},
-        {"cells", cells},
+        {"cells", double(s.cells)},
+        {"vertices", double(s.vertices)},
+        {"cells_multi_vertex", double(s.multiVertexCells)},
+        {"face_vertices", double(s.faceVertices)},
         {"quads", double(s.quads)},
         {"cells_rank_0", double(s.rank[0])},
         {"cells_rank_1", double(s.rank[1])},
@@ -174,7 +188,7 @@ std::vector<std::pair<std::string, double>> DualContouring::counters() const
         {"normals_skipped", double(s.skippedNormals)},
         {"cells_without_normals", double(s.cellsWithoutPlanes)},
         {"vertices_left_cell", double(s.leftCell)},
-        {"vertices_left_cell_share", share(s.leftCell, s.cells)},
+        {"vertices_left_cell_share", share(s.leftCell, s.patchVertices)},
         {"split_diagonal_13_share", share(s.flippedSplits, s.quads)},
         {"material_boundary_vertices", double(s.boundaryVertices)},
         {"material_relaxation_max_shift", s.maxRelaxationShift},

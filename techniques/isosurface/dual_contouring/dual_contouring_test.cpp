@@ -1,12 +1,14 @@
 #include "dual_contouring.h"
 
 #include "extraction.h"
+#include "isosurface/case_table.h"
 #include "plugin/technique.h"
 #include "qef.h"
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
+#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -20,6 +22,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <string>
@@ -263,6 +266,41 @@ void expectWatertight(const Topology& t)
     EXPECT_EQ(t.badIndices, 0u);
     EXPECT_EQ(t.unbalancedEdges, 0u) << "holes or inconsistent orientation";
     EXPECT_EQ(t.unreferenced, 0u);
+}
+
+//! Vertices whose triangles do not form one closed fan (a single cycle of opposite edges): the
+//! vertex-manifold condition that edge-manifoldness alone does not imply.
+std::size_t countNonManifoldVertices(const TriangleMesh& mesh)
+{
+    std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> link(mesh.vertexCount());
+    for (std::size_t f = 0; f < mesh.triangleCount(); ++f) {
+        const std::uint32_t v[3] = {mesh.indices[3 * f], mesh.indices[3 * f + 1],
+                                    mesh.indices[3 * f + 2]};
+        for (int k = 0; k < 3; ++k)
+            link[v[k]].push_back({v[(k + 1) % 3], v[(k + 2) % 3]});
+    }
+    std::size_t bad = 0;
+    for (const auto& fan : link) {
+        if (fan.empty())
+            continue;
+        std::unordered_map<std::uint32_t, std::uint32_t> next;
+        bool ok = true;
+        for (const auto& [a, b] : fan)
+            ok = next.emplace(a, b).second && ok;
+        std::size_t steps = 0;
+        std::uint32_t at = fan.front().first;
+        do {
+            const auto it = next.find(at);
+            if (it == next.end()) {
+                ok = false;
+                break;
+            }
+            at = it->second;
+            ++steps;
+        } while (at != fan.front().first && steps <= fan.size());
+        bad += !(ok && steps == fan.size());
+    }
+    return bad;
 }
 
 bool isMeshFinite(const TriangleMesh& mesh)
@@ -717,6 +755,192 @@ TEST(DualContouringSmooth, TorusIsAClosedManifoldOfGenusOne)
 }
 
 // ---------------------------------------------------------------------------------------------
+// One vertex per surface patch: 2-manifold output
+
+//! The family suite's torus: R 0.55, r 0.2, around the y axis through (0.01, -0.02, 0.03), 40^3
+//! samples over [-1, 1]^3.
+Sdf makeSuiteTorus()
+{
+    const glm::dvec3 c(0.01, -0.02, 0.03);
+    const auto value = [c](const glm::dvec3& p) {
+        const glm::dvec3 q = p - c;
+        return glm::length(glm::dvec2(glm::length(glm::dvec2(q.x, q.z)) - 0.55, q.y)) - 0.2;
+    };
+    const auto gradient = [value](const glm::dvec3& p) {
+        glm::dvec3 g;
+        for (int axis = 0; axis < 3; ++axis) {
+            glm::dvec3 d(0.0);
+            d[axis] = 1e-6;
+            g[axis] = (value(p + d) - value(p - d)) / 2e-6;
+        }
+        return g;
+    };
+    return {value, gradient};
+}
+
+//! Euler characteristic of the marching cubes polygon complex of a field whose surface stays
+//! inside the grid (every crossed edge a vertex, every loop a face, every segment an edge shared
+//! by the two cells on its face), from the same table and face rule as per_component.
+long computeMarchingCubesEuler(const plugin::SampledField& field)
+{
+    namespace tables = isosurface::tables;
+    const tables::CaseTable& table = tables::CaseTable::getInstance();
+    const glm::ivec3 n = field.samples;
+    long crossed = 0;
+    long loops = 0;
+    long loopEdges = 0;
+    for (int z = 0; z < n.z; ++z)
+        for (int y = 0; y < n.y; ++y)
+            for (int x = 0; x < n.x; ++x) {
+                const bool in = field.at(x, y, z) < 0.0f;
+                crossed += x + 1 < n.x && in != (field.at(x + 1, y, z) < 0.0f);
+                crossed += y + 1 < n.y && in != (field.at(x, y + 1, z) < 0.0f);
+                crossed += z + 1 < n.z && in != (field.at(x, y, z + 1) < 0.0f);
+                if (x + 1 == n.x || y + 1 == n.y || z + 1 == n.z)
+                    continue;
+                unsigned cube = 0;
+                std::array<double, 8> values;
+                for (int c = 0; c < 8; ++c) {
+                    values[c] = field.at(x + (c & 1), y + ((c >> 1) & 1), z + ((c >> 2) & 1));
+                    cube |= unsigned(values[c] < 0.0) << c;
+                }
+                const tables::CellTriangulation& entry = table.findJoined(
+                    cube,
+                    tables::decideJoinedFaces(cube, values, tables::AmbiguityRule::Asymptotic));
+                loops += entry.loopCount;
+                for (int l = 0; l < entry.loopCount; ++l)
+                    loopEdges += std::popcount(unsigned(entry.loops[l]));
+            }
+    return crossed - loopEdges / 2 + loops;
+}
+
+//! Closed, consistently oriented, edge- and vertex-manifold, and outward.
+void expectClosedTwoManifold(const TriangleMesh& mesh)
+{
+    expectClosedManifold(analyzeTopology(mesh));
+    EXPECT_EQ(countNonManifoldVertices(mesh), 0u);
+    EXPECT_TRUE(isMeshFinite(mesh));
+    EXPECT_GT(computeSignedVolume(mesh), 0.0);
+}
+
+TEST(DualContouringManifold, SuiteTorusIsATwoManifoldPerComponentButNotPerCell)
+{
+    const Sdf sdf = makeSuiteTorus();
+    const plugin::SampledField field = sampleUnitCube(40, sdf);
+    for (const bool exact : {true, false}) {
+        SCOPED_TRACE(exact ? "exact" : "samples");
+        const Extraction r = extract(field, exact ? &sdf : nullptr);
+        expectClosedTwoManifold(r.mesh);
+        EXPECT_EQ(analyzeTopology(r.mesh).euler(), 0);
+        EXPECT_GT(r.stats.multiVertexCells, 0u) << "cells holding two sheets get two vertices";
+        EXPECT_EQ(r.stats.vertices, r.mesh.vertexCount());
+        EXPECT_EQ(r.stats.patchVertices + r.stats.faceVertices, r.stats.vertices);
+
+        // Classic dual contouring joins the two sheets of such cells at one vertex.
+        const Extraction classic =
+            extract(field, exact ? &sdf : nullptr, {{"vertices", std::string("per_cell")}});
+        const Topology t = analyzeTopology(classic.mesh);
+        expectWatertight(t);
+        EXPECT_GT(t.nonManifoldEdges, 0u);
+        EXPECT_EQ(classic.stats.multiVertexCells, 0u);
+        EXPECT_EQ(classic.stats.vertices, classic.stats.cells);
+        EXPECT_EQ(classic.stats.cells, r.stats.cells);
+    }
+}
+
+TEST(DualContouringManifold, RingAroundACheckerboardFaceIsATorusWithFaceVertices)
+{
+    // Eight inside samples form a ring through two cells stacked along z; their shared face has
+    // inside corners on one diagonal (-1) and outside ones on the other (+2), so the asymptotic
+    // decider connects the outside corners across it, and in both cells one patch crosses that
+    // face twice: the surface is a tube through the face.
+    plugin::SampledField field;
+    field.samples = glm::ivec3(4, 4, 5);
+    field.spacing = 0.5;
+    field.values.assign(4 * 4 * 5, 1.0f);
+    for (const glm::ivec3 s :
+         {glm::ivec3(1, 1, 1), glm::ivec3(2, 1, 1), glm::ivec3(2, 2, 1), glm::ivec3(1, 1, 2),
+          glm::ivec3(2, 2, 2), glm::ivec3(1, 1, 3), glm::ivec3(2, 1, 3), glm::ivec3(2, 2, 3)})
+        field.values[field.index(s.x, s.y, s.z)] = -1.0f;
+    field.values[field.index(2, 1, 2)] = 2.0f;
+    field.values[field.index(1, 2, 2)] = 2.0f;
+
+    const Extraction r = extract(field, nullptr);
+    expectClosedTwoManifold(r.mesh);
+    EXPECT_EQ(analyzeTopology(r.mesh).euler(), 0) << "a tube closed into a torus";
+    EXPECT_EQ(analyzeTopology(r.mesh).euler(), computeMarchingCubesEuler(field));
+    EXPECT_EQ(r.stats.faceVertices, 2u) << "one per segment of the shared face";
+    EXPECT_EQ(r.counters.at("face_vertices"), 2.0);
+    // Each face vertex is the midpoint of its segment's two crossings on the shared face
+    // (z = 2 samples). The segments cut off the inside corners: around (1, 1) the crossings are
+    // at (1 + 1/3, 1) and (1, 1 + 1/3) samples, around (2, 2) at (2 - 1/3, 2) and (2, 2 - 1/3).
+    for (const glm::dvec3 expected :
+         {glm::dvec3(7.0 / 6.0, 7.0 / 6.0, 2.0), glm::dvec3(11.0 / 6.0, 11.0 / 6.0, 2.0)}) {
+        const glm::vec3 world(expected * field.spacing);
+        const bool found =
+            std::any_of(r.mesh.positions.begin(), r.mesh.positions.end(),
+                        [&](const glm::vec3& p) { return glm::length(p - world) < 1e-6f; });
+        EXPECT_TRUE(found) << "face vertex at " << world.x << ", " << world.y << ", " << world.z;
+    }
+
+    const Topology classic =
+        analyzeTopology(extract(field, nullptr, {{"vertices", std::string("per_cell")}}).mesh);
+    expectWatertight(classic);
+    EXPECT_GT(classic.nonManifoldEdges, 0u);
+}
+
+TEST(DualContouringManifold, RandomFieldsAreClosedTwoManifoldsPerComponent)
+{
+    // Random values on 12^3 samples with an outside border, so every surface is closed: most
+    // cells are ambiguous somewhere. Quantised fields add ties in the asymptotic decider.
+    std::size_t multiVertexCells = 0;
+    std::size_t faceVertices = 0;
+    for (int seed = 0; seed < 20; ++seed) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        std::mt19937 rng(std::uint32_t(1000 + seed));
+        std::uniform_real_distribution<double> u(-1.0, 1.0);
+        std::uniform_int_distribution<int> q(-2, 2);
+        plugin::SampledField field;
+        field.samples = glm::ivec3(12);
+        field.spacing = 1.0 / 11.0;
+        field.values.resize(12 * 12 * 12);
+        const bool quantised = seed % 4 == 3;
+        for (int z = 0; z < 12; ++z)
+            for (int y = 0; y < 12; ++y)
+                for (int x = 0; x < 12; ++x) {
+                    const bool border = x == 0 || y == 0 || z == 0 || x == 11 || y == 11 || z == 11;
+                    const double value = quantised ? double(q(rng)) : u(rng);
+                    field.values[field.index(x, y, z)] = border ? 1.0f : float(value);
+                }
+        const Extraction r = extract(field, nullptr);
+        expectClosedTwoManifold(r.mesh);
+        EXPECT_EQ(analyzeTopology(r.mesh).euler(), computeMarchingCubesEuler(field));
+        EXPECT_EQ(r.stats.vertices, r.mesh.vertexCount());
+        multiVertexCells += r.stats.multiVertexCells;
+        faceVertices += r.stats.faceVertices;
+    }
+    EXPECT_GT(multiVertexCells, 0u);
+    EXPECT_GT(faceVertices, 0u) << "random fields exercise tunnels through faces";
+}
+
+TEST(DualContouringManifold, EveryTableEntryGivesEachCrossedEdgeOnePatch)
+{
+    namespace tables = isosurface::tables;
+    const tables::CaseTable& table = tables::CaseTable::getInstance();
+    for (std::size_t i = 0; i < table.entryCount(); ++i) {
+        const tables::CellTriangulation& entry = table.entry(i);
+        unsigned all = 0;
+        for (int l = 0; l < entry.loopCount; ++l) {
+            EXPECT_EQ(all & entry.loops[l], 0u) << "loops share no edge";
+            all |= entry.loops[l];
+            EXPECT_GE(std::popcount(unsigned(entry.loops[l])), 3);
+        }
+        for (int e = 0; e < tables::kEdgeCount; ++e)
+            EXPECT_EQ(entry.edgeLoop[e] >= 0, ((all >> e) & 1u) != 0);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
 // Degenerate placements and scales
 
 TEST(DualContouringDegenerate, FacesOnGridPlanesAndExactZeroSamples)
@@ -1025,6 +1249,7 @@ TEST(DualContouringThreads, OutputDoesNotDependOnTheThreadCount)
         materials[i] = field.position(int(i % 41), int(i / 41 % 41), int(i / (41 * 41))).x > 0.1;
     const std::vector<Overrides> variants = {
         {},
+        {{"vertices", std::string("per_cell")}},
         {{"solver", std::string("schmitz")}},
         {{"material_relaxation_iterations", std::int64_t(5)}},
     };
@@ -1042,6 +1267,35 @@ TEST(DualContouringThreads, OutputDoesNotDependOnTheThreadCount)
             EXPECT_EQ(one.counters, many.counters);
             EXPECT_TRUE(isMeshFinite(one.mesh));
         }
+    }
+}
+
+TEST(DualContouringThreads, PatchAndFaceVerticesDoNotDependOnTheThreadCount)
+{
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    plugin::SampledField field;
+    field.samples = glm::ivec3(24, 20, 22);
+    field.spacing = 0.1;
+    field.values.resize(24 * 20 * 22);
+    for (float& value : field.values)
+        value = float(u(rng));
+    std::vector<std::uint32_t> materials(field.values.size());
+    for (std::size_t i = 0; i < materials.size(); ++i)
+        materials[i] = std::uint32_t(i % 24 > 11);
+    for (const Overrides& overrides :
+         {Overrides{}, Overrides{{"material_relaxation_iterations", std::int64_t(3)}}}) {
+        Extraction one;
+        Extraction many;
+        tbb::task_arena(1).execute([&] { one = extract(field, nullptr, overrides, &materials); });
+        tbb::task_arena(8).execute([&] { many = extract(field, nullptr, overrides, &materials); });
+        EXPECT_GT(one.stats.faceVertices, 0u);
+        EXPECT_GT(one.stats.multiVertexCells, 0u);
+        EXPECT_EQ(one.mesh.positions, many.mesh.positions);
+        EXPECT_EQ(one.mesh.normals, many.mesh.normals);
+        EXPECT_EQ(one.mesh.indices, many.mesh.indices);
+        EXPECT_EQ(one.counters, many.counters);
+        EXPECT_TRUE(isMeshFinite(one.mesh));
     }
 }
 
@@ -1223,10 +1477,12 @@ TEST(DualContouringTechnique, RegistersWithItsParametersAndCounters)
     EXPECT_EQ(defaults.getFloat("svd_threshold"), 0.1);
     EXPECT_EQ(defaults.getString("outside_policy"), "clamp");
     EXPECT_EQ(defaults.getString("solver"), "svd");
+    EXPECT_EQ(defaults.getString("vertices"), "per_component");
     EXPECT_EQ(defaults.getInt("schmitz_iterations"), 20);
     EXPECT_EQ(defaults.getInt("material_relaxation_iterations"), 0);
 
-    const Overrides custom = {{"solver", std::string("schmitz")},
+    const Overrides custom = {{"vertices", std::string("per_cell")},
+                              {"solver", std::string("schmitz")},
                               {"svd_threshold", 0.25},
                               {"outside_policy", std::string("keep")},
                               {"schmitz_iterations", std::int64_t(7)},
@@ -1236,20 +1492,40 @@ TEST(DualContouringTechnique, RegistersWithItsParametersAndCounters)
 
     EXPECT_THROW(DualContouring(makeParams({{"solver", std::string("qr")}})),
                  std::invalid_argument);
+    EXPECT_THROW(DualContouring(makeParams({{"vertices", std::string("per_edge")}})),
+                 std::invalid_argument);
     EXPECT_THROW(DualContouring(makeParams({{"svd_threshold", 2.0}})), std::invalid_argument);
     EXPECT_THROW(DualContouring(makeParams({{"schmitz_step", 2.5}})), std::invalid_argument);
 
     const Sdf sdf = makeSphere(glm::dvec3(0.0), 0.6);
     const plugin::SampledField field = sampleUnitCube(17, sdf);
     const Extraction r = extract(field, &sdf);
-    for (const char* name :
-         {"hermite_source", "hermite_edges_missing", "qef_solver", "crossed_edges", "cells",
-          "quads", "cells_rank_0", "cells_rank_1", "cells_rank_2", "cells_rank_3",
-          "normals_skipped", "cells_without_normals", "vertices_left_cell",
-          "vertices_left_cell_share", "split_diagonal_13_share", "material_boundary_vertices",
-          "material_relaxation_max_shift"})
+    for (const char* name : {"hermite_source",
+                             "hermite_edges_missing",
+                             "qef_solver",
+                             "crossed_edges",
+                             "cells",
+                             "vertices",
+                             "cells_multi_vertex",
+                             "face_vertices",
+                             "quads",
+                             "cells_rank_0",
+                             "cells_rank_1",
+                             "cells_rank_2",
+                             "cells_rank_3",
+                             "normals_skipped",
+                             "cells_without_normals",
+                             "vertices_left_cell",
+                             "vertices_left_cell_share",
+                             "split_diagonal_13_share",
+                             "material_boundary_vertices",
+                             "material_relaxation_max_shift"})
         EXPECT_EQ(r.counters.count(name), 1u) << name;
-    EXPECT_EQ(r.counters.at("cells"), double(r.mesh.vertexCount()));
+    EXPECT_EQ(r.counters.at("vertices"), double(r.mesh.vertexCount()));
+    EXPECT_EQ(r.counters.at("cells"), double(r.mesh.vertexCount()))
+        << "a sphere: one sheet per cell";
+    EXPECT_EQ(r.counters.at("cells_multi_vertex"), 0.0);
+    EXPECT_EQ(r.counters.at("face_vertices"), 0.0);
     EXPECT_EQ(2.0 * r.counters.at("quads"), double(r.mesh.triangleCount()));
     EXPECT_EQ(r.counters.at("qef_solver"), 0.0);
     EXPECT_EQ(extract(field, &sdf, {{"solver", std::string("schmitz")}}).counters.at("qef_solver"),

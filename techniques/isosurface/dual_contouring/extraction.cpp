@@ -2,6 +2,8 @@
 
 #include "qef.h"
 
+#include "isosurface/case_table.h"
+
 #include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -31,6 +33,10 @@ constexpr double kOutsideTolerance = 1e-9;
 constexpr int kProjectionSteps = 8;
 //! Halvings of a relaxation step whose projection leaves the vertex's cell before it is dropped.
 constexpr int kMaxStepHalvings = 4;
+//! Triangles of one crossed edge at most: a quad with a face vertex on each side, fanned.
+constexpr int kMaxEdgeTriangles = 6;
+//! Boundary neighbours of a vertex at most: one per segment of its patch.
+constexpr std::size_t kMaxNeighbours = 12;
 
 bool isFinite(const glm::dvec3& v)
 {
@@ -399,38 +405,141 @@ std::array<glm::ivec3, 4> getCellsAroundEdge(const glm::ivec3& s, int axis)
     return cells;
 }
 
-struct CellVertices {
-    std::vector<std::uint32_t> vertexOfCell; //!< per cell, kNone when the cell has no sign change
-    std::vector<glm::ivec3> cell;            //!< per vertex
-    std::vector<glm::dvec3> local;           //!< per vertex, position relative to its cell, cells
-    std::vector<glm::dvec3> normal;          //!< per vertex, unit
-    std::vector<QefSystem> qef;              //!< per vertex, kept for the relaxation only
+//! Marching cubes edge id (framework/isosurface/case_table.h numbering) of the cell edge that
+//! starts at `offset` (0 or 1 per axis) from the cell's lowest sample and runs along `axis`.
+int getTableEdge(const glm::ivec3& offset, int axis)
+{
+    const int u = axis == 0 ? 1 : 0;
+    const int v = axis == 2 ? 1 : 2;
+    return axis * 4 + offset[u] + 2 * offset[v];
+}
+
+//! Per DC cell edge (getCellEdgeOffsets order), its table edge id.
+const std::array<int, 12>& getTableEdges()
+{
+    static const std::array<int, 12> ids = [] {
+        std::array<int, 12> e{};
+        for (int k = 0; k < 12; ++k)
+            e[k] = getTableEdge(getCellEdgeOffsets()[k].offset, getCellEdgeOffsets()[k].axis);
+        return e;
+    }();
+    return ids;
+}
+
+//! A table edge mask converted to a DC cell edge mask.
+std::uint16_t toCellEdgeMask(unsigned tableMask)
+{
+    std::uint16_t mask = 0;
+    for (int k = 0; k < 12; ++k) {
+        if ((tableMask >> getTableEdges()[k]) & 1u)
+            mask |= std::uint16_t(1u << k);
+    }
+    return mask;
+}
+
+//! What the vertex passes need to know about each cell.
+struct CellCase {
+    std::uint16_t entry = 0;  //!< index into the case table (per_component)
+    std::uint8_t cube = 0;    //!< bit c set when corner c is inside
+    std::uint8_t joined = 0;  //!< ambiguous faces whose inside corners are joined across them
+    std::uint8_t paired = 0;  //!< faces that this cell's and the neighbour's patch both cross twice
+    std::uint8_t patches = 0; //!< patch vertices of the cell (0 when it has no sign change)
 };
 
-//! Pass 2: number the cells with a sign change in scan order.
-void numberCells(const Grid& grid, const EdgeTable& table, CellVertices& vertices)
+struct CellVertices {
+    std::vector<CellCase> cases;             //!< per cell
+    std::vector<std::uint32_t> vertexOfCell; //!< per cell: its first vertex, kNone when inactive
+    std::vector<glm::ivec3> cell;            //!< per vertex
+    std::vector<std::uint16_t> edges; //!< per vertex: its cell edges (getCellEdgeOffsets bits)
+    std::vector<std::uint8_t> onFace; //!< per vertex: 1 for a face vertex (see numberCells)
+    std::vector<glm::dvec3> local;    //!< per vertex, position relative to its cell, cells
+    std::vector<glm::dvec3> normal;   //!< per vertex, unit
+    std::vector<QefSystem> qef;       //!< per vertex, kept for the relaxation only
+};
+
+//! Bit f of a face mask for the faces on the high side of a cell (x, y, z).
+constexpr unsigned kHighFaces = (1u << 1) | (1u << 3) | (1u << 5);
+
+//! Pass 2: the case of every cell and its vertices, numbered in cell scan order.
+//!
+//! per_cell: one vertex per cell with a sign change, on all its crossed edges [Ju et al. 2002].
+//! per_component: one vertex per surface patch of the cell, the patches being the loops of the
+//! marching cubes case table under the asymptotic decider (framework/isosurface), as in Nielson's
+//! Dual Marching Cubes [G. M. Nielson, "Dual Marching Cubes", IEEE Visualization 2004] and the
+//! finest-level vertex clustering of Manifold Dual Contouring [S. Schaefer, T. Ju, J. Warren,
+//! "Manifold Dual Contouring", IEEE TVCG 2007]. Face decisions depend on the face's values only,
+//! so the two cells on a face split its crossed edges into the same segments. Where both cells'
+//! patches cross a shared ambiguous face twice (a tunnel through the face), one vertex per patch
+//! would join the two patches by a mesh edge that four quads use; instead each of the face's two
+//! segments gets a vertex of its own on the face, owned by the lower cell and numbered after its
+//! patch vertices, and the quads around the segment's edges pass through it (pentagons).
+void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptions& options,
+                 CellVertices& vertices)
 {
+    const tables::CaseTable& caseTable = tables::CaseTable::getInstance();
+    const bool perComponent = options.vertices == VertexMode::PerComponent;
     const glm::ivec3 cells(grid.cells(0), grid.cells(1), grid.cells(2));
     const std::size_t cellLayer = std::size_t(cells.x) * cells.y;
+    vertices.cases.assign(cellLayer * cells.z, CellCase{});
     vertices.vertexOfCell.assign(cellLayer * cells.z, kNone);
-    std::vector<std::uint64_t> layerCount(cells.z + 1, 0);
     std::array<std::size_t, 8> corner{};
     for (int k = 0; k < 8; ++k)
         corner[k] = grid.index({k & 1, (k >> 1) & 1, (k >> 2) & 1});
-    const auto isActive = [&](std::size_t sample) {
-        const std::uint8_t in = table.flags[sample] & kInsideBit;
-        for (int k = 1; k < 8; ++k) {
-            if ((table.flags[sample + corner[k]] & kInsideBit) != in)
-                return true;
-        }
-        return false;
-    };
+
+    // Cases and patches.
+    tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
+        for (int z = r.begin(); z != r.end(); ++z)
+            for (int y = 0; y < cells.y; ++y)
+                for (int x = 0; x < cells.x; ++x) {
+                    const std::size_t base = grid.index({x, y, z});
+                    unsigned cube = 0;
+                    for (int k = 0; k < 8; ++k)
+                        cube |= unsigned((table.flags[base + corner[k]] & kInsideBit) != 0) << k;
+                    CellCase& c = vertices.cases[grid.cellIndex({x, y, z})];
+                    c.cube = std::uint8_t(cube);
+                    if (cube == 0 || cube == 255)
+                        continue;
+                    if (!perComponent) {
+                        c.patches = 1;
+                        continue;
+                    }
+                    std::array<double, 8> values;
+                    for (int k = 0; k < 8; ++k)
+                        values[k] = grid.relative(base + corner[k]);
+                    c.joined = std::uint8_t(
+                        tables::decideJoinedFaces(cube, values, tables::AmbiguityRule::Asymptotic));
+                    const std::size_t entry = caseTable.entryIndex(cube, c.joined);
+                    c.entry = std::uint16_t(entry);
+                    c.patches = std::uint8_t(caseTable.entry(entry).loopCount);
+                }
+    });
+
+    // Faces that the patches on both sides cross twice, and the vertex count per cell layer.
+    std::vector<std::uint64_t> layerCount(cells.z + 1, 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         for (int z = r.begin(); z != r.end(); ++z) {
             std::uint64_t count = 0;
             for (int y = 0; y < cells.y; ++y)
-                for (int x = 0; x < cells.x; ++x)
-                    count += isActive(grid.index({x, y, z}));
+                for (int x = 0; x < cells.x; ++x) {
+                    CellCase& c = vertices.cases[grid.cellIndex({x, y, z})];
+                    count += c.patches;
+                    if (!perComponent || c.patches == 0)
+                        continue;
+                    const unsigned doubled = caseTable.entry(c.entry).doubledFaces;
+                    for (int f = 0; f < tables::kFaceCount; ++f) {
+                        if (((doubled >> f) & 1u) == 0)
+                            continue;
+                        glm::ivec3 other(x, y, z);
+                        other[f / 2] += (f & 1) ? 1 : -1;
+                        if (other[f / 2] < 0 || other[f / 2] >= cells[f / 2])
+                            continue;
+                        const CellCase& n = vertices.cases[grid.cellIndex(other)];
+                        if ((caseTable.entry(n.entry).doubledFaces >> tables::getOppositeFace(f)) &
+                            1u)
+                            c.paired |= std::uint8_t(1u << f);
+                    }
+                    count += 2 * std::popcount(unsigned(c.paired & kHighFaces));
+                }
             layerCount[z + 1] = count;
         }
     });
@@ -441,18 +550,81 @@ void numberCells(const Grid& grid, const EdgeTable& table, CellVertices& vertice
         throw std::length_error("dual_contouring: " + std::to_string(total) +
                                 " vertices exceed 32-bit indices");
     vertices.cell.resize(total);
+    vertices.edges.resize(total);
+    vertices.onFace.assign(total, 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         for (int z = r.begin(); z != r.end(); ++z) {
             std::uint32_t next = std::uint32_t(layerCount[z]);
             for (int y = 0; y < cells.y; ++y)
                 for (int x = 0; x < cells.x; ++x) {
-                    if (!isActive(grid.index({x, y, z})))
+                    const std::size_t cellIndex = grid.cellIndex({x, y, z});
+                    const CellCase& c = vertices.cases[cellIndex];
+                    if (c.patches == 0)
                         continue;
-                    vertices.vertexOfCell[grid.cellIndex({x, y, z})] = next;
-                    vertices.cell[next++] = glm::ivec3(x, y, z);
+                    vertices.vertexOfCell[cellIndex] = next;
+                    if (!perComponent) {
+                        vertices.cell[next] = glm::ivec3(x, y, z);
+                        vertices.edges[next++] = 0xfff;
+                        continue;
+                    }
+                    const tables::CellTriangulation& entry = caseTable.entry(c.entry);
+                    for (int l = 0; l < entry.loopCount; ++l) {
+                        vertices.cell[next] = glm::ivec3(x, y, z);
+                        vertices.edges[next++] = toCellEdgeMask(entry.loops[l]);
+                    }
+                    for (int f = 1; f < tables::kFaceCount; f += 2) {
+                        if (((c.paired >> f) & 1u) == 0)
+                            continue;
+                        const bool joined = ((c.joined >> f) & 1u) != 0;
+                        for (int segment = 0; segment < 2; ++segment) {
+                            unsigned mask = 0;
+                            for (const int e : tables::getCellFaces()[f].edges) {
+                                if (tables::findFaceSegment(c.cube, f, joined, e) == segment)
+                                    mask |= 1u << e;
+                            }
+                            vertices.cell[next] = glm::ivec3(x, y, z);
+                            vertices.edges[next] = toCellEdgeMask(mask);
+                            vertices.onFace[next++] = 1;
+                        }
+                    }
                 }
         }
     });
+}
+
+//! The vertex that the quads around the crossed grid edge (sample s, axis) use in `cell`.
+std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertices,
+                             const ExtractionOptions& options, const glm::ivec3& cell,
+                             const glm::ivec3& s, int axis)
+{
+    const std::size_t cellIndex = grid.cellIndex(cell);
+    const std::uint32_t first = vertices.vertexOfCell[cellIndex];
+    if (options.vertices == VertexMode::PerCell)
+        return first;
+    const auto& entry = tables::CaseTable::getInstance().entry(vertices.cases[cellIndex].entry);
+    return first + std::uint32_t(entry.edgeLoop[getTableEdge(s - cell, axis)]);
+}
+
+//! The face vertex between `cell` and its neighbour `other` (one step along one axis) for the
+//! segment holding the crossed grid edge (sample s, axis), or kNone when that face has none.
+std::uint32_t findFaceVertex(const Grid& grid, const CellVertices& vertices, glm::ivec3 cell,
+                             glm::ivec3 other, const glm::ivec3& s, int axis)
+{
+    int normalAxis = 0;
+    while (cell[normalAxis] == other[normalAxis])
+        ++normalAxis;
+    if (other[normalAxis] < cell[normalAxis])
+        std::swap(cell, other);
+    const std::size_t cellIndex = grid.cellIndex(cell);
+    const CellCase& c = vertices.cases[cellIndex];
+    const int face = 2 * normalAxis + 1;
+    if (((c.paired >> face) & 1u) == 0)
+        return kNone;
+    const int segment = tables::findFaceSegment(c.cube, face, ((c.joined >> face) & 1u) != 0,
+                                                getTableEdge(s - cell, axis));
+    const unsigned before = unsigned(c.paired & kHighFaces) & ((1u << face) - 1u);
+    return vertices.vertexOfCell[cellIndex] + c.patches + 2u * std::popcount(before) +
+           std::uint32_t(segment);
 }
 
 bool isInsideBox(const glm::dvec3& p)
@@ -464,8 +636,9 @@ bool isInsideBox(const glm::dvec3& p)
     return true;
 }
 
-//! Pass 3: one QEF vertex per cell [Ju et al. 2002, sec. 2.2], in the cell's frame (its lowest
-//! sample at the origin, the box [0, 1]^3).
+//! Pass 3: one QEF vertex per cell or patch [Ju et al. 2002, sec. 2.2], from the crossings of its
+//! own edges only, in the cell's frame (its lowest sample at the origin, the box [0, 1]^3). A face
+//! vertex is the midpoint of its segment's two crossings, which lies on the face.
 void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOptions& options,
                    bool keepQef, CellVertices& vertices, ExtractionStats& stats)
 {
@@ -489,7 +662,10 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                 const glm::ivec3 cell = vertices.cell[v];
                 int n = 0;
                 glm::dvec3 normalSum(0.0);
-                for (const CellEdgeOffset& e : cellEdges) {
+                for (int k = 0; k < 12; ++k) {
+                    if (((vertices.edges[v] >> k) & 1u) == 0)
+                        continue;
+                    const CellEdgeOffset& e = cellEdges[k];
                     const std::uint32_t id = table.find(grid.index(cell + e.offset), e.axis);
                     if (id == kNone)
                         continue;
@@ -498,6 +674,16 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                     normals[n] = c.normal;
                     normalSum += c.normal;
                     ++n;
+                }
+                if (vertices.onFace[v]) {
+                    glm::dvec3 mid(0.0);
+                    for (int i = 0; i < n; ++i)
+                        mid += points[i];
+                    vertices.local[v] = mid / double(std::max(n, 1));
+                    glm::dvec3 normal = normalizeOrZero(normalSum);
+                    vertices.normal[v] =
+                        normal == glm::dvec3(0.0) ? glm::dvec3(0.0, 0.0, 1.0) : normal;
+                    continue;
                 }
                 int skippedHere = 0;
                 const QefSystem qef = buildQef(std::span(points.data(), n),
@@ -554,6 +740,8 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
             }
         });
     for (std::size_t v = 0; v < count; ++v) {
+        if (vertices.onFace[v])
+            continue;
         ++stats.rank[std::min<int>(rank[v], 3)];
         stats.leftCell += left[v];
         stats.skippedNormals += skipped[v];
@@ -585,24 +773,24 @@ public:
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t v = range.begin(); v != range.end(); ++v)
-                                  mBoundary[v] = hasMixedQuads(mVertices.cell[v]) ? 1 : 0;
+                                  mBoundary[v] = !mVertices.onFace[v] && hasMixedQuads(v);
                           });
         mNeighbourStart.assign(count + 1, 0);
-        std::vector<std::uint32_t> found(6 * count);
+        std::vector<std::uint32_t> found(kMaxNeighbours * count);
         std::vector<std::uint8_t> foundCount(count, 0);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t v = range.begin(); v != range.end(); ++v) {
                                   if (mBoundary[v])
-                                      foundCount[v] =
-                                          std::uint8_t(findBoundaryNeighbours(v, &found[6 * v]));
+                                      foundCount[v] = std::uint8_t(
+                                          findBoundaryNeighbours(v, &found[kMaxNeighbours * v]));
                               }
                           });
         for (std::size_t v = 0; v < count; ++v)
             mNeighbourStart[v + 1] = mNeighbourStart[v] + foundCount[v];
         mNeighbours.resize(mNeighbourStart[count]);
         for (std::size_t v = 0; v < count; ++v)
-            std::copy_n(found.begin() + 6 * v, foundCount[v],
+            std::copy_n(found.begin() + kMaxNeighbours * v, foundCount[v],
                         mNeighbours.begin() + mNeighbourStart[v]);
         std::size_t boundary = 0;
         for (std::uint8_t b : mBoundary)
@@ -669,13 +857,16 @@ private:
         return mMaterials[lowInside ? sample : sample + mGrid.stride(axis)];
     }
 
-    //! Whether the quads of the cell's crossed interior edges carry more than one material.
-    bool hasMixedQuads(const glm::ivec3& cell) const
+    //! Whether the quads of the vertex's crossed interior edges carry more than one material.
+    bool hasMixedQuads(std::size_t v) const
     {
         bool any = false;
         std::uint32_t material = 0;
-        for (const CellEdgeOffset& e : getCellEdgeOffsets()) {
-            const glm::ivec3 s = cell + e.offset;
+        for (int k = 0; k < 12; ++k) {
+            if (((mVertices.edges[v] >> k) & 1u) == 0)
+                continue;
+            const CellEdgeOffset& e = getCellEdgeOffsets()[k];
+            const glm::ivec3 s = mVertices.cell[v] + e.offset;
             const std::size_t sample = mGrid.index(s);
             if (mTable.find(sample, e.axis) == kNone || !isInteriorEdge(mGrid, s, e.axis))
                 continue;
@@ -688,8 +879,9 @@ private:
         return false;
     }
 
-    //! Boundary vertices joined to v by a quad side: cells across a face of v's cell that has a
-    //! crossed interior edge (a quad around that edge has both cells as consecutive corners).
+    //! Boundary vertices joined to v by a quad side: for each face of v's cell, the vertices of
+    //! the neighbour cell that the quads around v's crossed interior edges on that face use
+    //! (faces with face vertices join v to those instead, which are not relaxed).
     int findBoundaryNeighbours(std::size_t v, std::uint32_t* out) const
     {
         const glm::ivec3 cell = mVertices.cell[v];
@@ -700,26 +892,22 @@ private:
                 other[axis] += side;
                 if (other[axis] < 0 || other[axis] >= mGrid.cells(axis))
                     continue;
-                const std::uint32_t u = mVertices.vertexOfCell[mGrid.cellIndex(other)];
-                if (u == kNone || !mBoundary[u])
-                    continue;
-                // The shared face lies at cell[axis] + (side > 0); its four edges run along the
-                // two other axes.
-                glm::ivec3 faceOrigin = cell;
-                faceOrigin[axis] += side > 0 ? 1 : 0;
-                bool joined = false;
-                for (int k = 1; k <= 2 && !joined; ++k) {
-                    const int along = (axis + k) % 3;
-                    const int across = (axis + 3 - k) % 3;
-                    for (int j = 0; j < 2 && !joined; ++j) {
-                        glm::ivec3 s = faceOrigin;
-                        s[across] += j;
-                        joined = mTable.find(mGrid.index(s), along) != kNone &&
-                                 isInteriorEdge(mGrid, s, along);
-                    }
-                }
-                if (joined)
+                for (int k = 0; k < 12; ++k) {
+                    const CellEdgeOffset& e = getCellEdgeOffsets()[k];
+                    if (((mVertices.edges[v] >> k) & 1u) == 0 || e.axis == axis ||
+                        e.offset[axis] != (side > 0 ? 1 : 0))
+                        continue;
+                    const glm::ivec3 s = cell + e.offset;
+                    if (mTable.find(mGrid.index(s), e.axis) == kNone ||
+                        !isInteriorEdge(mGrid, s, e.axis) ||
+                        findFaceVertex(mGrid, mVertices, cell, other, s, e.axis) != kNone)
+                        continue;
+                    const std::uint32_t u =
+                        findEdgeVertex(mGrid, mVertices, mOptions, other, s, e.axis);
+                    if (u == kNone || !mBoundary[u] || std::find(out, out + n, u) != out + n)
+                        continue;
                     out[n++] = u;
+                }
             }
         }
         return n;
@@ -817,10 +1005,16 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     stats.hermiteMissing = missing.load();
 
     CellVertices vertices;
-    numberCells(grid, table, vertices);
+    numberCells(grid, table, options, vertices);
     const bool relaxing = input.materials != nullptr && options.materialRelaxationIterations > 0;
     placeVertices(grid, table, options, relaxing && !source.hasExactProjection(), vertices, stats);
-    stats.cells = vertices.cell.size();
+    stats.vertices = vertices.cell.size();
+    for (const CellCase& c : vertices.cases) {
+        stats.cells += c.patches > 0;
+        stats.multiVertexCells += c.patches > 1;
+        stats.patchVertices += c.patches;
+    }
+    stats.faceVertices = stats.vertices - stats.patchVertices;
 
     if (input.materials != nullptr) {
         MaterialRelaxation relaxation(grid, table, *input.materials, options, source, input,
@@ -833,37 +1027,66 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     // One quad per crossed edge with four cells around it [Ju et al. 2002, sec. 2.1], wound
     // counter-clockwise seen from the outside: when the edge's low end is inside the outward
     // normal points along +axis, and the cells come counter-clockwise seen from +axis.
-    std::vector<std::array<std::uint32_t, 3>> triangles(2 * edgeCount);
+    // A quad side between two cells whose patches both cross their shared face twice passes
+    // through the face vertex of the edge's segment (see numberCells); such polygons are fanned
+    // around their first face vertex.
+    std::vector<std::array<std::array<std::uint32_t, 3>, kMaxEdgeTriangles>> triangles(edgeCount);
+    std::vector<std::uint8_t> triangleCount(edgeCount, 0);
     std::vector<std::uint8_t> hasQuad(edgeCount, 0);
     std::vector<std::uint8_t> flipped(edgeCount, 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edgeCount),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                              const std::size_t sample = std::size_t(table.edges[k] / 3u);
-                              const int axis = int(table.edges[k] % 3u);
-                              const glm::ivec3 s = grid.sampleOf(sample);
-                              if (!isInteriorEdge(grid, s, axis))
-                                  continue;
-                              const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
-                              const bool lowInside = (table.flags[sample] & kInsideBit) != 0;
-                              std::array<std::uint32_t, 4> q;
-                              std::array<glm::dvec3, 4> p;
-                              for (int c = 0; c < 4; ++c) {
-                                  const glm::ivec3 cell = cells[lowInside ? c : (4 - c) % 4];
-                                  q[c] = vertices.vertexOfCell[grid.cellIndex(cell)];
-                                  p[c] = glm::dvec3(cell - s) + vertices.local[q[c]];
-                              }
-                              hasQuad[k] = 1;
-                              if (chooseDiagonal13(q, p)) {
-                                  flipped[k] = 1;
-                                  triangles[2 * k] = {q[0], q[1], q[3]};
-                                  triangles[2 * k + 1] = {q[1], q[2], q[3]};
-                              } else {
-                                  triangles[2 * k] = {q[0], q[1], q[2]};
-                                  triangles[2 * k + 1] = {q[0], q[2], q[3]};
-                              }
-                          }
-                      });
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, edgeCount),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                const std::size_t sample = std::size_t(table.edges[k] / 3u);
+                const int axis = int(table.edges[k] % 3u);
+                const glm::ivec3 s = grid.sampleOf(sample);
+                if (!isInteriorEdge(grid, s, axis))
+                    continue;
+                const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
+                const bool lowInside = (table.flags[sample] & kInsideBit) != 0;
+                std::array<glm::ivec3, 4> around;
+                std::array<std::uint32_t, 4> q;
+                std::array<glm::dvec3, 4> p;
+                for (int c = 0; c < 4; ++c) {
+                    around[c] = cells[lowInside ? c : (4 - c) % 4];
+                    q[c] = findEdgeVertex(grid, vertices, options, around[c], s, axis);
+                    p[c] = glm::dvec3(around[c] - s) + vertices.local[q[c]];
+                }
+                hasQuad[k] = 1;
+                std::array<std::uint32_t, 8> polygon;
+                int size = 0;
+                int firstFace = -1;
+                for (int c = 0; c < 4; ++c) {
+                    polygon[size++] = q[c];
+                    if (options.vertices == VertexMode::PerCell)
+                        continue;
+                    const std::uint32_t f =
+                        findFaceVertex(grid, vertices, around[c], around[(c + 1) % 4], s, axis);
+                    if (f == kNone)
+                        continue;
+                    if (firstFace < 0)
+                        firstFace = size;
+                    polygon[size++] = f;
+                }
+                auto& out = triangles[k];
+                if (firstFace >= 0) {
+                    for (int i = 1; i + 1 < size; ++i)
+                        out[triangleCount[k]++] = {polygon[firstFace],
+                                                   polygon[(firstFace + i) % size],
+                                                   polygon[(firstFace + i + 1) % size]};
+                } else if (chooseDiagonal13(q, p)) {
+                    flipped[k] = 1;
+                    out[0] = {q[0], q[1], q[3]};
+                    out[1] = {q[1], q[2], q[3]};
+                    triangleCount[k] = 2;
+                } else {
+                    out[0] = {q[0], q[1], q[2]};
+                    out[1] = {q[0], q[2], q[3]};
+                    triangleCount[k] = 2;
+                }
+            }
+        });
 
     TriangleMesh mesh;
     const std::size_t vertexCount = vertices.cell.size();
@@ -884,9 +1107,8 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
             continue;
         ++stats.quads;
         stats.flippedSplits += flipped[k];
-        for (int t = 0; t < 2; ++t)
-            mesh.indices.insert(mesh.indices.end(), triangles[2 * k + t].begin(),
-                                triangles[2 * k + t].end());
+        for (int t = 0; t < triangleCount[k]; ++t)
+            mesh.indices.insert(mesh.indices.end(), triangles[k][t].begin(), triangles[k][t].end());
     }
     out = std::move(mesh);
 }

@@ -1,6 +1,7 @@
 #pragma once
-// The dual contouring mesher proper: Hermite data, one QEF vertex per cell, one quad per crossed
-// grid edge, optional material boundary relaxation. See dual_contouring.h for the doc block.
+// The dual contouring mesher proper: Hermite data, one QEF vertex per surface patch of a cell (or
+// per cell), one quad per crossed grid edge, optional material boundary relaxation. See
+// dual_contouring.h for the doc block.
 
 #include "core/mesh.h"
 #include "plugin/isosurface.h"
@@ -26,6 +27,11 @@ enum class OutsidePolicy {
     Keep,      //!< leave it where the solver put it
 };
 
+enum class VertexMode {
+    PerComponent, //!< one vertex per surface patch (marching cubes loop) of a cell
+    PerCell,      //!< one vertex per cell with a sign change (classic dual contouring)
+};
+
 enum class HermiteMode {
     Auto,    //!< input.hermite, else exactValue/exactGradient, else the samples
     Samples, //!< always the samples (linear crossings, central-difference normals)
@@ -39,6 +45,7 @@ enum class HermiteSource {
 };
 
 struct ExtractionOptions {
+    VertexMode vertices = VertexMode::PerComponent;
     QefSolver solver = QefSolver::Svd;
     double svdThreshold = 0.1;  //!< relative to the largest singular value, [0, 1]
     int schmitzIterations = 20; //!< >= 1
@@ -57,12 +64,16 @@ struct ExtractionStats {
     HermiteSource source = HermiteSource::Samples;
     std::size_t crossedEdges = 0;   //!< grid edges with a sign change
     std::size_t hermiteMissing = 0; //!< crossed edges absent from input.hermite (next source used)
-    std::size_t cells = 0;          //!< cells with a sign change = vertices
-    std::size_t quads = 0;          //!< crossed edges with four cells around them
-    std::size_t rank[4] = {0, 0, 0, 0}; //!< cells by QEF rank (SVD solver; Schmitz: 0 or 3)
+    std::size_t cells = 0;          //!< cells with a sign change
+    std::size_t vertices = 0;       //!< all output vertices (patch and face vertices)
+    std::size_t patchVertices = 0;  //!< QEF vertices: one per cell (per_cell) or per patch
+    std::size_t multiVertexCells = 0;   //!< cells with more than one patch vertex
+    std::size_t faceVertices = 0;       //!< vertices on faces that two patches cross twice
+    std::size_t quads = 0;              //!< crossed edges with four cells around them
+    std::size_t rank[4] = {0, 0, 0, 0}; //!< patch vertices by QEF rank (Schmitz: 0 or 3)
     std::size_t skippedNormals = 0;     //!< crossings whose normal was zero, NaN or infinite
-    std::size_t cellsWithoutPlanes = 0; //!< cells placed at their mass point for lack of normals
-    std::size_t leftCell = 0;           //!< vertices outside their cell box before the policy
+    std::size_t cellsWithoutPlanes = 0; //!< patch vertices at their mass point (no normals)
+    std::size_t leftCell = 0;           //!< patch vertices outside their cell box (pre-policy)
     std::size_t flippedSplits = 0;      //!< quads split along the diagonal v1-v3
     std::size_t boundaryVertices = 0;   //!< material boundary vertices (when materials are given)
     double maxRelaxationShift = 0.0;    //!< largest relaxation displacement, cells

@@ -9,6 +9,7 @@
 #include <tbb/partitioner.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cassert>
 #include <cmath>
@@ -270,33 +271,13 @@ private:
     unsigned decideFaces(unsigned cube, std::size_t base) const
     {
         const unsigned ambiguous = mTable.ambiguousFaces(cube);
-        if (ambiguous == 0 || mOptions.ambiguity == AmbiguityRule::SeparateInside)
+        if (ambiguous == 0)
             return 0;
-        if (mOptions.ambiguity == AmbiguityRule::JoinInside)
-            return (1u << std::popcount(ambiguous)) - 1u;
-        unsigned decisions = 0;
-        int bit = 0;
-        for (int f = 0; f < kFaceCount; ++f) {
-            if (((ambiguous >> f) & 1u) == 0)
-                continue;
-            const auto& corners = getCellFaces()[f].corners;
-            double v[4];
-            for (int k = 0; k < 4; ++k)
-                v[k] = mGrid.relative(base + mCornerOffset[corners[k]]);
-            const bool firstInside = ((cube >> corners[0]) & 1u) != 0;
-            const double insideProduct = firstInside ? v[0] * v[2] : v[1] * v[3];
-            const double outsideProduct = firstInside ? v[1] * v[3] : v[0] * v[2];
-            // [Nielson & Hamann 1991] asymptotic decider: the bilinear interpolant on the face has
-            // its saddle value (ac - bd) / (a + c - b - d) (a, c diagonal). With a, c the inside
-            // pair the denominator is negative, so the saddle is inside, and the inside corners
-            // connected through it, exactly when ac > bd. A saddle exactly on the iso-value is
-            // outside, as samples on it are. Both cells sharing the face compute the same two
-            // products from the same four values, so they always agree: the mesh stays closed.
-            if (insideProduct > outsideProduct)
-                decisions |= 1u << bit;
-            ++bit;
-        }
-        return decisions;
+        std::array<double, kCornerCount> values;
+        for (int c = 0; c < kCornerCount; ++c)
+            values[c] = mGrid.relative(base + mCornerOffset[c]);
+        return CaseTable::packDecisions(ambiguous,
+                                        decideJoinedFaces(cube, values, mOptions.ambiguity));
     }
 
     void meshCellLayer(int z, const LayerVertices& lower, const LayerVertices& upper,

@@ -1,6 +1,8 @@
 #pragma once
 // The marching cubes mesher proper: grid walk, shared edge vertices, TBB slabs.
 
+#include "case_table.h"
+
 #include "core/mesh.h"
 #include "plugin/isosurface.h"
 
@@ -9,12 +11,6 @@ namespace rtlab::isosurface::mc {
 enum class VertexPlacement {
     Linear,   //!< crossing of the linear interpolant along the edge
     Midpoint, //!< edge midpoint (the field values only pick the topology)
-};
-
-enum class AmbiguityRule {
-    Asymptotic,     //!< per face, the bilinear interpolant's saddle value decides
-    SeparateInside, //!< inside corners of an ambiguous face are never connected across it
-    JoinInside,     //!< inside corners of an ambiguous face are always connected across it
 };
 
 struct ExtractionOptions {

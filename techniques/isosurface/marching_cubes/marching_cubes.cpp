@@ -20,17 +20,18 @@
 //   zero (or the edge midpoint); when the outside end is exactly on the iso-value the vertex is
 //   exactly that sample. NaN samples are rejected (std::invalid_argument, naming the sample);
 //   +inf / -inf samples are valid (outside / inside) and give finite vertices at the finite end.
-// - The case table is generated at first use (case_table.cpp), not copied: per face, segments
-//   between the crossed edges, oriented with the inside corners on the right seen from outside;
-//   segments chain into loops. Each loop gets its minimum-length triangulation (diagonals measured
-//   between edge midpoints) among those that never join two edges of an ambiguous face that no
-//   segment joins: such a diagonal lies in the face, the neighbouring cell may use it as well, and
-//   the mesh edge would carry four triangles. Loops with no such triangulation (116 of the 1026
-//   loops in the table, all from mixed decisions that only the asymptotic decider makes, at most
-//   one per cell) are fanned around an interior vertex at the centroid of their edge vertices, as
-//   the marching cubes 33 tables do; interior vertices are numbered after all edge vertices.
-//   Triangles wind counter-clockwise seen from the positive side. Entries exist for every
-//   decision on every ambiguous face (1, 2, 4, ... 64 per corner configuration).
+// - The case table is generated at first use (framework/isosurface/case_table.cpp, shared with
+//   dual_contouring), not copied: per face, segments between the crossed edges, oriented with the
+//   inside corners on the right seen from outside; segments chain into loops. Each loop gets its
+//   minimum-length triangulation (diagonals measured between edge midpoints) among those that never
+//   join two edges of an ambiguous face that no segment joins: such a diagonal lies in the face,
+//   the neighbouring cell may use it as well, and the mesh edge would carry four triangles. Loops
+//   with no such triangulation (116 of the 1026 loops in the table, all from mixed decisions that
+//   only the asymptotic decider makes, at most one per cell) are fanned around an interior vertex
+//   at the centroid of their edge vertices, as the marching cubes 33 tables do; interior vertices
+//   are numbered after all edge vertices. Triangles wind counter-clockwise seen from the positive
+//   side. Entries exist for every decision on every ambiguous face (1, 2, 4, ... 64 per corner
+//   configuration).
 // - Ambiguous faces (inside corners on a diagonal) are decided by the asymptotic decider on the
 //   face's four values, or by a fixed rule. Either way the decision depends on the face alone,
 //   which both cells sharing it see identically, so closed surfaces give closed meshes. Ambiguity
