@@ -130,9 +130,16 @@ int runExperimentCommand(const RunOptions& options)
             std::string techniques;
             for (const auto& [family, choice] : r.techniques)
                 techniques += fmt::format(" {}={}({})", family, choice.technique, choice.params.toString());
-            const std::string size = r.techniques.count("isosurface")
-                                          ? fmt::format("grid={}", r.grid)
-                                          : fmt::format("resolution={}x{} frames={}", r.width, r.height, r.frames);
+            std::string size = r.techniques.count("isosurface")
+                                    ? fmt::format("grid={}", r.grid)
+                                    : fmt::format("resolution={}x{} frames={}", r.width, r.height, r.frames);
+            if (!r.cameraPath.empty())
+                size += " camera_path=" + r.cameraPath;
+            if (!r.metrics.empty())
+                size += " metrics=" + joinList(r.metrics);
+            if (!r.reference.quantity.empty() || r.reference.radius > 0.0)
+                size += fmt::format(" reference={}{}", r.reference.quantity.empty() ? "declared" : r.reference.quantity,
+                                    r.reference.radius > 0.0 ? fmt::format("@{}", r.reference.radius) : "");
             fmt::print("  {:>4}  {}  scene={} {}{}\n", i + 1, r.id(), r.scene, size, techniques);
         }
         return kExitOk;
