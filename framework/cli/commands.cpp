@@ -11,9 +11,12 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <regex>
 
 namespace rtlab::cli {
@@ -71,12 +74,16 @@ int listTechniques(const ListOptions& options)
                                          .addRaw("parameters", jsonArray(params))
                                          .str());
             }
+            std::vector<std::string> metricsJson;
+            for (const auto& m : info->metrics)
+                metricsJson.push_back(JsonObject().add("name", m.name).add("doc", m.doc).str());
             familyJson.push_back(JsonObject()
                                      .add("name", f)
                                      .add("summary", info->summary)
                                      .add("input", info->input)
                                      .add("output", info->output)
                                      .add("ground_truth", info->groundTruth)
+                                     .addRaw("metrics", jsonArray(metricsJson))
                                      .addRaw("techniques", jsonArray(techniques))
                                      .str());
         }
@@ -88,6 +95,11 @@ int listTechniques(const ListOptions& options)
         fmt::print("{}: {}\n", f, info->summary);
         fmt::print("  input:        {}\n  output:       {}\n  ground truth: {}\n", info->input, info->output,
                    info->groundTruth);
+        if (!info->metrics.empty()) {
+            fmt::print("  metrics (experiment key `metrics:`; default all):\n");
+            for (const auto& m : info->metrics)
+                fmt::print("    {:<20} {}\n", m.name, m.doc);
+        }
         const auto techniques = registry.techniques(f);
         if (techniques.empty())
             fmt::print("  (no techniques yet: `rtlab new-technique {} <name>` adds one)\n", f);
@@ -275,8 +287,6 @@ int mergeCommand(const MergeOptions& options)
 int bestCommand(const BestOptions& options)
 {
     experiment::BestQuery query;
-    query.costColumn = options.timeColumn;
-    query.errorColumn = options.errorColumn;
     if (!options.maxTime.empty()) {
         try {
             query.maxCost = experiment::parseDurationMs(options.maxTime);
@@ -287,18 +297,53 @@ int bestCommand(const BestOptions& options)
     } else {
         query.maxError = options.maxError;
     }
-    const auto rows = experiment::loadResults(options.resultsDirectory);
+    auto rows = experiment::loadResults(options.resultsDirectory);
     if (rows.empty()) {
         fmt::print(stderr, "rtlab best: {}/results.jsonl has no rows\n", options.resultsDirectory);
         return kExitBadInput;
     }
+    for (const auto& filter : options.where) {
+        const auto eq = filter.find('=');
+        if (eq == std::string::npos || eq == 0) {
+            fmt::print(stderr, "rtlab best: --where '{}': expected column=value\n", filter);
+            return kExitBadInput;
+        }
+        const std::string column = filter.substr(0, eq), value = filter.substr(eq + 1);
+        std::erase_if(rows, [&](const experiment::Row& r) {
+            auto it = r.find(column);
+            return it == r.end() || it->second != value;
+        });
+    }
+    if (rows.empty()) {
+        fmt::print(stderr, "rtlab best: no row matches {}\n", joinList(options.where, "and"));
+        return kExitBadInput;
+    }
+    // Default columns: those the family's report uses.
+    query.costColumn = options.timeColumn;
+    query.errorColumn = options.errorColumn;
+    if (query.costColumn.empty() || query.errorColumn.empty()) {
+        const auto family = rows.front().find("family");
+        try {
+            const report::FamilyColumns columns = report::getFamilyColumns(family == rows.front().end() ? "" : family->second);
+            if (query.costColumn.empty())
+                query.costColumn = columns.cost;
+            if (query.errorColumn.empty())
+                query.errorColumn = columns.error;
+        } catch (const Error&) {
+            fmt::print(stderr, "rtlab best: the rows name no family with default columns; give --time-column and "
+                               "--error-column\n");
+            return kExitBadInput;
+        }
+    }
     for (const auto* column : {&query.costColumn, &query.errorColumn}) {
         bool found = false;
         std::vector<std::string> columns;
-        for (const auto& [k, v] : rows.front()) {
-            columns.push_back(k);
-            found = found || k == *column;
-        }
+        for (const auto& row : rows)
+            for (const auto& [k, v] : row) {
+                if (std::find(columns.begin(), columns.end(), k) == columns.end())
+                    columns.push_back(k);
+                found = found || k == *column;
+            }
         if (!found) {
             const auto close = closestNames(*column, columns);
             fmt::print(stderr, "rtlab best: no column '{}' in the results{}\n", *column,
@@ -306,17 +351,47 @@ int bestCommand(const BestOptions& options)
             return kExitBadInput;
         }
     }
+    const std::string bound = query.maxCost >= 0.0 ? query.costColumn + " <= " + options.maxTime
+                                                    : query.errorColumn + " <= " + config::formatValue(options.maxError);
+    if (options.perTechnique) {
+        // Each technique's best run under the bound, cheapest (or most accurate) first.
+        std::map<std::string, std::vector<experiment::Row>> byTechnique;
+        for (const auto& r : rows)
+            byTechnique[r.count("technique") ? r.at("technique") : "?"].push_back(r);
+        std::vector<std::pair<double, std::string>> lines;
+        for (const auto& [technique, techniqueRows] : byTechnique) {
+            const long b = experiment::findBest(techniqueRows, query);
+            if (b < 0) {
+                lines.push_back({std::numeric_limits<double>::infinity(),
+                                 fmt::format("  {:<16} no run satisfies {}", technique, bound)});
+                continue;
+            }
+            const auto& row = techniqueRows[std::size_t(b)];
+            const double cost = experiment::getNumber(row, query.costColumn);
+            const double error = experiment::getNumber(row, query.errorColumn);
+            std::string params;
+            for (const auto& [k, v] : row)
+                if (k.rfind("param.", 0) == 0)
+                    params += (params.empty() ? "" : " ") + k.substr(6) + "=" + v;
+            lines.push_back({query.maxCost >= 0.0 ? error : cost,
+                             fmt::format("  {:<16} {}={:.4g} {}={:.4g}  {}  ({})", technique, query.costColumn, cost,
+                                         query.errorColumn, error, params, row.at("run_id"))});
+        }
+        std::sort(lines.begin(), lines.end());
+        fmt::print("best run per technique with {}:\n", bound);
+        for (const auto& [key, line] : lines)
+            fmt::print("{}\n", line);
+        return kExitOk;
+    }
     const long best = experiment::findBest(rows, query);
     if (best < 0) {
-        fmt::print("no run satisfies {}\n", query.maxCost >= 0.0 ? options.timeColumn + " <= " + options.maxTime
-                                                                  : options.errorColumn + " <= " +
-                                                                        config::formatValue(options.maxError));
+        fmt::print("no run satisfies {}\n", bound);
         return kExitFailed;
     }
     const auto& row = rows[std::size_t(best)];
     fmt::print("{}\n", row.at("run_id"));
-    fmt::print("  {:<22} {}\n", options.timeColumn, row.at(options.timeColumn));
-    fmt::print("  {:<22} {}\n", options.errorColumn, row.at(options.errorColumn));
+    fmt::print("  {:<22} {}\n", query.costColumn, row.at(query.costColumn));
+    fmt::print("  {:<22} {}\n", query.errorColumn, row.at(query.errorColumn));
     for (const auto& [k, v] : row)
         if (k == "scene" || k == "technique" || k == "grid" || k.rfind("param.", 0) == 0)
             fmt::print("  {:<22} {}\n", k, v);

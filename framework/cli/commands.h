@@ -55,8 +55,10 @@ struct BestOptions {
     std::string resultsDirectory;
     std::string maxTime;   //!< e.g. "5ms"
     double maxError = -1.0;
-    std::string timeColumn = "extract.cpu_ms";
-    std::string errorColumn = "rms_deviation";
+    std::string timeColumn;   //!< "" = the family's time column (report/report.h)
+    std::string errorColumn;  //!< "" = the family's error column
+    std::vector<std::string> where;  //!< "column=value" filters, all must hold
+    bool perTechnique = false;       //!< one answer per technique (the equal-time comparison)
 };
 int bestCommand(const BestOptions& options);
 

@@ -87,9 +87,14 @@ int main(int argc, char** argv)
     auto* maxTime = bestCmd->add_option("--max-time", best.maxTime, "Time budget, e.g. 5ms, 0.5s, 250us");
     auto* maxError = bestCmd->add_option("--max-error", best.maxError, "Error bound (in the error column's unit)");
     maxTime->excludes(maxError);
-    bestCmd->add_option("--time-column", best.timeColumn, "Column holding the time in ms")
-        ->capture_default_str();
-    bestCmd->add_option("--error-column", best.errorColumn, "Column holding the error")->capture_default_str();
+    bestCmd->add_option("--time-column", best.timeColumn,
+                        "Column holding the time in ms (default: the family's, e.g. extract.cpu_ms, technique_ms)");
+    bestCmd->add_option("--error-column", best.errorColumn,
+                        "Column holding the error (default: the family's, e.g. chamfer.mean, ao.rmse)");
+    bestCmd->add_option("--where", best.where,
+                        "Only rows with column=value, e.g. --where scene=tomorrow_town --where width=640 (repeatable)");
+    bestCmd->add_flag("--per-technique", best.perTechnique,
+                      "One answer per technique: each one's best run under the bound (equal-time comparisons)");
 
     NewTechniqueOptions scaffold;
     auto* newCmd = app.add_subcommand("new-technique",

@@ -145,3 +145,29 @@ TEST(Cli, NewTechniqueScaffoldsFromTheTemplate)
     EXPECT_EQ(fam.exitCode, 2);
     EXPECT_NE(fam.output.find("did you mean occlusion?"), std::string::npos) << fam.output;
 }
+
+TEST(Cli, BestAnswersPerTechniqueWithTheFamilysColumnsAndFilters)
+{
+    // A hand-made results table with a known answer: under RMSE 0.05 on scene "a", technique t's
+    // cheapest run is t2 (20 ms), u's is u1 (15 ms); rows of scene "b" are filtered out.
+    const auto dir = freshDirectory("best");
+    std::ofstream(dir / "results.jsonl")
+        << R"({"run_id":"t1","status":"ok","family":"occlusion","scene":"a","technique":"t","technique_ms":10,"ao.rmse":0.08}
+{"run_id":"t2","status":"ok","family":"occlusion","scene":"a","technique":"t","technique_ms":20,"ao.rmse":0.04}
+{"run_id":"t3","status":"ok","family":"occlusion","scene":"a","technique":"t","technique_ms":40,"ao.rmse":0.02}
+{"run_id":"u1","status":"ok","family":"occlusion","scene":"a","technique":"u","technique_ms":15,"ao.rmse":0.05}
+{"run_id":"u0","status":"ok","family":"occlusion","scene":"b","technique":"u","technique_ms":1,"ao.rmse":0.01}
+)";
+    const auto perTechnique = runRtlab("best " + dir.string() + " --max-error 0.05 --per-technique --where scene=a");
+    ASSERT_EQ(perTechnique.exitCode, 0) << perTechnique.output;
+    const auto u = perTechnique.output.find("(u1)"), t = perTechnique.output.find("(t2)");
+    ASSERT_NE(u, std::string::npos) << perTechnique.output;
+    ASSERT_NE(t, std::string::npos) << perTechnique.output;
+    EXPECT_LT(u, t) << "cheapest first: " << perTechnique.output;
+    const auto single = runRtlab("best " + dir.string() + " --max-time 25ms --where scene=a");
+    ASSERT_EQ(single.exitCode, 0) << single.output;
+    EXPECT_EQ(single.output.rfind("t2", 0), 0u) << "lowest error within 25 ms: " << single.output;
+    const auto bad = runRtlab("best " + dir.string() + " --max-error 0.05 --where scene");
+    EXPECT_EQ(bad.exitCode, 2) << bad.output;
+    EXPECT_NE(bad.output.find("column=value"), std::string::npos) << bad.output;
+}
