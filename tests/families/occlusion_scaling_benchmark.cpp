@@ -1,8 +1,8 @@
 // How every registered occlusion technique's cost scales with the image size and with its own
 // direction / sample count. Each technique runs on a synthetic G-buffer (a floor, two walls and a
 // sphere: planes, a crease, a curved surface, silhouettes) at 3 resolutions x 3 values of its
-// knob (the first of `slices`, `directions`, `samples` in its schema: default / 2, default,
-// default x 2), timed by the experiments' harness: metrics::measure around compute(), GPU pass
+// knob (the first of `slices`, `directions`, `samples`, `samples_per_pixel` in its schema:
+// default / 2, default, default x 2), timed by the experiments' harness: metrics::measure around compute(), GPU pass
 // times from the context's run log (experiment/gpu_timing.h: timestamps on a GPU, submit-to-fence
 // wall time on a CPU device such as lavapipe). The scaling exponents come from one least-squares
 // fit per technique over all 9 runs:
@@ -232,7 +232,7 @@ std::optional<Options> parseOptions(int argc, char** argv)
 std::pair<std::string, std::vector<std::int64_t>> chooseKnob(const config::ParamSchema& schema,
                                                              bool quick)
 {
-    for (const char* name : {"slices", "directions", "samples"}) {
+    for (const char* name : {"slices", "directions", "samples", "samples_per_pixel"}) {
         const config::ParamSpec* spec = schema.find(name);
         if (!spec || spec->type != config::ParamType::Int)
             continue;
