@@ -2,8 +2,8 @@
 // direction / sample count. Each technique runs on a synthetic G-buffer (a floor, two walls and a
 // sphere: planes, a crease, a curved surface, silhouettes) at 3 resolutions x 3 values of its
 // knob (the first of `slices`, `directions`, `samples`, `samples_per_pixel` in its schema:
-// default / 2, default, default x 2), timed by the experiments' harness: metrics::measure around compute(), GPU pass
-// times from the context's run log (experiment/gpu_timing.h: timestamps on a GPU, submit-to-fence
+// default / 2, default, default x 2), timed by the experiments' harness: metrics::measure around
+// compute(), GPU pass times from the context's run log (experiment/gpu_timing.h: timestamps on a GPU, submit-to-fence
 // wall time on a CPU device such as lavapipe). The scaling exponents come from one least-squares
 // fit per technique over all 9 runs:
 //   log(time) = a + b log(pixels) + c log(knob)
