@@ -1,6 +1,7 @@
 #include "reference/screen_space_reference.h"
 
 #include "core/error.h"
+#include "reference/bent_estimate.h"
 #include "reference/exr_io.h"
 #include "reference/prepared.h"
 #include "reference/progressive.h"
@@ -396,57 +397,6 @@ void validate(const ScreenSpaceView& view, const ReferenceSettings& settings,
         fail("depthBias must be in [0, 0.1], got " + std::to_string(options.depthBias));
 }
 
-template <class F> double propagateStdErr(F f, double a, double se)
-{
-    if (!(se > 0.0))
-        return 0.0;
-    const double fa = f(a);
-    return std::max(std::abs(f(std::min(1.0, a + se)) - fa),
-                    std::abs(fa - f(std::max(0.0, a - se))));
-}
-
-double computeAperture(double a)
-{
-    return std::asin(std::sqrt(std::clamp(a, 0.0, 1.0))); // sin^2(alpha) = A
-}
-
-double computeApertureUniform(double a)
-{
-    return std::acos(1.0 - std::clamp(a, 0.0, 1.0)); // 1 - cos(alpha) = A_u
-}
-
-//! The bent channels (V w, V, V_u) to the outputs of reference.h, standard errors by the delta
-//! method on the mean vector.
-void storeBent(ReferenceResult& r, std::size_t i, const PixelEstimate& e, const glm::dvec3& normal)
-{
-    const glm::dvec3 m(e.mean[0], e.mean[1], e.mean[2]);
-    const double length = glm::length(m);
-    if (length > 0.0) {
-        const glm::dvec3 u = m / length;
-        r.bentNormal.pixels[i] = glm::vec3(u);
-        // cov(u) = P cov(m) P / |m|^2, P = I - u u^T; trace(P S P) = trace(S) - u^T S u.
-        double trace = 0.0;
-        for (int k = 0; k < 3; ++k) {
-            trace += e.covariance[k * kMaxChannels + k];
-            for (int l = 0; l < 3; ++l)
-                trace -= u[k] * e.covariance[k * kMaxChannels + l] * u[l];
-        }
-        r.bentNormalStdErr.pixels[i] = float(std::sqrt(std::max(0.0, trace)) / length);
-    } else {
-        r.bentNormal.pixels[i] = glm::vec3(normal);
-        r.bentNormalStdErr.pixels[i] = 0.0f;
-    }
-    const double a = e.mean[3];
-    const double au = e.mean[4];
-    r.occlusion.pixels[i] = float(a);
-    r.occlusionStdErr.pixels[i] = float(e.getStdErr(3));
-    r.aperture.pixels[i] = float(computeAperture(a));
-    r.apertureStdErr.pixels[i] = float(propagateStdErr(computeAperture, a, e.getStdErr(3)));
-    r.apertureUniform.pixels[i] = float(computeApertureUniform(au));
-    r.apertureUniformStdErr.pixels[i] =
-        float(propagateStdErr(computeApertureUniform, au, e.getStdErr(4)));
-}
-
 } // namespace
 
 ScreenSpaceResult computeScreenSpaceReference(const ScreenSpaceView& view,
@@ -574,7 +524,7 @@ ScreenSpaceResult computeScreenSpaceReference(const ScreenSpaceView& view,
         for (int c = 0; c < rule.channels; ++c)
             result.stats.maxStdErr = std::max(result.stats.maxStdErr, e.getStdErr(c));
         if (quantity == Quantity::Bent) {
-            storeBent(result, i, e, frames[i].normal);
+            storeBentEstimate(result, i, e, frames[i].normal);
         } else {
             result.occlusion.pixels[i] = float(e.mean[0]);
             result.occlusionStdErr.pixels[i] = float(e.getStdErr(0));

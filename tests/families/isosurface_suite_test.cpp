@@ -1,8 +1,9 @@
 // The isosurface family suite: every registered isosurface technique through the same checks, at
 // its default parameters. A new isosurface plugin inherits them by registering.
 //
-// Each case is a field sampled from an analytic SDF written below (the exact value and gradient
-// are passed too, as the harness does for analytic models). The checks:
+// Each case is a field sampled from an analytic SDF (shapes from isosurface_test_support.h and
+// below; the exact value and gradient are passed too, as the harness does for analytic models).
+// The checks:
 // - closed shapes (sphere, torus, box, off-centre and between sample planes): every undirected
 //   edge is shared by exactly two triangles, each directed edge is used once (consistent
 //   orientation), no triangle repeats a vertex, and the enclosed volume is positive (triangles
@@ -17,11 +18,11 @@
 //   box up to float rounding (kBoundsTolerance below).
 
 #include "core/mesh.h"
+#include "isosurface_test_support.h"
 #include "plugin/isosurface.h"
 #include "plugin/technique.h"
 
 #include <glm/geometric.hpp>
-#include <glm/vec2.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -30,34 +31,17 @@
 #include <functional>
 #include <memory>
 #include <string>
-#include <unordered_map>
 #include <vector>
 
 using namespace rtlab;
 
 namespace {
 
-using Sdf = std::function<double(const glm::dvec3&)>;
+using namespace rtlab::test;
+using Sdf = SdfFunction;
 
 // ---------------------------------------------------------------------------------------------
 // Shapes (SDFs in world units, negative inside)
-
-double computeSphereSdf(const glm::dvec3& p, const glm::dvec3& center, double radius)
-{
-    return glm::length(p - center) - radius;
-}
-
-double computeTorusSdf(const glm::dvec3& p, const glm::dvec3& center, double major, double minor)
-{
-    const glm::dvec3 q = p - center;
-    return glm::length(glm::dvec2(glm::length(glm::dvec2(q.x, q.z)) - major, q.y)) - minor;
-}
-
-double computeBoxSdf(const glm::dvec3& p, const glm::dvec3& center, const glm::dvec3& halfExtent)
-{
-    const glm::dvec3 q = glm::abs(p - center) - halfExtent;
-    return glm::length(glm::max(q, 0.0)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
-}
 
 //! Capsule (rod) from a to b.
 double computeRodSdf(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& b, double radius)
@@ -72,21 +56,6 @@ struct Case {
     plugin::SampledField field;
     Sdf sdf;  //!< exact field; empty when the samples are written directly
 };
-
-plugin::SampledField sampleField(glm::ivec3 samples, glm::dvec3 origin, double spacing,
-                                 const Sdf& sdf)
-{
-    plugin::SampledField field;
-    field.samples = samples;
-    field.origin = origin;
-    field.spacing = spacing;
-    field.values.resize(std::size_t(samples.x) * samples.y * samples.z);
-    for (int z = 0; z < samples.z; ++z)
-        for (int y = 0; y < samples.y; ++y)
-            for (int x = 0; x < samples.x; ++x)
-                field.values[field.index(x, y, z)] = float(sdf(field.position(x, y, z)));
-    return field;
-}
 
 //! A case on n^3 samples spanning `origin` + [0, (n - 1) h]^3.
 Case makeCase(std::string name, int n, glm::dvec3 origin, double h, Sdf sdf)
@@ -275,56 +244,6 @@ void expectValidMesh(const TriangleMesh& mesh, const plugin::SampledField& field
     }
 }
 
-struct EdgeCounts {
-    std::size_t degenerateTriangles = 0;    //!< a vertex repeated within a triangle
-    std::size_t boundaryEdges = 0;          //!< undirected edges used by one triangle
-    std::size_t overusedEdges = 0;          //!< undirected edges used by three or more
-    std::size_t repeatedDirectedEdges = 0;  //!< directed edges used twice: inconsistent winding
-};
-
-EdgeCounts countEdges(const TriangleMesh& mesh)
-{
-    EdgeCounts counts;
-    std::unordered_map<std::uint64_t, int> directed;
-    for (std::size_t f = 0; f < mesh.triangleCount(); ++f) {
-        const std::uint32_t v[3] = {mesh.indices[3 * f], mesh.indices[3 * f + 1],
-                                    mesh.indices[3 * f + 2]};
-        if (v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
-            ++counts.degenerateTriangles;
-            continue;
-        }
-        for (int k = 0; k < 3; ++k)
-            ++directed[(std::uint64_t(v[k]) << 32) | v[(k + 1) % 3]];
-    }
-    for (const auto& [key, count] : directed) {
-        if (count > 1)
-            ++counts.repeatedDirectedEdges;
-        const std::uint64_t a = key >> 32;
-        const std::uint64_t b = key & 0xffffffffu;
-        const auto reverse = directed.find((b << 32) | a);
-        const int reverseCount = reverse == directed.end() ? 0 : reverse->second;
-        if (reverseCount != 0 && a > b)
-            continue;
-        if (count + reverseCount == 1)
-            ++counts.boundaryEdges;
-        if (count + reverseCount > 2)
-            ++counts.overusedEdges;
-    }
-    return counts;
-}
-
-double computeSignedVolume(const TriangleMesh& mesh)
-{
-    double volume = 0.0;
-    for (std::size_t f = 0; f < mesh.triangleCount(); ++f) {
-        const glm::dvec3 a = mesh.positions[mesh.indices[3 * f]];
-        const glm::dvec3 b = mesh.positions[mesh.indices[3 * f + 1]];
-        const glm::dvec3 c = mesh.positions[mesh.indices[3 * f + 2]];
-        volume += glm::dot(a, glm::cross(b, c)) / 6.0;
-    }
-    return volume;
-}
-
 // ---------------------------------------------------------------------------------------------
 // The suite
 
@@ -377,11 +296,11 @@ TEST_P(IsosurfaceSuite, ClosedShapesAreClosedAndConsistentlyOriented)
         const TriangleMesh mesh = extract(c);
         expectValidMesh(mesh, c.field, c.name);
         ASSERT_GT(mesh.triangleCount(), 0u) << c.name;
-        const EdgeCounts e = countEdges(mesh);
-        EXPECT_EQ(e.degenerateTriangles, 0u) << c.name << ": triangles repeating a vertex";
-        EXPECT_EQ(e.boundaryEdges, 0u) << c.name << ": edges used by one triangle (holes)";
-        EXPECT_EQ(e.overusedEdges, 0u) << c.name << ": edges used by three or more triangles";
-        EXPECT_EQ(e.repeatedDirectedEdges, 0u) << c.name << ": inconsistent orientation";
+        const Topology t = analyzeTopology(mesh);
+        EXPECT_EQ(t.badIndices, 0u) << c.name << ": triangles repeating a vertex";
+        EXPECT_EQ(t.boundaryEdges, 0u) << c.name << ": edges used by one triangle (holes)";
+        EXPECT_EQ(t.overusedEdges, 0u) << c.name << ": edges used by three or more triangles";
+        EXPECT_EQ(t.repeatedDirectedEdges, 0u) << c.name << ": inconsistent orientation";
         EXPECT_GT(computeSignedVolume(mesh), 0.0) << c.name << ": triangles face inward";
     }
 }

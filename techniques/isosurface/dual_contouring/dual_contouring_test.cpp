@@ -2,13 +2,13 @@
 
 #include "extraction.h"
 #include "isosurface/case_table.h"
+#include "isosurface_test_support.h"
 #include "plugin/technique.h"
 #include "qef.h"
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
 #include <glm/matrix.hpp>
-#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -23,7 +23,6 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <numeric>
 #include <random>
 #include <string>
 #include <unordered_map>
@@ -35,7 +34,8 @@ void rtlabRegisterTechnique_isosurface_dual_contouring(rtlab::plugin::Registry& 
 namespace rtlab::isosurface {
 namespace {
 
-using Overrides = std::map<std::string, config::ParamValue>;
+using namespace test;
+using Overrides = ParamOverrides;
 using dc::QefSystem;
 
 //! A signed distance function with its gradient, written here so the tests do not depend on the
@@ -134,33 +134,15 @@ Sdf makeTorus(double major, double minor)
             }};
 }
 
-plugin::SampledField sampleField(glm::ivec3 samples, glm::dvec3 origin, double spacing,
-                                 const std::function<double(const glm::dvec3&)>& f)
-{
-    plugin::SampledField field;
-    field.samples = samples;
-    field.origin = origin;
-    field.spacing = spacing;
-    field.values.resize(std::size_t(samples.x) * samples.y * samples.z);
-    for (int z = 0; z < samples.z; ++z)
-        for (int y = 0; y < samples.y; ++y)
-            for (int x = 0; x < samples.x; ++x)
-                field.values[field.index(x, y, z)] = float(f(field.position(x, y, z)));
-    return field;
-}
-
 //! n^3 samples spanning [-1, 1]^3 (spacing 2 / (n - 1)).
 plugin::SampledField sampleUnitCube(int n, const Sdf& sdf)
 {
-    return sampleField(glm::ivec3(n), glm::dvec3(-1.0), 2.0 / (n - 1), sdf.value);
+    return test::sampleUnitCube(n, sdf.value);
 }
 
 config::ParamSet makeParams(const Overrides& overrides = {})
 {
-    config::ParamSet params = config::ParamSet::defaultsOf(DualContouring::declareParams());
-    for (const auto& [name, value] : overrides)
-        params.set(name, value);
-    return params;
+    return test::makeParams<DualContouring>(overrides);
 }
 
 struct Extraction {
@@ -192,80 +174,13 @@ Extraction extract(const plugin::SampledField& field, const Sdf* sdf,
     return result;
 }
 
-struct Topology {
-    std::size_t vertices = 0; //!< referenced by some triangle
-    std::size_t edges = 0;    //!< undirected
-    std::size_t faces = 0;
-    std::size_t badIndices = 0;       //!< out of range or repeated within a triangle
-    std::size_t unbalancedEdges = 0;  //!< a->b used a different number of times than b->a
-    std::size_t nonManifoldEdges = 0; //!< undirected edges not used by exactly two triangles
-    std::size_t repeatedDirected = 0; //!< directed edges used more than once
-    std::size_t unreferenced = 0;
-
-    long euler() const { return long(vertices) - long(edges) + long(faces); }
-};
-
-Topology analyzeTopology(const TriangleMesh& mesh)
-{
-    Topology t;
-    t.faces = mesh.triangleCount();
-    const std::size_t n = mesh.vertexCount();
-    std::unordered_map<std::uint64_t, int> directed;
-    std::vector<bool> used(n, false);
-    for (std::size_t f = 0; f < t.faces; ++f) {
-        const std::uint32_t v[3] = {mesh.indices[3 * f], mesh.indices[3 * f + 1],
-                                    mesh.indices[3 * f + 2]};
-        if (v[0] >= n || v[1] >= n || v[2] >= n || v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
-            ++t.badIndices;
-            continue;
-        }
-        for (int k = 0; k < 3; ++k) {
-            used[v[k]] = true;
-            ++directed[(std::uint64_t(v[k]) << 32) | v[(k + 1) % 3]];
-        }
-    }
-    for (const auto& [key, count] : directed) {
-        if (count > 1)
-            ++t.repeatedDirected;
-        const std::uint64_t a = key >> 32;
-        const std::uint64_t b = key & 0xffffffffu;
-        const auto reverse = directed.find((b << 32) | a);
-        const int reverseCount = reverse == directed.end() ? 0 : reverse->second;
-        if (reverseCount != 0 && a > b)
-            continue; // counted from the other direction
-        ++t.edges;
-        if (count != reverseCount)
-            ++t.unbalancedEdges;
-        if (count + reverseCount != 2)
-            ++t.nonManifoldEdges;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-        if (used[i])
-            ++t.vertices;
-        else
-            ++t.unreferenced;
-    }
-    return t;
-}
-
-//! Every undirected edge shared by exactly two triangles with opposite directions.
-void expectClosedManifold(const Topology& t)
-{
-    EXPECT_GT(t.faces, 0u);
-    EXPECT_EQ(t.badIndices, 0u);
-    EXPECT_EQ(t.unbalancedEdges, 0u) << "holes or inconsistent orientation";
-    EXPECT_EQ(t.nonManifoldEdges, 0u) << "edges not shared by exactly two triangles";
-    EXPECT_EQ(t.repeatedDirected, 0u) << "inconsistent orientation";
-    EXPECT_EQ(t.unreferenced, 0u);
-}
-
 //! Watertight in the weaker sense that holds at non-manifold edges too: every directed edge is
 //! matched by as many reverse uses.
 void expectWatertight(const Topology& t)
 {
     EXPECT_EQ(t.badIndices, 0u);
     EXPECT_EQ(t.unbalancedEdges, 0u) << "holes or inconsistent orientation";
-    EXPECT_EQ(t.unreferenced, 0u);
+    EXPECT_EQ(t.unreferencedVertices, 0u);
 }
 
 //! Vertices whose triangles do not form one closed fan (a single cycle of opposite edges): the
@@ -301,27 +216,6 @@ std::size_t countNonManifoldVertices(const TriangleMesh& mesh)
         bad += !(ok && steps == fan.size());
     }
     return bad;
-}
-
-bool isMeshFinite(const TriangleMesh& mesh)
-{
-    const auto finite = [](const glm::vec3& v) {
-        return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-    };
-    return std::all_of(mesh.positions.begin(), mesh.positions.end(), finite) &&
-           std::all_of(mesh.normals.begin(), mesh.normals.end(), finite);
-}
-
-double computeSignedVolume(const TriangleMesh& mesh)
-{
-    double volume = 0.0;
-    for (std::size_t f = 0; f < mesh.triangleCount(); ++f) {
-        const glm::dvec3 a = mesh.positions[mesh.indices[3 * f]];
-        const glm::dvec3 b = mesh.positions[mesh.indices[3 * f + 1]];
-        const glm::dvec3 c = mesh.positions[mesh.indices[3 * f + 2]];
-        volume += glm::dot(a, glm::cross(b, c)) / 6.0;
-    }
-    return volume;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -631,7 +525,7 @@ TEST(DualContouringCube, AxisAlignedCubeKeepsCornersAndPlanarFaces)
     const double h = field.spacing;
     const Extraction r = extract(field, &sdf);
     const Topology t = analyzeTopology(r.mesh);
-    expectClosedManifold(t);
+    expectClosedOriented(t);
     EXPECT_EQ(t.euler(), 2);
     EXPECT_TRUE(isMeshFinite(r.mesh));
     expectSharpBox(r.mesh, box, 1e-4 * h);
@@ -685,7 +579,7 @@ TEST(DualContouringCube, AxisAlignedCubeFromHermiteDataOfSchmitzSolver)
     const Extraction r =
         extract(field, &sdf,
                 {{"solver", std::string("schmitz")}, {"schmitz_iterations", std::int64_t(400)}});
-    expectClosedManifold(analyzeTopology(r.mesh));
+    expectClosedOriented(analyzeTopology(r.mesh));
     expectSharpBox(r.mesh, box, 1e-4 * field.spacing);
     EXPECT_EQ(r.counters.at("qef_solver"), 1.0);
 }
@@ -720,7 +614,7 @@ TEST(DualContouringSmooth, SphereIsAClosedManifoldOfGenusZero)
             SCOPED_TRACE("n = " + std::to_string(n) + (exact ? " exact" : " samples"));
             const Extraction r = extract(field, exact ? &sdf : nullptr);
             const Topology t = analyzeTopology(r.mesh);
-            expectClosedManifold(t);
+            expectClosedOriented(t);
             EXPECT_EQ(t.euler(), 2);
             EXPECT_TRUE(isMeshFinite(r.mesh));
             double worst = 0.0;
@@ -746,7 +640,7 @@ TEST(DualContouringSmooth, TorusIsAClosedManifoldOfGenusOne)
             SCOPED_TRACE(std::string(exact ? "exact " : "samples ") + solver);
             const Extraction r = extract(field, exact ? &sdf : nullptr, {{"solver", solver}});
             const Topology t = analyzeTopology(r.mesh);
-            expectClosedManifold(t);
+            expectClosedOriented(t);
             EXPECT_EQ(t.euler(), 0);
             EXPECT_TRUE(isMeshFinite(r.mesh));
             EXPECT_GT(computeSignedVolume(r.mesh), 0.0);
@@ -762,10 +656,7 @@ TEST(DualContouringSmooth, TorusIsAClosedManifoldOfGenusOne)
 Sdf makeSuiteTorus()
 {
     const glm::dvec3 c(0.01, -0.02, 0.03);
-    const auto value = [c](const glm::dvec3& p) {
-        const glm::dvec3 q = p - c;
-        return glm::length(glm::dvec2(glm::length(glm::dvec2(q.x, q.z)) - 0.55, q.y)) - 0.2;
-    };
+    const auto value = [c](const glm::dvec3& p) { return computeTorusSdf(p, c, 0.55, 0.2); };
     const auto gradient = [value](const glm::dvec3& p) {
         glm::dvec3 g;
         for (int axis = 0; axis < 3; ++axis) {
@@ -817,7 +708,7 @@ long computeMarchingCubesEuler(const plugin::SampledField& field)
 //! Closed, consistently oriented, edge- and vertex-manifold, and outward.
 void expectClosedTwoManifold(const TriangleMesh& mesh)
 {
-    expectClosedManifold(analyzeTopology(mesh));
+    expectClosedOriented(analyzeTopology(mesh));
     EXPECT_EQ(countNonManifoldVertices(mesh), 0u);
     EXPECT_TRUE(isMeshFinite(mesh));
     EXPECT_GT(computeSignedVolume(mesh), 0.0);
@@ -962,7 +853,7 @@ TEST(DualContouringDegenerate, FacesOnGridPlanesAndExactZeroSamples)
                 const Extraction r =
                     extract(field, exact ? sdf : nullptr, {{"outside_policy", policy}});
                 const Topology t = analyzeTopology(r.mesh);
-                expectClosedManifold(t);
+                expectClosedOriented(t);
                 EXPECT_EQ(t.euler(), 2);
                 EXPECT_TRUE(isMeshFinite(r.mesh));
             }
@@ -1004,7 +895,7 @@ TEST(DualContouringDegenerate, TinyAndHugeScalesGiveTheSameMesh)
             const Extraction r = extract(field, exact ? &sdf : nullptr);
             EXPECT_TRUE(isMeshFinite(r.mesh));
             const Topology t = analyzeTopology(r.mesh);
-            expectClosedManifold(t);
+            expectClosedOriented(t);
             EXPECT_EQ(t.euler(), 2);
             if (!exact)
                 continue;
@@ -1407,7 +1298,7 @@ TEST(DualContouringMaterials, RelaxedVerticesStayOnACurvedExactSurface)
     EXPECT_GT(relaxed.counters.at("material_boundary_vertices"), 0.0);
     EXPECT_EQ(still.mesh.triangleCount(), relaxed.mesh.triangleCount());
     const Topology t = analyzeTopology(relaxed.mesh);
-    expectClosedManifold(t);
+    expectClosedOriented(t);
     EXPECT_EQ(t.euler(), 2);
     EXPECT_TRUE(isMeshFinite(relaxed.mesh));
     std::size_t moved = 0;

@@ -1,10 +1,10 @@
 #include "marching_cubes.h"
 
 #include "case_table.h"
+#include "isosurface_test_support.h"
 #include "plugin/technique.h"
 
 #include <glm/geometric.hpp>
-#include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 #include <tbb/task_arena.h>
@@ -13,14 +13,11 @@
 #include <array>
 #include <bit>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
-#include <numeric>
 #include <random>
 #include <tuple>
-#include <unordered_map>
 #include <vector>
 
 // Defined by RTLAB_REGISTER_TECHNIQUE at the bottom of marching_cubes.cpp.
@@ -29,143 +26,18 @@ void rtlabRegisterTechnique_isosurface_marching_cubes(rtlab::plugin::Registry& r
 namespace rtlab::isosurface {
 namespace {
 
-using Sdf = std::function<double(const glm::dvec3&)>;
-using Overrides = std::map<std::string, config::ParamValue>;
+using namespace test;
+using Sdf = SdfFunction;
 
 //! Float rounding of samples (2^-24 relative, |f| <= 2 here) and of vertex positions (2^-24
 //! relative, |p| <= 10 here) is below 1e-6 by more than an order of magnitude.
 constexpr double kRounding = 1e-6;
 
-plugin::SampledField sampleField(glm::ivec3 samples, glm::dvec3 origin, double spacing,
-                                 const Sdf& sdf)
-{
-    plugin::SampledField field;
-    field.samples = samples;
-    field.origin = origin;
-    field.spacing = spacing;
-    field.values.resize(std::size_t(samples.x) * samples.y * samples.z);
-    for (int z = 0; z < samples.z; ++z)
-        for (int y = 0; y < samples.y; ++y)
-            for (int x = 0; x < samples.x; ++x)
-                field.values[field.index(x, y, z)] = float(sdf(field.position(x, y, z)));
-    return field;
-}
-
-//! n^3 samples spanning [-1, 1]^3.
-plugin::SampledField sampleUnitCube(int n, const Sdf& sdf)
-{
-    return sampleField(glm::ivec3(n), glm::dvec3(-1.0), 2.0 / (n - 1), sdf);
-}
-
-TriangleMesh extractMesh(const plugin::SampledField& field, const Overrides& overrides = {},
+TriangleMesh extractMesh(const plugin::SampledField& field, const ParamOverrides& overrides = {},
                          double isoValue = 0.0)
 {
-    config::ParamSet params = config::ParamSet::defaultsOf(MarchingCubes::declareParams());
-    for (const auto& [name, value] : overrides)
-        params.set(name, value);
-    MarchingCubes technique(params);
-    plugin::IsosurfaceInput input;
-    input.field = &field;
-    input.isoValue = isoValue;
-    TriangleMesh mesh;
-    technique.extract(input, mesh);
-    return mesh;
-}
-
-struct Topology {
-    std::size_t vertices = 0; //!< referenced by some triangle
-    std::size_t edges = 0;    //!< undirected
-    std::size_t faces = 0;
-    std::size_t unreferencedVertices = 0;
-    std::size_t badIndices = 0;            //!< out of range or repeated within a triangle
-    std::size_t boundaryEdges = 0;         //!< undirected edges used by one triangle
-    std::size_t overusedEdges = 0;         //!< undirected edges used by three or more triangles
-    std::size_t repeatedDirectedEdges = 0; //!< directed edges used twice: inconsistent winding
-    std::size_t components = 0;            //!< connected by shared vertices
-
-    long euler() const { return long(vertices) - long(edges) + long(faces); }
-};
-
-std::size_t findRoot(std::vector<std::size_t>& parent, std::size_t i)
-{
-    while (parent[i] != i)
-        i = parent[i] = parent[parent[i]];
-    return i;
-}
-
-Topology analyzeTopology(const TriangleMesh& mesh)
-{
-    Topology t;
-    t.faces = mesh.triangleCount();
-    const std::size_t n = mesh.vertexCount();
-    std::unordered_map<std::uint64_t, int> directed;
-    std::vector<bool> used(n, false);
-    std::vector<std::size_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0);
-    for (std::size_t f = 0; f < t.faces; ++f) {
-        const std::uint32_t v[3] = {mesh.indices[3 * f], mesh.indices[3 * f + 1],
-                                    mesh.indices[3 * f + 2]};
-        if (v[0] >= n || v[1] >= n || v[2] >= n || v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
-            ++t.badIndices;
-            continue;
-        }
-        for (int k = 0; k < 3; ++k) {
-            used[v[k]] = true;
-            ++directed[(std::uint64_t(v[k]) << 32) | v[(k + 1) % 3]];
-            parent[findRoot(parent, v[k])] = findRoot(parent, v[(k + 1) % 3]);
-        }
-    }
-    for (const auto& [key, count] : directed) {
-        if (count > 1)
-            ++t.repeatedDirectedEdges;
-        const std::uint64_t a = key >> 32;
-        const std::uint64_t b = key & 0xffffffffu;
-        const auto reverse = directed.find((b << 32) | a);
-        const int reverseCount = reverse == directed.end() ? 0 : reverse->second;
-        if (reverseCount != 0 && a > b)
-            continue; // counted from the other direction
-        ++t.edges;
-        const int total = count + reverseCount;
-        if (total == 1)
-            ++t.boundaryEdges;
-        if (total > 2)
-            ++t.overusedEdges;
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-        if (!used[i])
-            ++t.unreferencedVertices;
-        else
-            ++t.vertices;
-        if (used[i] && findRoot(parent, i) == i)
-            ++t.components;
-    }
-    return t;
-}
-
-//! Every undirected edge shared by exactly two triangles, each directed edge used once, every
-//! vertex used, no bad index.
-void expectClosedOriented(const Topology& t)
-{
-    EXPECT_GT(t.faces, 0u);
-    EXPECT_EQ(t.badIndices, 0u);
-    EXPECT_EQ(t.boundaryEdges, 0u) << "holes";
-    EXPECT_EQ(t.overusedEdges, 0u) << "edges shared by more than two triangles";
-    EXPECT_EQ(t.repeatedDirectedEdges, 0u) << "inconsistent orientation";
-    EXPECT_EQ(t.unreferencedVertices, 0u);
-    EXPECT_EQ(2 * t.edges, 3 * t.faces);
-}
-
-//! Enclosed volume by the divergence theorem; positive when triangles face outward.
-double computeSignedVolume(const TriangleMesh& mesh)
-{
-    double volume = 0.0;
-    for (std::size_t f = 0; f < mesh.triangleCount(); ++f) {
-        const glm::dvec3 a = mesh.positions[mesh.indices[3 * f]];
-        const glm::dvec3 b = mesh.positions[mesh.indices[3 * f + 1]];
-        const glm::dvec3 c = mesh.positions[mesh.indices[3 * f + 2]];
-        volume += glm::dot(a, glm::cross(b, c)) / 6.0;
-    }
-    return volume;
+    MarchingCubes technique(makeParams<MarchingCubes>(overrides));
+    return extractMeshWith(technique, field, isoValue);
 }
 
 double computeTriangleArea(const TriangleMesh& mesh, std::size_t f)
@@ -176,32 +48,6 @@ double computeTriangleArea(const TriangleMesh& mesh, std::size_t f)
     return 0.5 * glm::length(glm::cross(b - a, c - a));
 }
 
-bool isMeshFinite(const TriangleMesh& mesh)
-{
-    const auto finite = [](const glm::vec3& v) {
-        return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-    };
-    return std::all_of(mesh.positions.begin(), mesh.positions.end(), finite) &&
-           std::all_of(mesh.normals.begin(), mesh.normals.end(), finite);
-}
-
-//! Grid edges whose ends are on opposite sides (f < iso inside), counted independently of the
-//! mesher: there must be exactly one vertex per such edge.
-std::size_t countCrossedEdges(const plugin::SampledField& field, double isoValue = 0.0)
-{
-    std::size_t count = 0;
-    const glm::ivec3 n = field.samples;
-    for (int z = 0; z < n.z; ++z)
-        for (int y = 0; y < n.y; ++y)
-            for (int x = 0; x < n.x; ++x) {
-                const bool in = field.at(x, y, z) < isoValue;
-                count += x + 1 < n.x && in != (field.at(x + 1, y, z) < isoValue);
-                count += y + 1 < n.y && in != (field.at(x, y + 1, z) < isoValue);
-                count += z + 1 < n.z && in != (field.at(x, y, z + 1) < isoValue);
-            }
-    return count;
-}
-
 std::size_t countDuplicatePositions(const TriangleMesh& mesh)
 {
     std::vector<std::array<float, 3>> sorted;
@@ -209,17 +55,6 @@ std::size_t countDuplicatePositions(const TriangleMesh& mesh)
         sorted.push_back({p.x, p.y, p.z});
     std::sort(sorted.begin(), sorted.end());
     return std::size_t(sorted.end() - std::unique(sorted.begin(), sorted.end()));
-}
-
-double computeSphereSdf(const glm::dvec3& p, double radius)
-{
-    return glm::length(p) - radius;
-}
-
-double computeBoxSdf(const glm::dvec3& p, const glm::dvec3& center, const glm::dvec3& halfExtent)
-{
-    const glm::dvec3 q = glm::abs(p - center) - halfExtent;
-    return glm::length(glm::max(q, 0.0)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -485,8 +320,7 @@ TEST(MarchingCubes, TorusIsClosedWithGenusOne)
     const double major = 0.5;
     const double minor = 0.2;
     const Sdf sdf = [&](const glm::dvec3& p) {
-        const glm::dvec2 q(glm::length(glm::dvec2(p.x, p.z)) - major, p.y);
-        return glm::length(q) - minor;
+        return computeTorusSdf(p, glm::dvec3(0.0), major, minor);
     };
     const TriangleMesh mesh = extractMesh(sampleUnitCube(48, sdf));
     const Topology t = analyzeTopology(mesh);

@@ -1,20 +1,16 @@
 #include "vtk_flying_edges.h"
 
+#include "isosurface_test_support.h"
 #include "plugin/technique.h"
 
 #include <glm/geometric.hpp>
-#include <glm/vec2.hpp>
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
 #include <map>
 #include <numbers>
-#include <numeric>
-#include <unordered_map>
-#include <vector>
 
 // Defined by RTLAB_REGISTER_TECHNIQUE at the bottom of vtk_flying_edges.cpp.
 void rtlabRegisterTechnique_isosurface_vtk_flying_edges(rtlab::plugin::Registry& registry);
@@ -22,152 +18,18 @@ void rtlabRegisterTechnique_isosurface_vtk_flying_edges(rtlab::plugin::Registry&
 namespace rtlab::isosurface {
 namespace {
 
-using Sdf = std::function<double(const glm::dvec3&)>;
-using Overrides = std::map<std::string, config::ParamValue>;
+using namespace test;
+using Sdf = SdfFunction;
 
 //! Float rounding of samples and of index-space vertex positions (2^-24 relative, indices <= 64
 //! here) mapped to world units (spacing <= 2/31): below 1e-6.
 constexpr double kRounding = 1e-6;
 
-plugin::SampledField sampleField(glm::ivec3 samples, glm::dvec3 origin, double spacing,
-                                 const Sdf& sdf)
-{
-    plugin::SampledField field;
-    field.samples = samples;
-    field.origin = origin;
-    field.spacing = spacing;
-    field.values.resize(std::size_t(samples.x) * samples.y * samples.z);
-    for (int z = 0; z < samples.z; ++z)
-        for (int y = 0; y < samples.y; ++y)
-            for (int x = 0; x < samples.x; ++x)
-                field.values[field.index(x, y, z)] = float(sdf(field.position(x, y, z)));
-    return field;
-}
-
-//! n^3 samples spanning [-1, 1]^3.
-plugin::SampledField sampleUnitCube(int n, const Sdf& sdf)
-{
-    return sampleField(glm::ivec3(n), glm::dvec3(-1.0), 2.0 / (n - 1), sdf);
-}
-
-TriangleMesh extractMesh(const plugin::SampledField& field, const Overrides& overrides = {},
+TriangleMesh extractMesh(const plugin::SampledField& field, const ParamOverrides& overrides = {},
                          VtkFlyingEdges* keep = nullptr)
 {
-    config::ParamSet params = config::ParamSet::defaultsOf(VtkFlyingEdges::declareParams());
-    for (const auto& [name, value] : overrides)
-        params.set(name, value);
-    VtkFlyingEdges technique(params);
-    plugin::IsosurfaceInput input;
-    input.field = &field;
-    TriangleMesh mesh;
-    (keep != nullptr ? *keep : technique).extract(input, mesh);
-    return mesh;
-}
-
-struct Topology {
-    std::size_t vertices = 0;
-    std::size_t edges = 0;
-    std::size_t faces = 0;
-    std::size_t unreferencedVertices = 0;
-    std::size_t badIndices = 0;
-    std::size_t boundaryEdges = 0;
-    std::size_t overusedEdges = 0;
-    std::size_t repeatedDirectedEdges = 0;
-
-    long euler() const { return long(vertices) - long(edges) + long(faces); }
-};
-
-Topology analyzeTopology(const TriangleMesh& mesh)
-{
-    Topology t;
-    t.faces = mesh.triangleCount();
-    const std::size_t n = mesh.vertexCount();
-    std::unordered_map<std::uint64_t, int> directed;
-    std::vector<bool> used(n, false);
-    for (std::size_t f = 0; f < t.faces; ++f) {
-        const std::uint32_t v[3] = {mesh.indices[3 * f], mesh.indices[3 * f + 1],
-                                    mesh.indices[3 * f + 2]};
-        if (v[0] >= n || v[1] >= n || v[2] >= n || v[0] == v[1] || v[1] == v[2] || v[0] == v[2]) {
-            ++t.badIndices;
-            continue;
-        }
-        for (int k = 0; k < 3; ++k) {
-            used[v[k]] = true;
-            ++directed[(std::uint64_t(v[k]) << 32) | v[(k + 1) % 3]];
-        }
-    }
-    for (const auto& [key, count] : directed) {
-        if (count > 1)
-            ++t.repeatedDirectedEdges;
-        const std::uint64_t a = key >> 32;
-        const std::uint64_t b = key & 0xffffffffu;
-        const auto reverse = directed.find((b << 32) | a);
-        const int reverseCount = reverse == directed.end() ? 0 : reverse->second;
-        if (reverseCount != 0 && a > b)
-            continue;
-        ++t.edges;
-        if (count + reverseCount == 1)
-            ++t.boundaryEdges;
-        if (count + reverseCount > 2)
-            ++t.overusedEdges;
-    }
-    for (std::size_t i = 0; i < n; ++i)
-        (used[i] ? t.vertices : t.unreferencedVertices) += 1;
-    return t;
-}
-
-void expectClosedOriented(const Topology& t)
-{
-    EXPECT_GT(t.faces, 0u);
-    EXPECT_EQ(t.badIndices, 0u);
-    EXPECT_EQ(t.boundaryEdges, 0u) << "holes";
-    EXPECT_EQ(t.overusedEdges, 0u) << "edges shared by more than two triangles";
-    EXPECT_EQ(t.repeatedDirectedEdges, 0u) << "inconsistent orientation";
-    EXPECT_EQ(t.unreferencedVertices, 0u);
-}
-
-//! Enclosed volume by the divergence theorem; positive when triangles face outward.
-double computeSignedVolume(const TriangleMesh& mesh)
-{
-    double volume = 0.0;
-    for (std::size_t f = 0; f < mesh.triangleCount(); ++f) {
-        const glm::dvec3 a = mesh.positions[mesh.indices[3 * f]];
-        const glm::dvec3 b = mesh.positions[mesh.indices[3 * f + 1]];
-        const glm::dvec3 c = mesh.positions[mesh.indices[3 * f + 2]];
-        volume += glm::dot(a, glm::cross(b, c)) / 6.0;
-    }
-    return volume;
-}
-
-bool isMeshFinite(const TriangleMesh& mesh)
-{
-    const auto finite = [](const glm::vec3& v) {
-        return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-    };
-    return std::all_of(mesh.positions.begin(), mesh.positions.end(), finite) &&
-           std::all_of(mesh.normals.begin(), mesh.normals.end(), finite);
-}
-
-//! Grid edges whose ends are on opposite sides of the iso-value: one vertex each.
-std::size_t countCrossedEdges(const plugin::SampledField& field)
-{
-    std::size_t count = 0;
-    const glm::ivec3 n = field.samples;
-    for (int z = 0; z < n.z; ++z)
-        for (int y = 0; y < n.y; ++y)
-            for (int x = 0; x < n.x; ++x) {
-                const bool in = field.at(x, y, z) < 0.0f;
-                count += x + 1 < n.x && in != (field.at(x + 1, y, z) < 0.0f);
-                count += y + 1 < n.y && in != (field.at(x, y + 1, z) < 0.0f);
-                count += z + 1 < n.z && in != (field.at(x, y, z + 1) < 0.0f);
-            }
-    return count;
-}
-
-double computeBoxSdf(const glm::dvec3& p, const glm::dvec3& center, const glm::dvec3& halfExtent)
-{
-    const glm::dvec3 q = glm::abs(p - center) - halfExtent;
-    return glm::length(glm::max(q, 0.0)) + std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+    VtkFlyingEdges technique(makeParams<VtkFlyingEdges>(overrides));
+    return extractMeshWith(keep != nullptr ? *keep : technique, field);
 }
 
 class VtkFlyingEdgesSphere : public ::testing::TestWithParam<int> {};
@@ -235,8 +97,7 @@ INSTANTIATE_TEST_SUITE_P(Resolutions, VtkFlyingEdgesSphere, ::testing::Values(32
 TEST(VtkFlyingEdges, TorusIsClosedWithGenusOne)
 {
     const Sdf sdf = [](const glm::dvec3& p) {
-        const glm::dvec2 q(glm::length(glm::dvec2(p.x, p.z)) - 0.5, p.y);
-        return glm::length(q) - 0.2;
+        return computeTorusSdf(p, glm::dvec3(0.0), 0.5, 0.2);
     };
     const TriangleMesh mesh = extractMesh(sampleUnitCube(48, sdf));
     const Topology t = analyzeTopology(mesh);
