@@ -47,7 +47,7 @@ struct Subject {
     glm::dvec3 boundsMin{0.0}, boundsMax{0.0};
     bool exactDistance = true;
     std::optional<double> volume;
-    std::optional<std::vector<metrics::FeatureSegment>> features;  //!< empty optional = unknown
+    std::optional<std::vector<metrics::FeatureSegment>> features; //!< empty optional = unknown
 };
 
 // CSG edits whose result is an exact distance on its own: one additive primitive (not the
@@ -72,13 +72,15 @@ Subject resolveSubject(const std::string& name)
         std::vector<metrics::FeatureSegment> features;
         if (shape->kind == scene::ShapeKind::Box)
             features = metrics::makeBoxFeatureEdges(shape->center, shape->size);
-        s.features = features;  // sphere and torus: smooth, no features
+        s.features = features; // sphere and torus: smooth, no features
         return s;
     }
     const auto slash = name.find('/');
     if (slash == std::string::npos)
-        throw Error("scene '" + name + "' is neither an analytic shape (" + joinList(scene::analyticShapeNames()) +
-                    ") nor an SDF model named <procedural scene>/<model> (e.g. csg_gallery/rotated_cube)");
+        throw Error(
+            "scene '" + name + "' is neither an analytic shape (" +
+            joinList(scene::analyticShapeNames()) +
+            ") nor an SDF model named <procedural scene>/<model> (e.g. csg_gallery/rotated_cube)");
     const scene::Scene parent = scene::makeProceduralScene(name.substr(0, slash));
     const std::string modelName = name.substr(slash + 1);
     for (const auto& m : parent.sdfModels)
@@ -120,9 +122,9 @@ plugin::SampledField sampleShape(const scene::AnalyticShape& shape, int grid)
     return field;
 }
 
-constexpr std::size_t kSurfacePoints = 50000;   // exact surface points for the Chamfer distance
-constexpr std::size_t kMeshSamples = 50000;     // area-uniform mesh samples for it
-constexpr std::size_t kMaxVtiSamples = 129u * 129u * 129u;  // fields above this are not exported
+constexpr std::size_t kSurfacePoints = 50000; // exact surface points for the Chamfer distance
+constexpr std::size_t kMeshSamples = 50000;   // area-uniform mesh samples for it
+constexpr std::size_t kMaxVtiSamples = 129u * 129u * 129u; // fields above this are not exported
 
 } // namespace
 
@@ -138,7 +140,8 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
     auto technique = entry->create(choice.params);
     auto* mesher = dynamic_cast<plugin::IsosurfaceTechnique*>(technique.get());
     if (!mesher)
-        throw Error("technique '" + choice.technique + "' does not implement the isosurface interface");
+        throw Error("technique '" + choice.technique +
+                    "' does not implement the isosurface interface");
     const config::ParamSet effective = technique->effectiveParams();
     for (const auto& [name, value] : effective.values())
         row.set("param." + name, config::formatValue(value));
@@ -158,8 +161,9 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
             if (subject.model) {
                 // The Dreams-style evaluator: pruned edit lists per 4x4x4 cell, a narrow band of
                 // exact values, Hermite data for dual contouring (sdf/evaluator.h).
-                evaluated = sdf::evaluateModel(*subject.model, sdf::makeModelGrid(*subject.model, run.grid),
-                                               sdf::kAllFrames, {.computeHermite = true, .computeMaterials = true});
+                evaluated = sdf::evaluateModel(
+                    *subject.model, sdf::makeModelGrid(*subject.model, run.grid), sdf::kAllFrames,
+                    {.computeHermite = true, .computeMaterials = true});
                 field = evaluated->field;
             } else {
                 field = sampleShape(*subject.shape, run.grid);
@@ -194,23 +198,27 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
             return metrics::GpuPassTimes{};
         });
         addTimingColumns(row, "extract", report);
-        const double cells = double(field.samples.x - 1) * double(field.samples.y - 1) * double(field.samples.z - 1);
+        const double cells =
+            double(field.samples.x - 1) * double(field.samples.y - 1) * double(field.samples.z - 1);
         row.set("extract.mcells_per_s", cells / (report.cpuMs.median * 1e3));
         for (const auto& [name, value] : technique->counters())
             row.set("counter." + name, value);
         return pipeline::PassOutcome{};
     });
-    graph.addPass({.name = "surface_samples", .reads = {"model"}, .writes = {"surface_points"}}, [&] {
-        surfacePoints = metrics::sampleSdfSurface(subject.distance, subject.gradient, subject.boundsMin,
-                                                  subject.boundsMax, kSurfacePoints);
-        return pipeline::PassOutcome{};
-    });
+    graph.addPass({.name = "surface_samples", .reads = {"model"}, .writes = {"surface_points"}},
+                  [&] {
+                      surfacePoints = metrics::sampleSdfSurface(subject.distance, subject.gradient,
+                                                                subject.boundsMin,
+                                                                subject.boundsMax, kSurfacePoints);
+                      return pipeline::PassOutcome{};
+                  });
     auto metricPass = [&](const std::string& name, std::vector<std::string> reads, auto&& compute) {
-        graph.addPass({.name = "metric." + name, .reads = std::move(reads), .writes = {"metric." + name}},
-                      [&, compute] {
-                          compute();
-                          return pipeline::PassOutcome{};
-                      });
+        graph.addPass(
+            {.name = "metric." + name, .reads = std::move(reads), .writes = {"metric." + name}},
+            [&, compute] {
+                compute();
+                return pipeline::PassOutcome{};
+            });
     };
     metricPass("deviation", {"mesh", "model"}, [&] {
         const auto deviation = metrics::measureSurfaceDeviation(mesh, subject.distance);
@@ -219,7 +227,8 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
             .set("rms_deviation", deviation.rms)
             .set("max_deviation_cells", deviation.maxAbs / field.spacing);
         if (subject.volume)
-            row.set("volume_rel_error", (metrics::computeEnclosedVolume(mesh) - *subject.volume) / *subject.volume);
+            row.set("volume_rel_error",
+                    (metrics::computeEnclosedVolume(mesh) - *subject.volume) / *subject.volume);
     });
     metricPass("topology", {"mesh"}, [&] {
         const auto topology = metrics::analyzeTopology(mesh);
@@ -231,8 +240,9 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
             .set("watertight", topology.watertight());
     });
     metricPass("chamfer", {"mesh", "surface_points"}, [&] {
-        const auto d = metrics::measureMeshDistance(mesh, subject.distance, surfacePoints,
-                                                    {.meshSamples = kMeshSamples, .cellSize = field.spacing});
+        const auto d =
+            metrics::measureMeshDistance(mesh, subject.distance, surfacePoints,
+                                         {.meshSamples = kMeshSamples, .cellSize = field.spacing});
         row.set("chamfer.mean", d.chamferMean)
             .set("chamfer.rms", d.chamferRms)
             .set("hausdorff", d.hausdorff)
@@ -244,8 +254,8 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
         // tenth separates meshers that cut sharp edges (marching cubes misses them by a fraction
         // of a cell, ~0.2 on the gallery's cubes) from those that place vertices on them.
         const double tolerance = 0.1 * field.spacing;
-        const auto score = metrics::measureSharpFeatures(mesh, *subject.features,
-                                                         {.minCreaseDeg = 30.0, .tolerance = tolerance});
+        const auto score = metrics::measureSharpFeatures(
+            mesh, *subject.features, {.minCreaseDeg = 30.0, .tolerance = tolerance});
         row.set("edge.f1_tolerance", tolerance);
         row.set("edge.chamfer", score.edgeChamfer)
             .set("edge.chamfer_cells", score.edgeChamfer / field.spacing)
@@ -261,8 +271,9 @@ std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::stri
             bins += (i ? " " : "") + std::to_string(h.counts[i]);
         row.set("angle.histogram_10deg", bins);
     });
-    metricPass("self_intersections", {"mesh"},
-               [&] { row.set("self_intersections", std::int64_t(metrics::findSelfIntersections(mesh).pairs)); });
+    metricPass("self_intersections", {"mesh"}, [&] {
+        row.set("self_intersections", std::int64_t(metrics::findSelfIntersections(mesh).pairs));
+    });
     graph.addPass({.name = "export", .reads = {"mesh", "field"}, .writes = {"exports"}}, [&] {
         for (const char* extension : {"obj", "ply", "vtp"})
             meshio::writeMesh(mesh, runDirectory + "/mesh." + extension);

@@ -31,7 +31,8 @@ void FrameGraph::addPass(PassDesc desc, std::function<PassOutcome()> run)
         checkKnown(r);
     for (const auto& w : desc.writes)
         if (findExternal(w) || findProducer(w) >= 0)
-            throw Error("frame graph: pass '" + desc.name + "' writes '" + w + "', which already has a producer");
+            throw Error("frame graph: pass '" + desc.name + "' writes '" + w +
+                        "', which already has a producer");
     mPasses.push_back(std::move(desc));
     mCallbacks.push_back(std::move(run));
 }
@@ -47,7 +48,8 @@ const FrameGraph::External* FrameGraph::findExternal(const std::string& resource
 int FrameGraph::findProducer(const std::string& resource) const
 {
     for (std::size_t i = 0; i < mPasses.size(); ++i)
-        if (std::find(mPasses[i].writes.begin(), mPasses[i].writes.end(), resource) != mPasses[i].writes.end())
+        if (std::find(mPasses[i].writes.begin(), mPasses[i].writes.end(), resource) !=
+            mPasses[i].writes.end())
             return int(i);
     return -1;
 }
@@ -65,7 +67,8 @@ std::vector<PassRecord> FrameGraph::plan(const scene::FeatureSet& features,
         for (scene::SceneFeature f : pass.needs)
             if (!features.has(f)) {
                 possible[i] = false;
-                records[i].reason = std::string("the scene has no ") + scene::FeatureSet::getName(f);
+                records[i].reason =
+                    std::string("the scene has no ") + scene::FeatureSet::getName(f);
                 break;
             }
         if (!possible[i])
@@ -82,8 +85,8 @@ std::vector<PassRecord> FrameGraph::plan(const scene::FeatureSet& features,
             const int producer = findProducer(r);
             if (!possible[std::size_t(producer)]) {
                 possible[i] = false;
-                records[i].reason = "input '" + r + "' is not produced: pass '" + mPasses[std::size_t(producer)].name +
-                                    "' is skipped";
+                records[i].reason = "input '" + r + "' is not produced: pass '" +
+                                    mPasses[std::size_t(producer)].name + "' is skipped";
                 break;
             }
         }
@@ -115,9 +118,11 @@ std::vector<PassRecord> FrameGraph::plan(const scene::FeatureSet& features,
                         break;
                     }
                 }
-            records[k].reason = skippedReaders.empty()
-                                    ? "no consumer: the run reads none of its outputs (" + joinList(pass.writes) + ")"
-                                    : "no consumer: its readers (" + joinList(skippedReaders) + ") are skipped";
+            records[k].reason =
+                skippedReaders.empty()
+                    ? "no consumer: the run reads none of its outputs (" + joinList(pass.writes) +
+                          ")"
+                    : "no consumer: its readers (" + joinList(skippedReaders) + ") are skipped";
             continue;
         }
         for (const auto& r : pass.reads)
@@ -133,7 +138,8 @@ std::vector<PassRecord> FrameGraph::plan(const scene::FeatureSet& features,
     return records;
 }
 
-std::vector<PassRecord> FrameGraph::execute(const scene::FeatureSet& features, const std::vector<std::string>& outputs)
+std::vector<PassRecord> FrameGraph::execute(const scene::FeatureSet& features,
+                                            const std::vector<std::string>& outputs)
 {
     std::vector<PassRecord> records = plan(features, outputs);
     for (std::size_t i = 0; i < records.size(); ++i) {

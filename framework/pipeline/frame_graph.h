@@ -14,9 +14,10 @@
 //   FrameGraph graph;
 //   graph.addExternal("scene");
 //   graph.addExternal("previous_frame", frame > 0, "first frame of the run");
-//   graph.addPass({.name = "gbuffer", .reads = {"scene"}, .writes = {"gbuffer"}}, [&] { ...; return PassOutcome{}; });
-//   graph.addPass({.name = "character_pose", .writes = {"characters"}, .needs = {SceneFeature::Characters}}, ...);
-//   const auto records = graph.execute(scene.computeFeatures(), {"ao_metrics", "images"});
+//   graph.addPass({.name = "gbuffer", .reads = {"scene"}, .writes = {"gbuffer"}}, [&] { ...; return
+//   PassOutcome{}; }); graph.addPass({.name = "character_pose", .writes = {"characters"}, .needs =
+//   {SceneFeature::Characters}}, ...); const auto records = graph.execute(scene.computeFeatures(),
+//   {"ao_metrics", "images"});
 
 #include "scene/scene.h"
 
@@ -29,24 +30,24 @@ namespace rtlab::pipeline {
 //! What a pass reports after its callback: ran (the default), or found its work already done.
 struct PassOutcome {
     bool ran = true;
-    std::string reason;  //!< why it did nothing, when !ran
+    std::string reason; //!< why it did nothing, when !ran
 
     static PassOutcome skipped(std::string why) { return {false, std::move(why)}; }
 };
 
 struct PassDesc {
-    std::string name;                          //!< unique in the graph, snake_case
-    std::vector<std::string> reads;            //!< required inputs
-    std::vector<std::string> optionalReads;    //!< used when available, never a reason to skip
-    std::vector<std::string> writes;           //!< each resource has exactly one producer
-    std::vector<scene::SceneFeature> needs;    //!< every one must be in the frame's features
+    std::string name;                       //!< unique in the graph, snake_case
+    std::vector<std::string> reads;         //!< required inputs
+    std::vector<std::string> optionalReads; //!< used when available, never a reason to skip
+    std::vector<std::string> writes;        //!< each resource has exactly one producer
+    std::vector<scene::SceneFeature> needs; //!< every one must be in the frame's features
 };
 
 //! How a pass ended in one frame.
 struct PassRecord {
     std::string name;
     bool ran = false;
-    std::string reason;  //!< why it was skipped; empty when it ran
+    std::string reason; //!< why it was skipped; empty when it ran
 };
 
 class FrameGraph {
@@ -61,9 +62,11 @@ public:
 
     //! Decides which passes run for `features` and the requested `outputs` (resource names the
     //! run keeps: metrics, images), without running anything. Throws for an unknown output.
-    std::vector<PassRecord> plan(const scene::FeatureSet& features, const std::vector<std::string>& outputs) const;
+    std::vector<PassRecord> plan(const scene::FeatureSet& features,
+                                 const std::vector<std::string>& outputs) const;
     //! plan(), then runs the passes that survive in order. Exceptions from a pass propagate.
-    std::vector<PassRecord> execute(const scene::FeatureSet& features, const std::vector<std::string>& outputs);
+    std::vector<PassRecord> execute(const scene::FeatureSet& features,
+                                    const std::vector<std::string>& outputs);
 
     const std::vector<PassDesc>& passes() const { return mPasses; }
 
@@ -74,7 +77,7 @@ private:
         std::string reason;
     };
     const External* findExternal(const std::string& resource) const;
-    int findProducer(const std::string& resource) const;  //!< pass index, -1 when none
+    int findProducer(const std::string& resource) const; //!< pass index, -1 when none
 
     std::vector<External> mExternals;
     std::vector<PassDesc> mPasses;

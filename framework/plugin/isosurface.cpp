@@ -7,8 +7,9 @@ namespace rtlab::plugin {
 const HermiteEdge* HermiteData::find(const glm::ivec3& s, int axis) const
 {
     const std::uint64_t wanted = key(s, axis);
-    const auto it = std::lower_bound(edges.begin(), edges.end(), wanted,
-                                     [&](const HermiteEdge& e, std::uint64_t k) { return key(e.sample, e.axis) < k; });
+    const auto it = std::lower_bound(
+        edges.begin(), edges.end(), wanted,
+        [&](const HermiteEdge& e, std::uint64_t k) { return key(e.sample, e.axis) < k; });
     if (it == edges.end() || key(it->sample, it->axis) != wanted)
         return nullptr;
     return &*it;
@@ -16,8 +17,9 @@ const HermiteEdge* HermiteData::find(const glm::ivec3& s, int axis) const
 
 void HermiteData::sort()
 {
-    std::sort(edges.begin(), edges.end(),
-              [&](const HermiteEdge& a, const HermiteEdge& b) { return key(a.sample, a.axis) < key(b.sample, b.axis); });
+    std::sort(edges.begin(), edges.end(), [&](const HermiteEdge& a, const HermiteEdge& b) {
+        return key(a.sample, a.axis) < key(b.sample, b.axis);
+    });
 }
 
 } // namespace rtlab::plugin

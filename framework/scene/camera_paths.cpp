@@ -17,8 +17,7 @@ namespace {
 constexpr int kGeneratedKeys = 5;
 
 // Keyframes of camera(u), u in [0, 1], spread over `frames` frames at `frameRate`.
-template <class F>
-CameraPath makePath(int frames, float frameRate, F cameraAt)
+template <class F> CameraPath makePath(int frames, float frameRate, F cameraAt)
 {
     const float duration = float(std::max(frames, 2) - 1) / frameRate;
     std::vector<CameraKeyframe> keys;

@@ -58,8 +58,8 @@ scene::SdfModel makeSphereModel()
     return m;
 }
 
-double timeTechnique(const plugin::TechniqueEntry& entry, const plugin::IsosurfaceInput& input, int threads,
-                     int repeats, std::size_t& triangles)
+double timeTechnique(const plugin::TechniqueEntry& entry, const plugin::IsosurfaceInput& input,
+                     int threads, int repeats, std::size_t& triangles)
 {
     config::ParamSet params = config::ParamSet::defaultsOf(entry.schema);
     if (entry.schema.find("threads"))
@@ -103,8 +103,10 @@ int main(int argc, char** argv)
             options.grid = 32;
             options.repeats = 1;
         } else {
-            std::fprintf(stderr, "unknown argument %s; usage: %s [--grid N] [--threads N] [--repeats N] [--quick]\n",
-                         a.c_str(), argv[0]);
+            std::fprintf(
+                stderr,
+                "unknown argument %s; usage: %s [--grid N] [--threads N] [--repeats N] [--quick]\n",
+                a.c_str(), argv[0]);
             return 2;
         }
     }
@@ -117,8 +119,9 @@ int main(int argc, char** argv)
         threadCounts = {1, tbb::info::default_concurrency()};
     const auto techniques = plugin::builtinRegistry().techniques("isosurface");
 
-    std::printf("| field | threads | technique | triangles | median ms | Mcells/s | / vtk_flying_edges | "
-                "/ openvdb_volume_to_mesh |\n|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| field | threads | technique | triangles | median ms | Mcells/s | / vtk_flying_edges | "
+        "/ openvdb_volume_to_mesh |\n|---|---|---|---|---|---|---|---|\n");
     for (const scene::SdfModel& model : {makeSphereModel(), findModel("chamfered_cube")}) {
         const auto evaluated = sdf::evaluateModel(model, sdf::makeModelGrid(model, options.grid));
         const sdf::ExactFunctions exact = sdf::makeExactFunctions(model);
@@ -133,15 +136,17 @@ int main(int argc, char** argv)
             std::map<std::string, double> ms;
             std::map<std::string, std::size_t> tris;
             for (const auto* entry : techniques)
-                ms[entry->info.name] = timeTechnique(*entry, input, threads, options.repeats, tris[entry->info.name]);
+                ms[entry->info.name] =
+                    timeTechnique(*entry, input, threads, options.repeats, tris[entry->info.name]);
             for (const auto* entry : techniques) {
                 const std::string& name = entry->info.name;
                 auto ratio = [&](const char* baseline) {
                     return ms.count(baseline) ? ms[name] / ms[baseline] : 0.0;
                 };
-                std::printf("| %s %dx%dx%d | %d | %s | %zu | %.1f | %.1f | %.2f | %.2f |\n", model.name.c_str(), n.x,
-                            n.y, n.z, threads, name.c_str(), tris[name], ms[name], cells / (ms[name] * 1e3),
-                            ratio("vtk_flying_edges"), ratio("openvdb_volume_to_mesh"));
+                std::printf("| %s %dx%dx%d | %d | %s | %zu | %.1f | %.1f | %.2f | %.2f |\n",
+                            model.name.c_str(), n.x, n.y, n.z, threads, name.c_str(), tris[name],
+                            ms[name], cells / (ms[name] * 1e3), ratio("vtk_flying_edges"),
+                            ratio("openvdb_volume_to_mesh"));
             }
         }
     }

@@ -38,16 +38,26 @@ struct Fixture {
                 return PassOutcome{};
             });
         };
-        pass({.name = "character_pose", .reads = {"scene"}, .writes = {"capsules"}, .needs = {SceneFeature::Characters}});
-        pass({.name = "geometry", .reads = {"scene"}, .optionalReads = {"capsules"}, .writes = {"geometry"}});
+        pass({.name = "character_pose",
+              .reads = {"scene"},
+              .writes = {"capsules"},
+              .needs = {SceneFeature::Characters}});
+        pass({.name = "geometry",
+              .reads = {"scene"},
+              .optionalReads = {"capsules"},
+              .writes = {"geometry"}});
         pass({.name = "gbuffer", .reads = {"geometry"}, .writes = {"gbuffer"}});
         pass({.name = "technique", .reads = {"gbuffer"}, .writes = {"ao", "bent"}});
         pass({.name = "reference", .reads = {"geometry", "gbuffer"}, .writes = {"gt_ao"}});
         pass({.name = "reference_bent", .reads = {"geometry", "gbuffer"}, .writes = {"gt_bent"}});
         pass({.name = "ao_metrics", .reads = {"ao", "gt_ao"}, .writes = {"ao_metrics"}});
         pass({.name = "bent_metrics", .reads = {"bent", "gt_bent"}, .writes = {"bent_metrics"}});
-        pass({.name = "flicker", .reads = {"ao", "gt_ao", "previous_frame"}, .writes = {"flicker"}});
-        pass({.name = "lit", .reads = {"gbuffer"}, .writes = {"lit"}, .needs = {SceneFeature::PointLights}});
+        pass(
+            {.name = "flicker", .reads = {"ao", "gt_ao", "previous_frame"}, .writes = {"flicker"}});
+        pass({.name = "lit",
+              .reads = {"gbuffer"},
+              .writes = {"lit"},
+              .needs = {SceneFeature::PointLights}});
         pass({.name = "lit_metrics", .reads = {"lit"}, .writes = {"lit_metrics"}});
     }
 };
@@ -63,8 +73,9 @@ FeatureSet makeFeatures(std::initializer_list<SceneFeature> list)
 TEST(FrameGraph, RunsEverythingAScenesWithAllFeaturesAndAllOutputsNeeds)
 {
     Fixture f;
-    const auto records = f.graph.execute(makeFeatures({SceneFeature::Characters, SceneFeature::PointLights}),
-                                         {"ao_metrics", "bent_metrics", "flicker", "lit_metrics"});
+    const auto records =
+        f.graph.execute(makeFeatures({SceneFeature::Characters, SceneFeature::PointLights}),
+                        {"ao_metrics", "bent_metrics", "flicker", "lit_metrics"});
     for (const auto& r : records)
         EXPECT_TRUE(r.ran) << r.name << ": " << r.reason;
     EXPECT_EQ(f.ran.size(), 11u);
@@ -81,7 +92,8 @@ TEST(FrameGraph, SkipsPassesWhoseSceneFeatureIsMissingAndTheirReaders)
     EXPECT_FALSE(find(records, "lit").ran);
     EXPECT_EQ(find(records, "lit").reason, "the scene has no point_lights");
     EXPECT_FALSE(find(records, "lit_metrics").ran);
-    EXPECT_EQ(find(records, "lit_metrics").reason, "input 'lit' is not produced: pass 'lit' is skipped");
+    EXPECT_EQ(find(records, "lit_metrics").reason,
+              "input 'lit' is not produced: pass 'lit' is skipped");
     EXPECT_EQ(std::count(f.ran.begin(), f.ran.end(), "lit"), 0);
 }
 
@@ -95,8 +107,8 @@ TEST(FrameGraph, SkipsPassesNobodyReads)
     EXPECT_FALSE(find(records, "bent_metrics").ran);
     EXPECT_TRUE(find(records, "reference").ran);
     EXPECT_TRUE(find(records, "technique").ran);
-    EXPECT_EQ(f.ran, (std::vector<std::string>{"character_pose", "geometry", "gbuffer", "technique", "reference",
-                                               "ao_metrics"}));
+    EXPECT_EQ(f.ran, (std::vector<std::string>{"character_pose", "geometry", "gbuffer", "technique",
+                                               "reference", "ao_metrics"}));
 }
 
 TEST(FrameGraph, AnUnavailableExternalSkipsItsReadersWithTheExternalsReason)
@@ -104,7 +116,8 @@ TEST(FrameGraph, AnUnavailableExternalSkipsItsReadersWithTheExternalsReason)
     Fixture f(/*previousFrame=*/false);
     const auto records = f.graph.execute(FeatureSet{}, {"ao_metrics", "flicker"});
     EXPECT_FALSE(find(records, "flicker").ran);
-    EXPECT_EQ(find(records, "flicker").reason, "input 'previous_frame' is not available: first frame of the run");
+    EXPECT_EQ(find(records, "flicker").reason,
+              "input 'previous_frame' is not available: first frame of the run");
     EXPECT_TRUE(find(records, "ao_metrics").ran);
 }
 
@@ -144,12 +157,15 @@ TEST(FrameGraph, RejectsMalformedGraphs)
     FrameGraph graph;
     graph.addExternal("scene");
     EXPECT_THROW(graph.addExternal("scene"), Error);
-    EXPECT_THROW(graph.addPass({.name = "a", .reads = {"later"}, .writes = {"x"}}, [] { return PassOutcome{}; }),
+    EXPECT_THROW(graph.addPass({.name = "a", .reads = {"later"}, .writes = {"x"}},
+                               [] { return PassOutcome{}; }),
                  Error);
     graph.addPass({.name = "a", .reads = {"scene"}, .writes = {"x"}}, [] { return PassOutcome{}; });
-    EXPECT_THROW(graph.addPass({.name = "a", .reads = {"scene"}, .writes = {"y"}}, [] { return PassOutcome{}; }),
+    EXPECT_THROW(graph.addPass({.name = "a", .reads = {"scene"}, .writes = {"y"}},
+                               [] { return PassOutcome{}; }),
                  Error);
-    EXPECT_THROW(graph.addPass({.name = "b", .reads = {"scene"}, .writes = {"x"}}, [] { return PassOutcome{}; }),
+    EXPECT_THROW(graph.addPass({.name = "b", .reads = {"scene"}, .writes = {"x"}},
+                               [] { return PassOutcome{}; }),
                  Error);
     EXPECT_THROW(graph.plan(FeatureSet{}, {"nothing_writes_this"}), Error);
 }

@@ -20,8 +20,9 @@ std::vector<experiment::Row> runStudy(const std::string& name, const std::string
     std::filesystem::remove_all(dir);
     const auto& registry = plugin::builtinRegistry();
     const auto e = experiment::parseExperiment(text, (dir / "study.yaml").string(), registry);
-    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true,
-                                            .queryVulkanForManifest = false});
+    experiment::runExperiment(
+        e, registry,
+        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     return experiment::loadResults(dir.string());
 }
 
@@ -36,7 +37,8 @@ TEST(IsosurfaceDriver, MeshesAGalleryModelThroughTheEvaluatorWithEveryMetric)
     ASSERT_EQ(rows.size(), 1u);
     const auto& row = rows[0];
     ASSERT_EQ(row.at("status"), "ok") << row.at("error");
-    EXPECT_EQ(row.at("passes").find("evaluate_field:run;extract:run;surface_samples:run"), 0u) << row.at("passes");
+    EXPECT_EQ(row.at("passes").find("evaluate_field:run;extract:run;surface_samples:run"), 0u)
+        << row.at("passes");
     EXPECT_EQ(row.at("passes_skipped"), "0") << row.at("passes");
     // The evaluator ran and culled (0.21 at 24 samples: coarse grids leave little to cull; its
     // own tests bound the rate at 128 samples).
@@ -51,10 +53,13 @@ TEST(IsosurfaceDriver, MeshesAGalleryModelThroughTheEvaluatorWithEveryMetric)
     EXPECT_LT(experiment::getNumber(row, "hausdorff"), cell);
     EXPECT_EQ(experiment::getNumber(row, "self_intersections"), 0.0);
     for (const char* file : {"mesh.obj", "mesh.ply", "mesh.vtp", "field.vti"})
-        EXPECT_TRUE(std::filesystem::exists(std::filesystem::path(row.at("mesh_file")).parent_path() / file)) << file;
+        EXPECT_TRUE(std::filesystem::exists(
+            std::filesystem::path(row.at("mesh_file")).parent_path() / file))
+            << file;
 }
 
-TEST(IsosurfaceDriver, SkipsTheFeatureMetricForAModelWithoutDeclaredFeaturesAndWhatTheRunDoesNotAskFor)
+TEST(IsosurfaceDriver,
+     SkipsTheFeatureMetricForAModelWithoutDeclaredFeaturesAndWhatTheRunDoesNotAskFor)
 {
     const auto rows = runStudy("landscape", R"(base:
   scene: tomorrow_town/landscape
@@ -67,9 +72,10 @@ TEST(IsosurfaceDriver, SkipsTheFeatureMetricForAModelWithoutDeclaredFeaturesAndW
     const auto& row = rows[0];
     ASSERT_EQ(row.at("status"), "ok") << row.at("error");
     const std::string& passes = row.at("passes");
-    EXPECT_NE(passes.find("metric.sharp_features:skipped(input 'feature_curves' is not available: model "
-                          "'tomorrow_town/landscape' declares no sharp feature curves)"),
-              std::string::npos)
+    EXPECT_NE(
+        passes.find("metric.sharp_features:skipped(input 'feature_curves' is not available: model "
+                    "'tomorrow_town/landscape' declares no sharp feature curves)"),
+        std::string::npos)
         << passes;
     EXPECT_NE(passes.find("surface_samples:skipped(no consumer"), std::string::npos) << passes;
     EXPECT_NE(passes.find("metric.topology:run"), std::string::npos) << passes;

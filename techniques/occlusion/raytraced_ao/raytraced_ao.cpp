@@ -48,19 +48,23 @@ namespace rtlab::occlusion {
 plugin::TechniqueInfo RaytracedAo::describe()
 {
     plugin::TechniqueInfo info;
-    info.summary = "ray-traced AO with Embree at a fixed ray count per pixel: the equal-time baseline";
-    info.reference = "Monte Carlo estimate of the cosine-weighted AO integral (the ground truth's estimator, "
-                     "reference/reference.h, stopped at N rays)";
+    info.summary =
+        "ray-traced AO with Embree at a fixed ray count per pixel: the equal-time baseline";
+    info.reference =
+        "Monte Carlo estimate of the cosine-weighted AO integral (the ground truth's estimator, "
+        "reference/reference.h, stopped at N rays)";
     return info;
 }
 
 config::ParamSchema RaytracedAo::declareParams()
 {
     config::ParamSchema schema;
-    schema.addInt("samples_per_pixel", 4, 1, 65536, "rays", "cosine-distributed rays per pixel and frame");
+    schema.addInt("samples_per_pixel", 4, 1, 65536, "rays",
+                  "cosine-distributed rays per pixel and frame");
     schema.addFloat("radius", 1.0, 0.0, std::numeric_limits<double>::infinity(), "world units",
                     "occluders farther than this from the receiver do not count");
-    schema.addBool("rotate_seed_per_frame", true, "new ray directions every frame (the frame index joins the seed)");
+    schema.addBool("rotate_seed_per_frame", true,
+                   "new ray directions every frame (the frame index joins the seed)");
     return schema;
 }
 
@@ -96,11 +100,12 @@ void RaytracedAo::compute(const plugin::OcclusionInput& input, plugin::Occlusion
     settings.quantity = reference::Quantity::Bent;
     settings.radius = mSettings.radius;
     settings.maxSamples = mSettings.samplesPerPixel;
-    settings.batchSize = mSettings.samplesPerPixel;  // one batch: exactly N rays, no stopping rule
+    settings.batchSize = mSettings.samplesPerPixel; // one batch: exactly N rays, no stopping rule
     settings.targetStdErr = 0.0;
     settings.targetRelStdErr = 0.0;
     settings.useCache = false;
-    settings.seed = mSettings.seed + (mSettings.rotateSeedPerFrame ? std::uint64_t(input.frameIndex) : 0u);
+    settings.seed =
+        mSettings.seed + (mSettings.rotateSeedPerFrame ? std::uint64_t(input.frameIndex) : 0u);
 
     const auto start = std::chrono::steady_clock::now();
     reference::ReferenceResult r;
@@ -110,10 +115,12 @@ void RaytracedAo::compute(const plugin::OcclusionInput& input, plugin::Occlusion
     } else {
         // Radius 0 (nothing is within it) and inputs without a scene: the height-field tracer,
         // which defines radius 0 as unoccluded.
-        const reference::ScreenSpaceView view{input.linearDepth, input.normal, input.projection, input.view};
+        const reference::ScreenSpaceView view{input.linearDepth, input.normal, input.projection,
+                                              input.view};
         r = reference::computeScreenSpaceReference(view, settings).reference;
     }
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     mRaysPerSecond = seconds > 0.0 ? double(r.stats.rayCount) / seconds : 0.0;
 
     // World-space bent normals to view space.
@@ -131,9 +138,11 @@ void RaytracedAo::compute(const plugin::OcclusionInput& input, plugin::Occlusion
         // "unoccluded vector minus the occluded part").
         const glm::vec3 b = a >= 1.0f ? (*input.normal).pixels[i] : toView * r.bentNormal.pixels[i];
         const float length = glm::length(b);
-        out.bentNormal.pixels[i] = length > 0.0f && std::isfinite(length) ? b / length : glm::vec3(0.0f);
+        out.bentNormal.pixels[i] =
+            length > 0.0f && std::isfinite(length) ? b / length : glm::vec3(0.0f);
         const float alpha = r.aperture.pixels[i];
-        out.coneAperture.pixels[i] = std::isfinite(alpha) ? std::clamp(alpha, 0.0f, 1.57079633f) : 0.0f;
+        out.coneAperture.pixels[i] =
+            std::isfinite(alpha) ? std::clamp(alpha, 0.0f, 1.57079633f) : 0.0f;
     }
 }
 

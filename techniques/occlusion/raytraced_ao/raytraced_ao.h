@@ -9,10 +9,10 @@
 namespace rtlab::occlusion {
 
 struct RaytracedAoSettings {
-    int samplesPerPixel = 4;  //!< rays per pixel and frame, [1, 65536]
-    double radius = 1.0;      //!< world units, [0, inf]
-    std::uint64_t seed = 0x5eed0fa0;  //!< of the ray directions; differs from the ground truth's
-    bool rotateSeedPerFrame = true;   //!< new directions every frame (frameIndex added to the seed)
+    int samplesPerPixel = 4;         //!< rays per pixel and frame, [1, 65536]
+    double radius = 1.0;             //!< world units, [0, inf]
+    std::uint64_t seed = 0x5eed0fa0; //!< of the ray directions; differs from the ground truth's
+    bool rotateSeedPerFrame = true;  //!< new directions every frame (frameIndex added to the seed)
 };
 
 class RaytracedAo final : public plugin::OcclusionTechnique {

@@ -97,14 +97,17 @@ TEST(RaytracedAo, UsesOtherDirectionsThanTheGroundTruthAndNewOnesEachFrame)
     settings.targetStdErr = 0.0;
     settings.targetRelStdErr = 0.0;
     settings.useCache = false;
-    const auto sameBudgetTruth = reference::computeReference(f.scene, f.g, settings);  // seed 0, 8 rays
+    const auto sameBudgetTruth =
+        reference::computeReference(f.scene, f.g, settings); // seed 0, 8 rays
     RaytracedAo technique(makeParams(8));
     plugin::OcclusionOutput frame0, frame1;
     technique.compute(f.input, frame0);
     f.input.frameIndex = 1;
     technique.compute(f.input, frame1);
-    EXPECT_GT(rmse(frame0.ambient, sameBudgetTruth.occlusion, f.g), 0.0) << "correlated with the ground truth";
-    EXPECT_GT(rmse(frame0.ambient, frame1.ambient, f.g), 0.0) << "the same directions in two frames";
+    EXPECT_GT(rmse(frame0.ambient, sameBudgetTruth.occlusion, f.g), 0.0)
+        << "correlated with the ground truth";
+    EXPECT_GT(rmse(frame0.ambient, frame1.ambient, f.g), 0.0)
+        << "the same directions in two frames";
 }
 
 TEST(RaytracedAo, BentNormalsAreUnitViewSpaceVectorsInTheNormalsHemisphere)
