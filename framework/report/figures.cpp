@@ -14,7 +14,6 @@
 #include <set>
 #include <sstream>
 #include <cstdio>
-#include <cstring>
 
 namespace rtlab::report::detail {
 
@@ -122,38 +121,50 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
         line.yScale = plot::AxisScale::Log;
         line.colors = colors;
         std::string orders;
-        for (const auto& [technique, runs] : byTechnique) {
-            std::map<double, std::pair<double, int>> byCell;
-            for (const RunSummary* run : runs) {
-                const double h = run->get("cell_size"), e = run->get(columns.error);
-                if (h > 0.0 && e > 0.0 && std::isfinite(e)) {
-                    byCell[h].first += e;
-                    byCell[h].second += 1;
+        // One line per technique and configuration (the other swept parameters), so that variants
+        // that converge at different orders (e.g. linear vs midpoint vertices) are not averaged.
+        std::vector<std::string> configParams;
+        for (const auto& p : group.varyingParams)
+            if (p != "grid")
+                configParams.push_back(p);
+        for (const auto& [technique, techniqueRuns] : byTechnique) {
+            std::map<std::string, std::vector<const RunSummary*>> byConfig;
+            for (const RunSummary* run : techniqueRuns)
+                byConfig[describeRun(*run, configParams)].push_back(run);
+            for (const auto& [config, runs] : byConfig) {
+                std::map<double, std::pair<double, int>> byCell;
+                for (const RunSummary* run : runs) {
+                    const double h = run->get("cell_size"), e = run->get(columns.error);
+                    if (h > 0.0 && e > 0.0 && std::isfinite(e)) {
+                        byCell[h].first += e;
+                        byCell[h].second += 1;
+                    }
                 }
+                if (byCell.size() < 2)
+                    continue;
+                plot::Series s;
+                double sx = 0, sy = 0, sxx = 0, sxy = 0;
+                for (const auto& [h, sum] : byCell) {
+                    const double e = sum.first / sum.second;
+                    s.x.push_back(h);
+                    s.y.push_back(e);
+                    const double lx = std::log(h), ly = std::log(e);
+                    sx += lx;
+                    sy += ly;
+                    sxx += lx * lx;
+                    sxy += lx * ly;
+                }
+                const double n = double(byCell.size());
+                const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+                char text[64];
+                std::snprintf(text, sizeof text, "%.2f", order);
+                const std::string name = technique + (config.empty() ? "" : " " + config);
+                s.label = name + " (order " + text + ")";
+                orders += (orders.empty() ? "" : ", ") + name + " " + text;
+                plot::Color c = line.colors.getColor(technique);
+                line.colors.setColor(s.label, c);
+                line.series.push_back(std::move(s));
             }
-            if (byCell.size() < 2)
-                continue;
-            plot::Series s;
-            double sx = 0, sy = 0, sxx = 0, sxy = 0;
-            for (const auto& [h, sum] : byCell) {
-                const double e = sum.first / sum.second;
-                s.x.push_back(h);
-                s.y.push_back(e);
-                const double lx = std::log(h), ly = std::log(e);
-                sx += lx;
-                sy += ly;
-                sxx += lx * lx;
-                sxy += lx * ly;
-            }
-            const double n = double(byCell.size());
-            const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-            char text[64];
-            std::snprintf(text, sizeof text, " (order %.2f)", order);
-            s.label = technique + text;
-            orders += (orders.empty() ? "" : ", ") + technique + " " + std::string(text + 8, text + std::strlen(text) - 1);
-            plot::Color c = line.colors.getColor(technique);
-            line.colors.setColor(s.label, c);
-            line.series.push_back(std::move(s));
         }
         if (!line.series.empty()) {
             const std::string path = plots + "/convergence_" + stem;
