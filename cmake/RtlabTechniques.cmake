@@ -35,7 +35,7 @@ function(rtlab_add_technique name)
     set_property(GLOBAL APPEND PROPERTY RTLAB_TECHNIQUE_TARGETS ${_target})
     if(_t_TESTS)
         rtlab_add_test(${_t_FAMILY}_${name}_test SOURCES ${_t_TESTS}
-            LIBS ${_target} ${_t_LIBS} ${_t_TEST_LIBS} LABELS "technique;${_t_FAMILY}")
+            LIBS ${_target} rtlab_families ${_t_LIBS} ${_t_TEST_LIBS} LABELS "technique;${_t_FAMILY}")
         target_include_directories(${_t_FAMILY}_${name}_test PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
         target_compile_definitions(${_t_FAMILY}_${name}_test PRIVATE
             RTLAB_TECHNIQUE_DIR="${CMAKE_CURRENT_SOURCE_DIR}")

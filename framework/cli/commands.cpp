@@ -93,8 +93,8 @@ int listTechniques(const ListOptions& options)
     for (const auto& f : families) {
         const auto* info = registry.findFamily(f);
         fmt::print("{}: {}\n", f, info->summary);
-        fmt::print("  input:        {}\n  output:       {}\n  ground truth: {}\n", info->input, info->output,
-                   info->groundTruth);
+        fmt::print("  input:        {}\n  output:       {}\n  ground truth: {}\n", info->input,
+                   info->output, info->groundTruth);
         if (!info->metrics.empty()) {
             fmt::print("  metrics (experiment key `metrics:`; default all):\n");
             for (const auto& m : info->metrics)
@@ -111,11 +111,12 @@ int listTechniques(const ListOptions& options)
                 fmt::print("    (no parameters)\n");
                 continue;
             }
-            fmt::print("    {:<22} {:<6} {:<10} {:<22} {:<12} {}\n", "parameter", "type", "default", "range",
-                       "unit", "doc");
+            fmt::print("    {:<22} {:<6} {:<10} {:<22} {:<12} {}\n", "parameter", "type", "default",
+                       "range", "unit", "doc");
             for (const auto& s : t->schema.specs())
-                fmt::print("    {:<22} {:<6} {:<10} {:<22} {:<12} {}\n", s.name, config::toString(s.type),
-                           config::formatValue(s.defaultValue), s.describeRange(), s.unit, s.doc);
+                fmt::print("    {:<22} {:<6} {:<10} {:<22} {:<12} {}\n", s.name,
+                           config::toString(s.type), config::formatValue(s.defaultValue),
+                           s.describeRange(), s.unit, s.doc);
         }
         fmt::print("\n");
     }
@@ -141,17 +142,20 @@ int runExperimentCommand(const RunOptions& options)
             const auto& r = e.runs[i];
             std::string techniques;
             for (const auto& [family, choice] : r.techniques)
-                techniques += fmt::format(" {}={}({})", family, choice.technique, choice.params.toString());
-            std::string size = r.techniques.count("isosurface")
-                                    ? fmt::format("grid={}", r.grid)
-                                    : fmt::format("resolution={}x{} frames={}", r.width, r.height, r.frames);
+                techniques +=
+                    fmt::format(" {}={}({})", family, choice.technique, choice.params.toString());
+            std::string size =
+                r.volume ? fmt::format("grid={}", r.grid)
+                         : fmt::format("resolution={}x{} frames={}", r.width, r.height, r.frames);
             if (!r.cameraPath.empty())
                 size += " camera_path=" + r.cameraPath;
             if (!r.metrics.empty())
                 size += " metrics=" + joinList(r.metrics);
             if (!r.reference.quantity.empty() || r.reference.radius > 0.0)
-                size += fmt::format(" reference={}{}", r.reference.quantity.empty() ? "declared" : r.reference.quantity,
-                                    r.reference.radius > 0.0 ? fmt::format("@{}", r.reference.radius) : "");
+                size += fmt::format(
+                    " reference={}{}",
+                    r.reference.quantity.empty() ? "declared" : r.reference.quantity,
+                    r.reference.radius > 0.0 ? fmt::format("@{}", r.reference.radius) : "");
             fmt::print("  {:>4}  {}  scene={} {}{}\n", i + 1, r.id(), r.scene, size, techniques);
         }
         return kExitOk;
@@ -168,13 +172,16 @@ int runExperimentCommand(const RunOptions& options)
     }
     const auto summary = experiment::runExperiment(e, registry, runnerOptions);
     fmt::print("{}: {} run(s){}: {} computed, {} already done, {} failed\n", e.name, summary.total,
-               options.shard.empty() ? "" : " in shard " + options.shard,
-               summary.succeeded, summary.alreadyDone, summary.failed);
-    fmt::print("results: {}/results.csv (and results.jsonl, manifest.json)\n", summary.outputDirectory);
-    if (options.report && summary.succeeded + summary.alreadyDone > 0 && reportCommand(summary.outputDirectory) != kExitOk)
+               options.shard.empty() ? "" : " in shard " + options.shard, summary.succeeded,
+               summary.alreadyDone, summary.failed);
+    fmt::print("results: {}/results.csv (and results.jsonl, manifest.json)\n",
+               summary.outputDirectory);
+    if (options.report && summary.succeeded + summary.alreadyDone > 0 &&
+        reportCommand(summary.outputDirectory) != kExitOk)
         return kExitFailed;
     if (summary.failed > 0) {
-        fmt::print(stderr, "{} run(s) failed; their errors are in the 'error' column of the results.\n",
+        fmt::print(stderr,
+                   "{} run(s) failed; their errors are in the 'error' column of the results.\n",
                    summary.failed);
         return kExitFailed;
     }
@@ -198,60 +205,148 @@ static std::string toPascalCase(const std::string& snake)
     return out;
 }
 
-int newTechnique(const NewTechniqueOptions& options)
+// Copies every regular file of `templateDir` into `target` with the substitutions applied, the
+// ".in" suffix dropped (unless keepSuffix) and `placeholder` in file names replaced by `name`.
+static std::vector<std::string>
+fillTemplate(const fs::path& templateDir, const fs::path& target, const std::string& placeholder,
+             const std::string& name,
+             const std::vector<std::pair<std::string, std::string>>& substitutions,
+             const std::vector<std::string>& excluded = {}, bool keepSuffix = false)
 {
-    const auto& registry = plugin::builtinRegistry();
-    if (!registry.findFamily(options.family)) {
-        const auto close = closestNames(options.family, registry.familyNames());
-        fmt::print(stderr, "rtlab new-technique: unknown family '{}'{}. Families: {}.\n", options.family,
-                   close.empty() ? "" : "; did you mean " + joinList(close, "or") + "?",
-                   joinList(registry.familyNames()));
-        return kExitBadInput;
-    }
-    if (!std::regex_match(options.name, std::regex("[a-z][a-z0-9_]*")) || options.name.back() == '_') {
-        fmt::print(stderr,
-                   "rtlab new-technique: name '{}' must be snake_case: a lowercase letter, then lowercase "
-                   "letters, digits and single underscores (e.g. my_ao)\n",
-                   options.name);
-        return kExitBadInput;
-    }
-    const fs::path root = options.sourceDirectory.empty() ? defaultSourceDirectory() : options.sourceDirectory;
-    const fs::path templateDir = root / "techniques" / "_template" / options.family;
-    const fs::path target = root / "techniques" / options.family / options.name;
-    if (!fs::is_directory(templateDir)) {
-        fmt::print(stderr, "rtlab new-technique: no template for family '{}' at {}\n", options.family,
-                   templateDir.string());
-        return kExitEnvironment;
-    }
-    if (fs::exists(target)) {
-        fmt::print(stderr, "rtlab new-technique: {} already exists; choose another name\n", target.string());
-        return kExitBadInput;
-    }
-    const std::string className = toPascalCase(options.name);
     fs::create_directories(target);
     std::vector<std::string> written;
     for (const auto& entry : fs::directory_iterator(templateDir)) {
         if (!entry.is_regular_file())
             continue;
         std::string fileName = entry.path().filename().string();
-        if (fileName.ends_with(".in"))
+        if (std::find(excluded.begin(), excluded.end(), fileName) != excluded.end())
+            continue;
+        if (!keepSuffix && fileName.ends_with(".in"))
             fileName.resize(fileName.size() - 3);
-        for (auto pos = fileName.find("technique"); pos != std::string::npos; pos = fileName.find("technique"))
-            fileName.replace(pos, 9, options.name);
+        if (!placeholder.empty())
+            for (auto pos = fileName.find(placeholder); pos != std::string::npos;
+                 pos = fileName.find(placeholder))
+                fileName.replace(pos, placeholder.size(), name);
         std::string text = readTextFile(entry.path().string());
-        const std::pair<std::string, std::string> substitutions[] = {
-            {"@NAME@", options.name}, {"@CLASS@", className}, {"@FAMILY@", options.family}};
         for (const auto& [from, to] : substitutions)
-            for (auto pos = text.find(from); pos != std::string::npos; pos = text.find(from, pos + to.size()))
+            for (auto pos = text.find(from); pos != std::string::npos;
+                 pos = text.find(from, pos + to.size()))
                 text.replace(pos, from.size(), to);
         std::ofstream(target / fileName) << text;
         written.push_back(fileName);
     }
     std::sort(written.begin(), written.end());
+    return written;
+}
+
+int newTechnique(const NewTechniqueOptions& options)
+{
+    const auto& registry = plugin::builtinRegistry();
+    if (!registry.findFamily(options.family)) {
+        const auto close = closestNames(options.family, registry.familyNames());
+        fmt::print(stderr, "rtlab new-technique: unknown family '{}'{}. Families: {}.\n",
+                   options.family,
+                   close.empty() ? "" : "; did you mean " + joinList(close, "or") + "?",
+                   joinList(registry.familyNames()));
+        return kExitBadInput;
+    }
+    if (!std::regex_match(options.name, std::regex("[a-z][a-z0-9_]*")) ||
+        options.name.back() == '_') {
+        fmt::print(
+            stderr,
+            "rtlab new-technique: name '{}' must be snake_case: a lowercase letter, then lowercase "
+            "letters, digits and single underscores (e.g. my_ao)\n",
+            options.name);
+        return kExitBadInput;
+    }
+    const fs::path root =
+        options.sourceDirectory.empty() ? defaultSourceDirectory() : options.sourceDirectory;
+    const fs::path templateDir = root / "techniques" / "_template" / options.family;
+    const fs::path target = root / "techniques" / options.family / options.name;
+    if (!fs::is_directory(templateDir)) {
+        fmt::print(stderr, "rtlab new-technique: no template for family '{}' at {}\n",
+                   options.family, templateDir.string());
+        return kExitEnvironment;
+    }
+    if (fs::exists(target)) {
+        fmt::print(stderr, "rtlab new-technique: {} already exists; choose another name\n",
+                   target.string());
+        return kExitBadInput;
+    }
+    const auto written = fillTemplate(templateDir, target, "technique", options.name,
+                                      {{"@NAME@", options.name},
+                                       {"@CLASS@", toPascalCase(options.name)},
+                                       {"@FAMILY@", options.family},
+                                       {"@FAMILY_CLASS@", toPascalCase(options.family)}});
     fmt::print("created {}/ ({})\n", target.string(), joinList(written));
     fmt::print("next: rebuild (cmake --build build) and it appears in `rtlab list --family {}`;\n"
                "      its unit test runs as ctest -R {}_{}\n",
                options.family, options.family, options.name);
+    return kExitOk;
+}
+
+// ---------------------------------------------------------------------------------- new-family
+
+int newFamily(const NewFamilyOptions& options)
+{
+    const auto& registry = plugin::builtinRegistry();
+    if (!std::regex_match(options.name, std::regex("[a-z][a-z0-9_]*")) ||
+        options.name.back() == '_' || options.name.front() == '_') {
+        fmt::print(stderr,
+                   "rtlab new-family: name '{}' must be snake_case: a lowercase letter, then "
+                   "lowercase letters, "
+                   "digits and single underscores (e.g. volumetric_fog)\n",
+                   options.name);
+        return kExitBadInput;
+    }
+    const fs::path root =
+        options.sourceDirectory.empty() ? defaultSourceDirectory() : options.sourceDirectory;
+    const fs::path templateDir = root / "framework" / "families" / "_template";
+    const fs::path familyDir = root / "framework" / "families" / options.name;
+    const fs::path techniqueTemplateDir = root / "techniques" / "_template" / options.name;
+    const std::string example = options.name + "_example";
+    const fs::path exampleDir = root / "techniques" / options.name / example;
+    const fs::path experimentFile = root / "experiments" / (options.name + ".yaml");
+    if (registry.findFamily(options.name) || fs::exists(familyDir)) {
+        fmt::print(stderr, "rtlab new-family: family '{}' already exists; choose another name\n",
+                   options.name);
+        return kExitBadInput;
+    }
+    if (!fs::is_directory(templateDir)) {
+        fmt::print(stderr, "rtlab new-family: no family template at {}\n", templateDir.string());
+        return kExitEnvironment;
+    }
+    for (const fs::path& p : {techniqueTemplateDir, exampleDir, experimentFile})
+        if (fs::exists(p)) {
+            fmt::print(stderr, "rtlab new-family: {} already exists; choose another name\n",
+                       p.string());
+            return kExitBadInput;
+        }
+    const std::string familyClass = toPascalCase(options.name);
+    // The family folder, without the technique template and the experiment.
+    std::vector<std::string> written =
+        fillTemplate(templateDir, familyDir, "NAME", options.name,
+                     {{"@NAME@", options.name}, {"@CLASS@", familyClass}}, {"experiment.yaml.in"});
+    fmt::print("created {}/ ({})\n", familyDir.string(), joinList(written));
+    // The technique template of the new family: @FAMILY@ filled in, @NAME@ and @CLASS@ left for
+    // `rtlab new-technique`.
+    written = fillTemplate(templateDir / "technique", techniqueTemplateDir, "", "",
+                           {{"@FAMILY@", options.name}, {"@FAMILY_CLASS@", familyClass}}, {},
+                           /*keepSuffix=*/true);
+    fmt::print("created {}/ ({})\n", techniqueTemplateDir.string(), joinList(written));
+    written = fillTemplate(techniqueTemplateDir, exampleDir, "technique", example,
+                           {{"@NAME@", example}, {"@CLASS@", toPascalCase(example)}});
+    fmt::print("created {}/ ({})\n", exampleDir.string(), joinList(written));
+    std::string study = readTextFile((templateDir / "experiment.yaml.in").string());
+    for (auto pos = study.find("@NAME@"); pos != std::string::npos;
+         pos = study.find("@NAME@", pos + options.name.size()))
+        study.replace(pos, 6, options.name);
+    fs::create_directories(experimentFile.parent_path());
+    std::ofstream(experimentFile) << study;
+    fmt::print("created {}\n", experimentFile.string());
+    fmt::print("next: rebuild (cmake --build build); `rtlab list --family {0}` shows it;\n"
+               "      build/rtlab run experiments/{0}.yaml writes results/{0}/report.html\n",
+               options.name);
     return kExitOk;
 }
 
@@ -260,8 +355,10 @@ int newTechnique(const NewTechniqueOptions& options)
 int reportCommand(const std::string& resultsDirectory)
 {
     try {
-        const report::ReportSummary s = report::writeStudyReport(resultsDirectory);
-        fmt::print("report: {} ({} plots in {}/plots, each .png and .pdf)\n", s.html, s.plots.size(), resultsDirectory);
+        const report::ReportSummary s =
+            report::writeStudyReport(resultsDirectory, plugin::builtinRegistry());
+        fmt::print("report: {} ({} plots in {}/plots, each .png and .pdf)\n", s.html,
+                   s.plots.size(), resultsDirectory);
         return kExitOk;
     } catch (const std::exception& e) {
         fmt::print(stderr, "rtlab report: {}\n", e.what());
@@ -274,9 +371,10 @@ int reportCommand(const std::string& resultsDirectory)
 int mergeCommand(const MergeOptions& options)
 {
     try {
-        const std::size_t rows = experiment::mergeShards(options.shardDirectories, options.outputDirectory);
-        fmt::print("merged {} shard(s): {} row(s) in {}/results.csv\n", options.shardDirectories.size(), rows,
-                   options.outputDirectory);
+        const std::size_t rows =
+            experiment::mergeShards(options.shardDirectories, options.outputDirectory);
+        fmt::print("merged {} shard(s): {} row(s) in {}/results.csv\n",
+                   options.shardDirectories.size(), rows, options.outputDirectory);
         return kExitOk;
     } catch (const Error& e) {
         fmt::print(stderr, "rtlab merge: {}\n", e.what());
@@ -324,14 +422,17 @@ int bestCommand(const BestOptions& options)
     if (query.costColumn.empty() || query.errorColumn.empty()) {
         const auto family = rows.front().find("family");
         try {
-            const report::FamilyColumns columns = report::getFamilyColumns(family == rows.front().end() ? "" : family->second);
+            const report::FamilyColumns columns = report::getFamilyColumns(
+                plugin::builtinRegistry(), family == rows.front().end() ? "" : family->second);
             if (query.costColumn.empty())
                 query.costColumn = columns.cost;
             if (query.errorColumn.empty())
                 query.errorColumn = columns.error;
         } catch (const Error&) {
-            fmt::print(stderr, "rtlab best: the rows name no family with default columns; give --time-column and "
-                               "--error-column\n");
+            fmt::print(
+                stderr,
+                "rtlab best: the rows name no family with default columns; give --time-column and "
+                "--error-column\n");
             return kExitBadInput;
         }
     }
@@ -351,8 +452,9 @@ int bestCommand(const BestOptions& options)
             return kExitBadInput;
         }
     }
-    const std::string bound = query.maxCost >= 0.0 ? query.costColumn + " <= " + options.maxTime
-                                                    : query.errorColumn + " <= " + config::formatValue(options.maxError);
+    const std::string bound =
+        query.maxCost >= 0.0 ? query.costColumn + " <= " + options.maxTime
+                             : query.errorColumn + " <= " + config::formatValue(options.maxError);
     if (options.perTechnique) {
         // Each technique's best run under the bound, cheapest (or most accurate) first.
         std::map<std::string, std::vector<experiment::Row>> byTechnique;
@@ -373,9 +475,10 @@ int bestCommand(const BestOptions& options)
             for (const auto& [k, v] : row)
                 if (k.rfind("param.", 0) == 0)
                     params += (params.empty() ? "" : " ") + k.substr(6) + "=" + v;
-            lines.push_back({query.maxCost >= 0.0 ? error : cost,
-                             fmt::format("  {:<16} {}={:.4g} {}={:.4g}  {}  ({})", technique, query.costColumn, cost,
-                                         query.errorColumn, error, params, row.at("run_id"))});
+            lines.push_back(
+                {query.maxCost >= 0.0 ? error : cost,
+                 fmt::format("  {:<16} {}={:.4g} {}={:.4g}  {}  ({})", technique, query.costColumn,
+                             cost, query.errorColumn, error, params, row.at("run_id"))});
         }
         std::sort(lines.begin(), lines.end());
         fmt::print("best run per technique with {}:\n", bound);

@@ -39,6 +39,15 @@ struct NewTechniqueOptions {
 };
 int newTechnique(const NewTechniqueOptions& options);
 
+struct NewFamilyOptions {
+    std::string name;
+    std::string sourceDirectory;  //!< repository root; empty = the one rtlab was built from
+};
+//! Writes framework/families/<name>/ from framework/families/_template/, the family's technique
+//! template techniques/_template/<name>/, a first technique techniques/<name>/<name>_example/ and
+//! experiments/<name>.yaml.
+int newFamily(const NewFamilyOptions& options);
+
 struct GpuOptions {
     std::string device;  //!< device name substring; empty = automatic
     bool validation = false;

@@ -104,6 +104,13 @@ int main(int argc, char** argv)
     newCmd->add_option("--source-dir", scaffold.sourceDirectory,
                        "Repository root (default: the one rtlab was built from)");
 
+    NewFamilyOptions family;
+    auto* newFamilyCmd = app.add_subcommand(
+        "new-family", "Create framework/families/<name>/, its technique template, a first technique and an experiment");
+    newFamilyCmd->add_option("name", family.name, "Family name, snake_case")->required();
+    newFamilyCmd->add_option("--source-dir", family.sourceDirectory,
+                             "Repository root (default: the one rtlab was built from)");
+
     GpuOptions gpu;
     auto* gpuCmd = app.add_subcommand("gpu", "Show the Vulkan device and time the smoke compute shader");
     gpuCmd->add_option("--device", gpu.device, "Device name substring (default: automatic)");
@@ -122,6 +129,8 @@ int main(int argc, char** argv)
         return runExperimentCommand(run);
     if (*newCmd)
         return newTechnique(scaffold);
+    if (*newFamilyCmd)
+        return newFamily(family);
     if (*gpuCmd)
         return gpuSmoke(gpu);
     if (*reportCmd)

@@ -55,6 +55,17 @@ std::string RunConfig::toJson() const
             list += (list.empty() ? "" : ",") + m;
         json.add("metrics", list);
     }
+    if (!culling || lighting) {
+        JsonObject frame;
+        if (!culling)
+            frame.add("culling", false);
+        if (lighting)
+            frame.add("lighting", true)
+                .add("tonemapper", tonemapper)
+                .add("exposure_ev", exposureEv)
+                .add("shadow_map_size", shadowMapSize);
+        json.addRaw("frame", frame.str());
+    }
     return json.addRaw("reference", referenceJson.str())
         .addRaw("timing", JsonObject().add("warmup", timing.warmup).add("repeats", timing.repeats).str())
         .addRaw("techniques", techniquesJson.str())
@@ -68,7 +79,7 @@ std::string RunConfig::hash() const
 
 std::string RunConfig::id() const
 {
-    const bool screenSpace = !techniques.count("isosurface");
+    const bool screenSpace = !volume;
     std::string s = std::filesystem::path(scene).stem().string() +
                     (screenSpace ? "-" + std::to_string(width) + "x" + std::to_string(height)
                                  : "-g" + std::to_string(grid));
@@ -231,6 +242,48 @@ struct Loader {
             run.timing.repeats = int(config::readInt(file, node["repeats"], "timing.repeats", 1, 10000));
     }
 
+    bool readBool(const YAML::Node& node, const std::string& what) const
+    {
+        if (node.IsScalar() && (node.Scalar() == "true" || node.Scalar() == "false"))
+            return node.Scalar() == "true";
+        file.fail(node, what + ": expected true or false, found " + config::describeNode(node));
+        return false;
+    }
+
+    void readFrame(const YAML::Node& node, RunConfig& run) const
+    {
+        if (!node.IsMap())
+            file.fail(node, "frame: expected a mapping such as {culling: false}, found " + config::describeNode(node));
+        config::checkKeys(file, node, {"culling", "lighting", "tonemapper", "exposure_ev", "shadow_map_size"}, {},
+                          "frame");
+        if (node["culling"])
+            run.culling = readBool(node["culling"], "frame.culling");
+        if (node["lighting"])
+            run.lighting = readBool(node["lighting"], "frame.lighting");
+        if (node["tonemapper"]) {
+            run.tonemapper = config::readString(file, node["tonemapper"], "frame.tonemapper");
+            config::checkName(file, node["tonemapper"], run.tonemapper, {"aces", "reinhard"}, "tonemapper");
+        }
+        if (node["exposure_ev"])
+            run.exposureEv = config::readFloat(file, node["exposure_ev"], "frame.exposure_ev");
+        if (node["shadow_map_size"])
+            run.shadowMapSize = int(config::readInt(file, node["shadow_map_size"], "frame.shadow_map_size", 1, 4096));
+    }
+
+    // A run's families share one frame: screen families share the frame start, a volume family
+    // has a frame of its own and cannot be combined.
+    void checkFamilyDomains(const YAML::Node& node, const RunConfig& run) const
+    {
+        std::vector<std::string> screen, volume;
+        for (const auto& [family, choice] : run.techniques)
+            (registry.findFamily(family)->domain == plugin::FamilyDomain::Volume ? volume : screen).push_back(family);
+        if (!volume.empty() && run.techniques.size() > 1)
+            file.fail(node, "techniques: family '" + volume.front() +
+                                "' works on a sampled volume and cannot share a run with other families (" +
+                                joinList(volume.size() > 1 ? volume : screen) +
+                                "); put it in a run of its own");
+    }
+
     void readTechniques(const YAML::Node& node, RunConfig& run) const
     {
         if (!node.IsMap() || node.size() == 0)
@@ -251,13 +304,14 @@ struct Loader {
                                                     "technique '" + name + "'");
             run.techniques[family] = std::move(choice);
         }
+        checkFamilyDomains(node, run);
     }
 
     RunConfig readBase(const YAML::Node& node) const
     {
         config::checkKeys(file, node,
                           {"scene", "grid", "resolution", "frames", "camera_path", "metrics", "timing", "reference",
-                           "techniques"},
+                           "frame", "techniques"},
                           {"scene", "techniques"}, "base");
         RunConfig run;
         readScene(node["scene"], run);
@@ -271,6 +325,8 @@ struct Loader {
             readReference(node["reference"], run);
         if (node["timing"])
             readTiming(node["timing"], run);
+        if (node["frame"])
+            readFrame(node["frame"], run);
         readTechniques(node["techniques"], run);
         if (node["camera_path"])
             readCameraPath(node["camera_path"], run);
@@ -297,9 +353,13 @@ struct Loader {
         }
         if (key == "camera_path")
             return readCameraPath(value, run);
+        if (key == "frame.culling") {
+            run.culling = readBool(value, "frame.culling");
+            return;
+        }
         const auto dot = key.find('.');
         if (dot == std::string::npos)
-            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, resolution, frames, camera_path, "
+            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, resolution, frames, camera_path, frame.culling, "
                                "<family>.technique, <family>.<parameter>, zip");
         const std::string family = key.substr(0, dot);
         const std::string field = key.substr(dot + 1);
@@ -313,6 +373,7 @@ struct Loader {
                     if (it->second.technique == name)
                         choice.params.set(param, v);
             run.techniques[family] = std::move(choice);
+            checkFamilyDomains(value, run);
             return;
         }
         auto it = run.techniques.find(family);
@@ -475,6 +536,14 @@ Experiment parseExperiment(const std::string& text, const std::string& label,
         e.description = config::readString(file, root["description"], "description");
     e.base = loader.readBase(root["base"]);
     e.runs = loader.expand(root["sweep"], e.base, e.sweepKeys);
+    auto markVolume = [&](RunConfig& run) {
+        run.volume = false;
+        for (const auto& [family, choice] : run.techniques)
+            run.volume = run.volume || registry.findFamily(family)->domain == plugin::FamilyDomain::Volume;
+    };
+    markVolume(e.base);
+    for (auto& run : e.runs)
+        markVolume(run);
     loader.checkCameraPaths(e.runs);
     return e;
 }

@@ -18,7 +18,11 @@
 //                 quantity: ao, radius: 0.5}  # quantity/radius/falloff override the technique's
 //                                             # declaration (default: exactly what it declares)
 //     timing: {warmup: 1, repeats: 5}
-//     techniques:
+//     frame: {culling: true,            # false: run every pass (frame graph ablation)
+//             lighting: false,          # true: compose the lit frame, measure it against Embree
+//             tonemapper: aces, exposure_ev: 0, shadow_map_size: 256}
+//     techniques:                       # one technique per family; several screen families
+//                                       # share one frame
 //       isosurface: {technique: marching_cubes, params: {vertex_placement: linear}}
 //   sweep:                              # cross product, axes in file order
 //     scene: [sphere, torus]
@@ -72,6 +76,20 @@ struct RunConfig {
     metrics::TimingOptions timing;
     ReferenceOptions reference;
     std::map<std::string, TechniqueChoice> techniques;  //!< family -> choice
+    //! `frame: {culling: false}` runs every pass of the frame graph (no pass is skipped for having
+    //! no consumer or for reusing earlier work): the ablation that proves culling changes nothing.
+    bool culling = true;
+    //! `frame: {lighting: true}` composes the lit frame after the families' passes
+    //! (pipeline/compose.h) and measures it against the Embree `full` radiance (and its direct
+    //! term against `direct`); with its tonemapper ("aces", "reinhard"), exposure in stops and
+    //! shadow-map size (texels per cube face).
+    bool lighting = false;
+    std::string tonemapper = "aces";
+    double exposureEv = 0.0;
+    int shadowMapSize = 256;
+    //! True when a family of the run works on a sampled volume (`grid`) rather than images; set
+    //! by the loader from the families' domains (not part of the hash).
+    bool volume = false;
 
     //! Short readable id, unique within an experiment: "sphere-g48-marching_cubes-3f2a91c0".
     std::string id() const;

@@ -14,6 +14,10 @@ namespace rtlab::experiment {
 void writeExr(const Image<float>& image, const std::string& path);
 //! Writes an RGB float32 EXR.
 void writeExr(const Image<glm::vec3>& image, const std::string& path);
+//! Writes an 8-bit RGB PNG of display values in [0, 1] (already tonemapped and encoded).
+void writePng(const Image<glm::vec3>& display, const std::string& path);
+//! Reads the first three channels of an EXR.
+Image<glm::vec3> readExrRgb(const std::string& path);
 //! Reads a one-channel EXR (the first channel).
 Image<float> readExrScalar(const std::string& path);
 

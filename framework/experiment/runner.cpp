@@ -3,28 +3,28 @@
 #include "core/error.h"
 #include "core/json.h"
 #include "core/progress.h"
+#include "experiment/family.h"
+#include "experiment/gpu_timing.h"
+#include "experiment/lit_frame.h"
 #include "experiment/manifest.h"
 #include "gpu/context.h"
+#include "pipeline/frame_graph.h"
+#include "pipeline/frame_start.h"
 #include "plugin/technique.h"
+#include "scene/camera_paths.h"
+#include "scene/scene_file.h"
+#include "scene/sdf_shapes.h"
 
 #include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <thread>
 
 #include "core/strings.h"
 
 namespace rtlab::experiment {
-
-const std::map<std::string, FamilyDriver>& familyDrivers()
-{
-    static const std::map<std::string, FamilyDriver> drivers = {
-        {"isosurface", &runIsosurfaceFamily},
-        {"occlusion", &runOcclusionFamily},
-    };
-    return drivers;
-}
 
 DriverContext::DriverContext(const plugin::Registry& registry, std::string runDirectory)
     : mRegistry(registry), mRunDirectory(std::move(runDirectory))
@@ -40,15 +40,31 @@ gpu::Context& DriverContext::getGpu()
     return *mGpu;
 }
 
-void PassLog::write(ResultRow& row) const
+void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& records)
 {
-    std::string text;
     std::int64_t ran = 0, skipped = 0;
-    for (const auto& [pass, reason] : mEntries) {
-        text += (text.empty() ? "" : ";") + pass + (reason.empty() ? ":run" : ":skipped(" + reason + ")");
-        (reason.empty() ? ran : skipped) += 1;
+    for (const auto& r : records) {
+        (r.ran ? ran : skipped) += 1;
+        if (!r.ran || !r.time)
+            continue;
+        if (r.timing == pipeline::PassTiming::Repeated) {
+            addTimingColumns(row, r.name, *r.time);
+        } else {
+            row.set(r.name + ".cpu_ms", r.time->cpuMs.median);
+            if (!r.time->gpuMs.empty())
+                row.set(r.name + ".gpu_ms", r.time->gpuTotalMedianMs());
+        }
     }
-    row.set("passes", text).set("passes_run", ran).set("passes_skipped", skipped);
+    row.set("passes", pipeline::formatPassRecords(records))
+        .set("passes_run", ran)
+        .set("passes_skipped", skipped);
+}
+
+void addParamColumns(ResultRow& row, const plugin::Technique& technique, const std::string& prefix)
+{
+    const config::ParamSet effective = technique.effectiveParams();
+    for (const auto& [name, value] : effective.values())
+        row.set(prefix + name, config::formatValue(value));
 }
 
 void addMemoryColumns(ResultRow& row)
@@ -83,6 +99,120 @@ void addTimingColumns(ResultRow& row, const std::string& pass, const metrics::Ti
 
 namespace {
 
+std::string joinFamilies(const RunConfig& run, bool techniques)
+{
+    std::string s;
+    for (const auto& [family, choice] : run.techniques)
+        s += (s.empty() ? "" : "+") + (techniques ? choice.technique : family);
+    return s;
+}
+
+// One run: the frame graph of its families (with the shared frame start when they are screen
+// families), executed once per frame; one row per frame.
+std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
+                                  const ResultRow& common)
+{
+    const plugin::Registry& registry = context.registry();
+    std::vector<const plugin::FamilyInfo*> families;
+    bool screen = false;
+    for (const auto& [family, choice] : run.techniques) {
+        const plugin::FamilyInfo* info = registry.findFamily(family);
+        if (!info || !info->runtime)
+            throw Error("family '" + family +
+                        "' cannot run in experiments (it registers no runtime)");
+        families.push_back(info);
+        screen = screen || info->domain == plugin::FamilyDomain::Screen;
+    }
+    for (const plugin::FamilyInfo* info : families)
+        if (info->domain == plugin::FamilyDomain::Volume && families.size() > 1)
+            throw Error("family '" + info->name +
+                        "' works on a sampled volume and cannot share a run with other "
+                        "families (" +
+                        joinFamilies(run, false) + ")");
+    pipeline::FrameGraph graph;
+    std::vector<std::string> outputs;
+    std::optional<scene::Scene> scene;
+    std::unique_ptr<pipeline::FrameStart> start;
+    int frames = 1;
+    if (screen) {
+        if (scene::findAnalyticShape(run.scene))
+            throw Error(
+                "scene '" + run.scene +
+                "' is an analytic shape for isosurface studies; screen-space families need a scene "
+                "with geometry and a camera (e.g. ao_testbed, tomorrow_town, or a .yaml file)");
+        scene = scene::loadScene(run.scene);
+        if (run.frames > scene->frameCount && (run.cameraPath.empty() || run.cameraPath == "scene"))
+            throw Error(
+                "the run asks for " + std::to_string(run.frames) + " frames but scene '" +
+                scene->name + "' has " + std::to_string(scene->frameCount) +
+                " (choose a camera_path such as orbit to move the camera over more frames)");
+        scene::selectCameraPath(*scene, run.cameraPath, run.frames);
+        start = std::make_unique<pipeline::FrameStart>(
+            *scene, context.getGpu(), pipeline::FrameStartOptions{run.width, run.height});
+        start->addPasses(graph);
+        frames = run.frames;
+    }
+    std::vector<std::unique_ptr<FamilyRun>> familyRuns;
+    for (const plugin::FamilyInfo* info : families) {
+        RunSetup setup{run,
+                       *info,
+                       context,
+                       graph,
+                       start.get(),
+                       outputs,
+                       families.size() > 1 ? "param." + info->name + "." : "param."};
+        familyRuns.push_back(info->runtime->beginRun(setup));
+    }
+
+    std::unique_ptr<LitFrame> litFrame;
+    if (run.lighting) {
+        if (!start)
+            throw Error("frame: {lighting: true} needs a screen family (the lit frame is composed "
+                        "from the G-buffer)");
+        litFrame = std::make_unique<LitFrame>(run, context, *start, graph, outputs);
+    }
+
+    ResultRow base = common;
+    for (const auto& family : familyRuns)
+        family->describe(base);
+    if (litFrame)
+        litFrame->describe(base);
+    if (screen) {
+        base.set("camera_path", run.cameraPath.empty() ? std::string("scene") : run.cameraPath)
+            .set("scene_features", start->getFeatures().toString())
+            .set("gpu_time_source",
+                 std::string(toString(chooseGpuTimeSource(context.getGpu().getDeviceInfo()))));
+        if (!run.culling)
+            base.set("frame.culling", false);
+    }
+    std::vector<ResultRow> rows;
+    for (int frame = 0; frame < frames; ++frame) {
+        ResultRow row = base;
+        if (screen)
+            row.set("frame", std::int64_t(frame));
+        for (const auto& family : familyRuns)
+            family->beginFrame(frame, row);
+        if (litFrame)
+            litFrame->beginFrame(row);
+        pipeline::FrameOptions options;
+        options.features = start ? start->getFeatures() : scene::FeatureSet{};
+        options.outputs = outputs;
+        options.frame = frame;
+        options.culling = run.culling;
+        options.timing = run.timing;
+        if (screen)
+            options.collectGpuTimes = [&] { return collectGpuPassTimes(context.getGpu()); };
+        const auto records = graph.execute(options);
+        for (const auto& family : familyRuns)
+            family->endFrame(frame, records, row);
+        if (litFrame)
+            litFrame->endFrame(row);
+        writePassRecords(row, records);
+        rows.push_back(std::move(row));
+    }
+    return rows;
+}
+
 } // namespace
 
 RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry& registry,
@@ -91,14 +221,16 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
     RunnerSummary summary;
     const bool sharded = options.shardCount > 1;
     const std::string shard =
-        sharded ? std::to_string(options.shardIndex) + "/" + std::to_string(options.shardCount) : "";
+        sharded ? std::to_string(options.shardIndex) + "/" + std::to_string(options.shardCount)
+                : "";
     summary.outputDirectory = !options.outputDirectory.empty() ? options.outputDirectory
                               : sharded ? "results/" + experiment.name + "/shard-" +
                                               std::to_string(options.shardIndex) + "-of-" +
                                               std::to_string(options.shardCount)
                                         : "results/" + experiment.name;
     ResultsStore store(summary.outputDirectory);
-    writeManifest(experiment, collectBuildInfo(options.queryVulkanForManifest), summary.outputDirectory, shard);
+    writeManifest(experiment, collectBuildInfo(options.queryVulkanForManifest),
+                  summary.outputDirectory, shard);
     const auto done = store.completedHashes();
 
     std::vector<const RunConfig*> mine;
@@ -109,8 +241,8 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
 
     std::unique_ptr<Progress> progress;
     if (!options.quiet)
-        progress = std::make_unique<Progress>("rtlab run " + experiment.name + (sharded ? " shard " + shard : ""),
-                                              mine.size());
+        progress = std::make_unique<Progress>(
+            "rtlab run " + experiment.name + (sharded ? " shard " + shard : ""), mine.size());
 
     DriverContext context(registry, summary.outputDirectory);
     for (const RunConfig* runPtr : mine) {
@@ -137,15 +269,11 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
         std::vector<ResultRow> rows;
         try {
             std::filesystem::create_directories(context.runDirectory());
-            for (const auto& [family, choice] : run.techniques) {
-                common.set("family", family).set("technique", choice.technique);
-                auto driver = familyDrivers().find(family);
-                if (driver == familyDrivers().end())
-                    throw Error("family '" + family + "' cannot run in experiments yet (no driver)");
-                for (auto& row : driver->second(run, family, context, common)) {
-                    addMemoryColumns(row);
-                    rows.push_back(std::move(row));
-                }
+            common.set("family", joinFamilies(run, false))
+                .set("technique", joinFamilies(run, true));
+            for (auto& row : executeRun(run, context, common)) {
+                addMemoryColumns(row);
+                rows.push_back(std::move(row));
             }
             ++summary.succeeded;
         } catch (const std::exception& e) {
@@ -184,12 +312,14 @@ void parseShard(const std::string& text, RunnerOptions& options)
         }
     }
     if (!ok || n < 1 || i < 1 || i > n)
-        throw InputError({"--shard", 0, 0}, "expected i/N with 1 <= i <= N (e.g. 2/4), found '" + text + "'");
+        throw InputError({"--shard", 0, 0},
+                         "expected i/N with 1 <= i <= N (e.g. 2/4), found '" + text + "'");
     options.shardIndex = i;
     options.shardCount = n;
 }
 
-std::size_t mergeShards(const std::vector<std::string>& shardDirectories, const std::string& outputDirectory)
+std::size_t mergeShards(const std::vector<std::string>& shardDirectories,
+                        const std::string& outputDirectory)
 {
     namespace fs = std::filesystem;
     ResultsStore out(outputDirectory);
@@ -206,7 +336,7 @@ std::size_t mergeShards(const std::vector<std::string>& shardDirectories, const 
         std::ifstream in(jsonl);
         for (std::string line; std::getline(in, line);) {
             if (line.empty() || line.front() != '{' || line.back() != '}')
-                continue;  // a torn line from an interrupted shard
+                continue; // a torn line from an interrupted shard
             const auto hashAt = line.find("\"config_hash\":\"");
             if (hashAt == std::string::npos)
                 continue;
@@ -239,8 +369,8 @@ std::size_t mergeShards(const std::vector<std::string>& shardDirectories, const 
         std::vector<std::string> quoted;
         for (const auto& s : shardNames)
             quoted.push_back(jsonEscape(s));
-        std::ofstream(fs::path(outputDirectory) / "manifest.json") << manifest << ",\"merged_from\":" << jsonArray(quoted)
-                                                                  << "}\n";
+        std::ofstream(fs::path(outputDirectory) / "manifest.json")
+            << manifest << ",\"merged_from\":" << jsonArray(quoted) << "}\n";
     }
     return out.writeCsv();
 }

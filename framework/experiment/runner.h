@@ -16,15 +16,18 @@ class Registry;
 namespace rtlab::gpu {
 class Context;
 }
+namespace rtlab::pipeline {
+struct PassRecord;
+}
 
 namespace rtlab::experiment {
 
 struct RunnerOptions {
-    std::string outputDirectory;  //!< results/<experiment name> when empty
-    bool quiet = false;           //!< no progress output (tests)
-    int shardIndex = 1;           //!< run only runs k with k % shardCount == shardIndex - 1
-    int shardCount = 1;           //!< 1 = the whole sweep
-    bool queryVulkanForManifest = true;  //!< tests turn it off
+    std::string outputDirectory;        //!< results/<experiment name> when empty
+    bool quiet = false;                 //!< no progress output (tests)
+    int shardIndex = 1;                 //!< run only runs k with k % shardCount == shardIndex - 1
+    int shardCount = 1;                 //!< 1 = the whole sweep
+    bool queryVulkanForManifest = true; //!< tests turn it off
 };
 
 //! Parses "i/N" (1 <= i <= N) into options.shardIndex and options.shardCount; throws
@@ -35,17 +38,18 @@ void parseShard(const std::string& text, RunnerOptions& options);
 //! that is "ok" in any shard wins over a failed attempt elsewhere, duplicates are dropped), the
 //! run folders, a CSV, and the first shard's manifest with the list of shards. Returns the row
 //! count. Throws rtlab::Error when a shard folder has no results.jsonl.
-std::size_t mergeShards(const std::vector<std::string>& shardDirectories, const std::string& outputDirectory);
+std::size_t mergeShards(const std::vector<std::string>& shardDirectories,
+                        const std::string& outputDirectory);
 
 struct RunnerSummary {
-    std::size_t total = 0;        //!< runs in this shard
-    std::size_t alreadyDone = 0;  //!< found complete in the results table (resumed)
+    std::size_t total = 0;       //!< runs in this shard
+    std::size_t alreadyDone = 0; //!< found complete in the results table (resumed)
     std::size_t succeeded = 0;
     std::size_t failed = 0;
     std::string outputDirectory;
 };
 
-//! What a family driver gets besides the run: the registry, the run's output folder, and the
+//! What a family gets besides the run: the registry, the run's output folder, and the
 //! Vulkan device (opened on first use and shared by every run of the sweep).
 class DriverContext {
 public:
@@ -62,43 +66,22 @@ private:
     std::unique_ptr<gpu::Context> mGpu;
 };
 
-//! Runs one family's part of a run and returns its rows (one per frame), each a copy of
-//! `common` (ids, scene, config) with the family's metric and timing columns added.
-using FamilyDriver = std::function<std::vector<ResultRow>(const RunConfig& run, const std::string& family,
-                                                          DriverContext& context, const ResultRow& common)>;
-
-//! The drivers of the families that can run in experiments, by family name.
-const std::map<std::string, FamilyDriver>& familyDrivers();
-
 //! Runs every run of `experiment` not already complete in the output folder.
 RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry& registry,
                             const RunnerOptions& options);
 
-//! The isosurface family's driver: samples the analytic shape, extracts, measures.
-std::vector<ResultRow> runIsosurfaceFamily(const RunConfig& run, const std::string& family,
-                                           DriverContext& context, const ResultRow& common);
-//! The occlusion family's driver: G-buffer on Vulkan, the technique, the Embree ground truth of
-//! the quantity it declares, image metrics, per-frame rows and images.
-std::vector<ResultRow> runOcclusionFamily(const RunConfig& run, const std::string& family,
-                                          DriverContext& context, const ResultRow& common);
-
-//! Which passes of a frame ran and which were skipped, and why. Written as the columns "passes"
-//! ("gbuffer:run;reference:skipped(read from the cache)"), "passes_run" and "passes_skipped".
-class PassLog {
-public:
-    void add(const std::string& pass) { mEntries.push_back({pass, ""}); }
-    void skip(const std::string& pass, const std::string& reason) { mEntries.push_back({pass, reason}); }
-    void write(ResultRow& row) const;
-
-private:
-    std::vector<std::pair<std::string, std::string>> mEntries;  //!< (pass, skip reason or "")
-};
+//! Writes a frame's pass log: the columns "passes" ("gbuffer:run;reference:skipped(read from the
+//! cache)"), "passes_run", "passes_skipped", and the time of every pass that ran: for passes timed
+//! with the run's repeats the columns of addTimingColumns, for the others <pass>.cpu_ms (and
+//! <pass>.gpu_ms when the pass ran GPU work).
+void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& records);
 
 //! Current and peak resident memory of the process: columns memory.rss_mb, memory.peak_rss_mb.
 void addMemoryColumns(ResultRow& row);
 
 //! Adds the timing columns of one pass: <pass>.cpu_ms (median), <pass>.cpu_ms_iqr,
 //! <pass>.first_use_ms, <pass>.setup_ms, and <pass>.gpu_ms when it ran GPU work.
-void addTimingColumns(ResultRow& row, const std::string& pass, const struct metrics::TimingReport& report);
+void addTimingColumns(ResultRow& row, const std::string& pass,
+                      const struct metrics::TimingReport& report);
 
 } // namespace rtlab::experiment

@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "gpu/format.h"
@@ -171,5 +172,19 @@ struct IndexedDraw {
     //! target holds.
     bool clear = true;
 };
+
+class CommandList;
+
+//! Label of attachment copies in RunResult when none is given.
+inline constexpr std::string_view kAttachmentCopyLabel = "attachment copy";
+
+//! Records into `cmd` a copy of colour attachment `index` of `target` into slice `destinationZ`
+//! of `destination` (0 for a 2D image). Attachments have no storage or sampled usage, so this is
+//! how compute passes read what a draw rendered (the G-buffer, shadow-map faces) without a round
+//! trip through the CPU. The destination must have the attachment's width, height and texel size.
+//! Like every command it is timed and separated from its neighbours by full barriers; both must
+//! live until Context::run() returns. Throws rtlab::Error on a mismatch.
+void copyAttachmentToImage(CommandList& cmd, const RenderTarget& target, std::size_t index, const Image& destination,
+                           std::uint32_t destinationZ = 0, std::string_view label = kAttachmentCopyLabel);
 
 } // namespace rtlab::gpu

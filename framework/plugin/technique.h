@@ -12,6 +12,7 @@
 #include <concepts>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -20,11 +21,11 @@ namespace rtlab::plugin {
 
 //! What a technique is, for listings, reports and doc generation.
 struct TechniqueInfo {
-    std::string name;       //!< registry key = folder name = config name (filled in at registration)
-    std::string family;     //!< family key (filled in at registration)
-    std::string summary;    //!< one line
-    std::string reference;  //!< the paper or talk it implements
-    std::string seed;       //!< the talk transcript in shared seeds it follows, if any
+    std::string name;      //!< registry key = folder name = config name (filled in at registration)
+    std::string family;    //!< family key (filled in at registration)
+    std::string summary;   //!< one line
+    std::string reference; //!< the paper or talk it implements
+    std::string seed;      //!< the talk transcript in shared seeds it follows, if any
 };
 
 //! Common base of all techniques. Family interfaces (occlusion.h, isosurface.h, voxel_gi.h)
@@ -50,18 +51,64 @@ struct TechniqueEntry {
 
 //! A metric (group) a family's driver can compute; experiments choose them with `metrics:`.
 struct MetricInfo {
-    std::string name;  //!< snake_case, as written in experiment files
-    std::string doc;   //!< one line: what it measures and its columns
+    std::string name; //!< snake_case, as written in experiment files
+    std::string doc;  //!< one line: what it measures and its columns
 };
 
-//! A technique family: one interface, interchangeable plugins, one ground-truth definition.
+//! What a family's runs are made of, which decides the run keys that apply and the run's frame.
+enum class FamilyDomain {
+    Volume, //!< a sampled field of `grid` samples per axis; one frame of its own passes
+    Screen, //!< images of `resolution` over `frames` frames, on the shared frame start
+            //!< (pipeline/frame_start.h): several screen families share one frame
+};
+
+//! A histogram the report draws per technique from a column of space-separated bin counts.
+struct HistogramFigure {
+    std::string column; //!< e.g. "angle.histogram_10deg"
+    std::string name;   //!< file name stem, e.g. "angles"
+    std::string title;  //!< e.g. "triangle angles"
+    std::string xLabel; //!< the bins span [0, xRange]
+    double xRange = 1.0;
+    std::string caption;
+};
+
+//! Which columns a family's figures and tables use (report/report.h).
+struct FamilyReport {
+    std::string cost;      //!< e.g. "technique_ms"
+    std::string costLabel; //!< axis label with unit
+    std::string error;     //!< e.g. "ao.rmse"
+    std::string errorLabel;
+    std::vector<std::string> passes; //!< per-pass time columns, stacked in this order
+    std::string passTimeLabel;       //!< y label of the stacked per-pass times
+    //! More error columns, each with its own time-against-error plot when the study has it.
+    std::vector<std::pair<std::string, std::string>> extraErrors; //!< (column, axis label)
+    //! Further columns of the report's run tables (topology counts, masked errors, ...).
+    std::vector<std::string> tableColumns;
+    bool convergence = false; //!< error against cell size with fitted order (grid sweeps)
+    std::vector<HistogramFigure> histograms; //!< per-technique histograms
+};
+
+} // namespace rtlab::plugin
+namespace rtlab::experiment {
+class Family;
+}
+namespace rtlab::plugin {
+
+//! A technique family: one interface, interchangeable plugins, one ground-truth definition. A
+//! family is one folder framework/families/<name>/ whose runtime (experiment/family.h) adds its
+//! passes to a run's frame graph; it registers itself like a technique (RTLAB_REGISTER_FAMILY).
 struct FamilyInfo {
-    std::string name;         //!< "occlusion", "isosurface", "voxel_gi", ...
-    std::string summary;      //!< one line
-    std::string input;        //!< what every technique of the family consumes
-    std::string output;       //!< what it produces
-    std::string groundTruth;  //!< what it is compared with
-    std::vector<MetricInfo> metrics;  //!< what its driver can measure (all by default)
+    std::string name;                //!< "occlusion", "isosurface", "voxel_gi", ...
+    std::string summary;             //!< one line
+    std::string input;               //!< what every technique of the family consumes
+    std::string output;              //!< what it produces
+    std::string groundTruth;         //!< what it is compared with
+    std::vector<MetricInfo> metrics; //!< what its passes can measure (all by default)
+    FamilyDomain domain = FamilyDomain::Screen;
+    FamilyReport report;
+    //! Adds the family's passes to runs; null for a family that describes techniques only
+    //! (registries built by hand in tests).
+    std::shared_ptr<const experiment::Family> runtime;
 };
 
 class Registry {
@@ -83,7 +130,8 @@ private:
     std::vector<std::unique_ptr<TechniqueEntry>> mTechniques;
 };
 
-//! Adds the built-in families (occlusion, isosurface, voxel_gi) to `registry`.
+//! Adds every family compiled into this program (the folders framework/families/<name>/). Defined
+//! in the file CMake generates from them (target rtlab_families).
 void registerBuiltinFamilies(Registry& registry);
 
 //! Calls the registration function of every technique compiled into this program. Defined in
@@ -96,10 +144,17 @@ const Registry& builtinRegistry();
 
 //! What a technique class must provide.
 template <class T>
-concept TechniquePlugin = std::derived_from<T, Technique> && requires(const config::ParamSet& p) {
-    { T::describe() } -> std::convertible_to<TechniqueInfo>;          // summary, reference, seed
-    { T::declareParams() } -> std::convertible_to<config::ParamSchema>;
-    { T::kFamily } -> std::convertible_to<const char*>;                  // from the family base
+concept TechniquePlugin = std::derived_from<T, Technique> && requires(const config::ParamSet& p)
+{
+    {
+        T::describe()
+        } -> std::convertible_to<TechniqueInfo>; // summary, reference, seed
+    {
+        T::declareParams()
+        } -> std::convertible_to<config::ParamSchema>;
+    {
+        T::kFamily
+        } -> std::convertible_to<const char*>; // from the family base
     requires std::constructible_from<T, const config::ParamSet&>;
 };
 
@@ -111,8 +166,9 @@ void registerTechnique(Registry& registry, const char* family, const char* name)
     entry.info.family = family;
     entry.info.name = name;
     if (entry.info.family != T::kFamily)
-        throw std::logic_error(std::string("technique '") + name + "' is registered in family '" + family +
-                               "' but derives from the interface of family '" + T::kFamily + "'");
+        throw std::logic_error(std::string("technique '") + name + "' is registered in family '" +
+                               family + "' but derives from the interface of family '" +
+                               T::kFamily + "'");
     entry.schema = T::declareParams();
     entry.create = [](const config::ParamSet& params) -> std::unique_ptr<Technique> {
         return std::make_unique<T>(params);
@@ -125,8 +181,21 @@ void registerTechnique(Registry& registry, const char* family, const char* name)
 //! Registers technique class `Class` as `name` in `family`. Put it once, at the bottom of the
 //! technique's main .cpp, outside any namespace. `family` and `name` must match the folder
 //! techniques/<family>/<name>/ (CMake checks the folder, the compiler checks the class).
-#define RTLAB_REGISTER_TECHNIQUE(family, name, Class)                                                  \
-    void rtlabRegisterTechnique_##family##_##name(::rtlab::plugin::Registry& registry)                 \
-    {                                                                                                  \
-        ::rtlab::plugin::registerTechnique<Class>(registry, #family, #name);                           \
+#define RTLAB_REGISTER_TECHNIQUE(family, name, Class)                                              \
+    void rtlabRegisterTechnique_##family##_##name(::rtlab::plugin::Registry& registry)             \
+    {                                                                                              \
+        ::rtlab::plugin::registerTechnique<Class>(registry, #family, #name);                       \
+    }
+
+//! Registers a family: `info` (a FamilyInfo with its runtime) as `name`. Put it once, at the
+//! bottom of the family's main .cpp (framework/families/<name>/<name>_family.cpp), outside any
+//! namespace; `name` must match the folder.
+#define RTLAB_REGISTER_FAMILY(familyName, makeInfo)                                                \
+    void rtlabRegisterFamily_##familyName(::rtlab::plugin::Registry& registry)                     \
+    {                                                                                              \
+        ::rtlab::plugin::FamilyInfo info = makeInfo();                                             \
+        if (info.name != #familyName)                                                              \
+            throw std::logic_error("family folder '" #familyName "' registers a family named '" +  \
+                                   info.name + "'");                                               \
+        registry.addFamily(std::move(info));                                                       \
     }

@@ -9,11 +9,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
 #include <set>
 #include <sstream>
-#include <cstdio>
 
 namespace rtlab::report::detail {
 
@@ -47,16 +47,19 @@ plot::PixelRect findWorstRegion(const Image<float>& error)
         }
     const int size = std::max(4, std::min(error.width, error.height) / 6);
     const int w = std::min(size, error.width), h = std::min(size, error.height);
-    const int cx = int(worst % std::size_t(error.width)), cy = int(worst / std::size_t(error.width));
-    return {std::clamp(cx - w / 2, 0, error.width - w), std::clamp(cy - h / 2, 0, error.height - h), w, h};
+    const int cx = int(worst % std::size_t(error.width)),
+              cy = int(worst / std::size_t(error.width));
+    return {std::clamp(cx - w / 2, 0, error.width - w), std::clamp(cy - h / 2, 0, error.height - h),
+            w, h};
 }
 
 } // namespace
 
-Figures writeGroupFigures(const Group& group, const std::string& directory, const std::vector<std::string>& techniques)
+Figures writeGroupFigures(const Group& group, const std::string& directory,
+                          const std::vector<std::string>& techniques)
 {
     Figures figures;
-    const FamilyColumns columns = getFamilyColumns(group.family);
+    const FamilyColumns& columns = group.columns;
     const std::string plots = directory + "/plots";
     std::filesystem::create_directories(plots);
     const plot::ColorTable colors(techniques);
@@ -85,8 +88,9 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
     const std::string scatterPath = plots + "/time_vs_error_" + stem;
     plot::writeScatter(scatter, scatterPath);
     figures.plots.push_back(scatterPath);
-    figures.captions.push_back("Run time against error on " + group.title +
-                               ". Each technique's Pareto front is the staircase; faded points are dominated.");
+    figures.captions.push_back(
+        "Run time against error on " + group.title +
+        ". Each technique's Pareto front is the staircase; faded points are dominated.");
 
     // 1b. The same for each further error column the study has.
     for (const auto& [column, label] : columns.extraErrors) {
@@ -107,12 +111,14 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
         const std::string path = plots + "/time_vs_" + makeFileName(column) + "_" + stem;
         plot::writeScatter(extra, path);
         figures.plots.push_back(path);
-        figures.captions.push_back("Run time against " + label + " on " + group.title + ", Pareto front per technique.");
+        figures.captions.push_back("Run time against " + label + " on " + group.title +
+                                   ", Pareto front per technique.");
     }
 
     // 1c. Convergence (grid sweeps): error against cell size on log-log axes, and the order p of
     //     error ~ h^p fitted by least squares on the logarithms of the per-cell-size means.
-    if (std::find(group.varyingParams.begin(), group.varyingParams.end(), "grid") != group.varyingParams.end()) {
+    if (columns.convergence && std::find(group.varyingParams.begin(), group.varyingParams.end(),
+                                         "grid") != group.varyingParams.end()) {
         plot::LineSpec line;
         line.title = group.title + ": convergence under grid refinement";
         line.xLabel = "cell size h (world units)";
@@ -170,18 +176,19 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
             const std::string path = plots + "/convergence_" + stem;
             plot::writeLineChart(line, path);
             figures.plots.push_back(path);
-            figures.captions.push_back("Convergence on " + group.title + ": mean " + columns.error +
-                                       " against cell size, log-log; fitted order p of error ~ h^p: " + orders + ".");
+            figures.captions.push_back(
+                "Convergence on " + group.title + ": mean " + columns.error +
+                " against cell size, log-log; fitted order p of error ~ h^p: " + orders + ".");
         }
     }
 
-    // 1d. Triangle-angle histograms (meshes): share of the interior angles per 10-degree bin, summed
-    //     over the technique's runs at the finest grid of the group.
-    if (group.family == "isosurface") {
+    // 1d. Histograms the family declares (e.g. triangle angles): the share of each bin per
+    //     technique, summed over the technique's runs at the finest grid of the group.
+    for (const plugin::HistogramFigure& histogram : columns.histograms) {
         plot::LineSpec line;
-        line.title = group.title + ": triangle angles";
-        line.xLabel = "interior angle (degrees, bin centre)";
-        line.yLabel = "share of angles";
+        line.title = group.title + ": " + histogram.title;
+        line.xLabel = histogram.xLabel;
+        line.yLabel = "share";
         line.xScale = plot::AxisScale::Linear;
         line.yScale = plot::AxisScale::Linear;
         line.colors = colors;
@@ -191,8 +198,8 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
         for (const auto& [technique, runs] : byTechnique) {
             std::vector<double> counts;
             for (const RunSummary* run : runs) {
-                auto it = run->text.find("angle.histogram_10deg");
-                if (it == run->text.end() || run->get("grid") != finest)
+                auto it = run->text.find(histogram.column);
+                if (it == run->text.end() || (std::isfinite(finest) && run->get("grid") != finest))
                     continue;
                 std::istringstream in(it->second);
                 double c;
@@ -208,7 +215,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
             if (total <= 0)
                 continue;
             plot::Series s{technique};
-            const double width = 180.0 / double(counts.size());
+            const double width = histogram.xRange / double(counts.size());
             for (std::size_t i = 0; i < counts.size(); ++i) {
                 s.x.push_back((double(i) + 0.5) * width);
                 s.y.push_back(counts[i] / total);
@@ -216,12 +223,12 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
             line.series.push_back(std::move(s));
         }
         if (!line.series.empty()) {
-            const std::string path = plots + "/angles_" + stem;
+            const std::string path = plots + "/" + histogram.name + "_" + stem;
             plot::writeLineChart(line, path);
             figures.plots.push_back(path);
-            figures.captions.push_back("Triangle interior angles on " + group.title + " at the finest grid (" +
-                                       std::to_string(int(finest)) + " samples per axis): share per 10-degree bin. "
-                                       "Slivers pile up near 0 and 180.");
+            figures.captions.push_back(
+                group.title + ": " + histogram.caption +
+                (finest > 0 ? " (grid " + std::to_string(int(finest)) + ")" : ""));
         }
     }
 
@@ -252,7 +259,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
             line.series.push_back(std::move(s));
         }
         if (line.series.empty())
-            continue;  // not numeric, or one value per technique
+            continue; // not numeric, or one value per technique
         const std::string path = plots + "/error_vs_" + makeFileName(name) + "_" + stem;
         plot::writeLineChart(line, path);
         figures.plots.push_back(path);
@@ -263,7 +270,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
     // 3. Per-pass time of each technique's Pareto-front runs, stacked.
     plot::StackedBarSpec bars;
     bars.title = group.title + ": time per pass of the Pareto-front runs";
-    bars.yLabel = group.family == "isosurface" ? "CPU time (ms, median)" : "time (ms, median; GPU, CPU for ray tracing)";
+    bars.yLabel = columns.passTimeLabel.empty() ? "time (ms, median)" : columns.passTimeLabel;
     bars.passes = columns.passes;
     for (const auto& [technique, runs] : byTechnique) {
         std::vector<double> x, y;
@@ -288,8 +295,8 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
         const std::string path = plots + "/pass_times_" + stem;
         plot::writeStackedBars(bars, path);
         figures.plots.push_back(path);
-        figures.captions.push_back("Time per pass of the runs on each technique's Pareto front on " + group.title +
-                                   ".");
+        figures.captions.push_back(
+            "Time per pass of the runs on each technique's Pareto front on " + group.title + ".");
     }
 
     // 4. Images (screen-space families): reference | each technique's lowest-error run, over
@@ -304,19 +311,27 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
             if (!best || run->get(columns.error) < best->get(columns.error))
                 best = run;
         const auto& frame0 = best->frames.front();
-        if (!frame0.count("image.technique") || !std::filesystem::exists(frame0.at("image.technique")))
+        if (!frame0.count("image.technique") ||
+            !std::filesystem::exists(frame0.at("image.technique")))
             continue;
         if (images.empty()) {
             grid.columnTitles.push_back("reference");
-            images.push_back(plot::makeColorCell(toGrey(experiment::readExrScalar(frame0.at("image.reference")))));
-            // Under the reference: its own noise floor (per-pixel standard error), on the same scale
-            // as the techniques' errors.
+            images.push_back(plot::makeColorCell(
+                toGrey(experiment::readExrScalar(frame0.at("image.reference")))));
+            // Under the reference: its own noise floor (per-pixel standard error), on the same
+            // scale as the techniques' errors.
             std::string stderrPath = frame0.at("image.reference");
             stderrPath.replace(stderrPath.rfind("reference.exr"), 13, "reference_stderr.exr");
-            errors.push_back(plot::makeErrorCell(experiment::readExrScalar(stderrPath)));
+            // A family whose reference is exact writes no noise floor: it is zero.
+            const Image<float> reference = experiment::readExrScalar(frame0.at("image.reference"));
+            errors.push_back(
+                plot::makeErrorCell(std::filesystem::exists(stderrPath)
+                                        ? experiment::readExrScalar(stderrPath)
+                                        : Image<float>(reference.width, reference.height, 0.0f)));
         }
         grid.columnTitles.push_back(technique + " " + describeRun(*best, group.varyingParams));
-        images.push_back(plot::makeColorCell(toGrey(experiment::readExrScalar(frame0.at("image.technique")))));
+        images.push_back(
+            plot::makeColorCell(toGrey(experiment::readExrScalar(frame0.at("image.technique")))));
         Image<float> error = experiment::readExrScalar(frame0.at("image.error"));
         for (auto& e : error.pixels)
             e = std::abs(e);
@@ -333,9 +348,10 @@ Figures writeGroupFigures(const Group& group, const std::string& directory, cons
         const std::string path = plots + "/images_" + stem;
         plot::writeImageGrid(grid, path);
         figures.plots.push_back(path);
-        figures.captions.push_back("Reference and each technique's lowest-error run on " + group.title +
-                                   " (frame 0), over their absolute error maps; the crop is the region of the "
-                                   "largest error, magnified.");
+        figures.captions.push_back(
+            "Reference and each technique's lowest-error run on " + group.title +
+            " (frame 0), over their absolute error maps; the crop is the region of the "
+            "largest error, magnified.");
     }
     return figures;
 }

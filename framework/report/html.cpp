@@ -72,7 +72,7 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
 
     for (std::size_t gi = 0; gi < groups.size(); ++gi) {
         const Group& g = groups[gi];
-        const FamilyColumns columns = getFamilyColumns(g.family);
+        const FamilyColumns& columns = g.columns;
         h << "<h2 id=\"" << escapeHtml(g.key) << "\">" << escapeHtml(g.title) << "</h2>\n";
         for (std::size_t i = 0; i < figures[gi].plots.size(); ++i) {
             const std::string rel = relativeTo(figures[gi].plots[i], directory);

@@ -11,32 +11,19 @@
 
 namespace rtlab::report {
 
-FamilyColumns getFamilyColumns(const std::string& family)
+FamilyColumns getFamilyColumns(const plugin::Registry& registry, const std::string& family)
 {
-    if (family == "occlusion")
-        return {"technique_ms",
-                "time of the technique (ms, median): GPU passes, or CPU for ray tracing",
-                "ao.rmse",
-                "RMSE against ground truth (AO / obscurance, unitless)",
-                {"gbuffer.gpu_ms", "technique_ms"},
-                {{"bent.angle_error_deg", "bent-normal angle error (degrees, mean)"},
-                 {"ao_vs_screen_truth.rmse", "RMSE against the screen-space ground truth (unitless)"},
-                 {"flicker.rms", "flicker: RMS frame-to-frame change of the error (unitless)"}},
-                {"ao.mean_signed_error", "ao.ssim", "ao.flip", "ao_depth_edges.rmse", "ao_thin.rmse", "ao_border.rmse",
-                 "bent.angle_error_deg", "cone.aperture_abs_error_deg", "screen_truth.rmse",
-                 "ao_vs_screen_truth.rmse", "flicker.rms"}};
-    if (family == "isosurface")
-        return {"extract.cpu_ms",
-                "CPU time of the extraction (ms, median)",
-                "chamfer.mean",
-                "Chamfer distance to the true surface (mean, world units)",
-                {"evaluate_field.cpu_ms", "extract.cpu_ms"},
-                {{"hausdorff", "Hausdorff distance to the true surface (world units)"},
-                 {"edge.chamfer", "edge-Chamfer distance to the sharp features (world units)"}},
-                {"grid", "hausdorff", "rms_deviation", "edge.chamfer", "edge.f1", "watertight", "boundary_edges",
-                 "non_manifold_edges", "self_intersections", "angle.min_deg", "angle.sliver_fraction",
-                 "counter.vertices_left_cell_share", "extract.mcells_per_s", "evaluator.culling_rate"}};
-    throw Error("no report columns for family '" + family + "'");
+    if (const plugin::FamilyInfo* info = registry.findFamily(family))
+        return info->report;
+    // A run of several families ("occlusion+voxel_gi"): the first one's columns.
+    for (std::size_t start = 0; start < family.size();) {
+        const std::size_t plus = std::min(family.find('+', start), family.size());
+        if (const plugin::FamilyInfo* info =
+                registry.findFamily(family.substr(start, plus - start)))
+            return info->report;
+        start = plus + 1;
+    }
+    throw Error("no report columns for family '" + family + "' (not registered in this build)");
 }
 
 namespace detail {
@@ -47,7 +34,8 @@ double RunSummary::get(const std::string& column) const
     return it == number.end() ? std::nan("") : it->second;
 }
 
-std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows)
+std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows,
+                             const plugin::Registry& registry)
 {
     // Runs by id, frames together.
     std::map<std::string, RunSummary> runs;
@@ -86,12 +74,17 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows)
         if (!run.number.count("technique_ms") && run.number.count("occlusion.gpu_ms"))
             run.number["technique_ms"] = run.number["occlusion.gpu_ms"];
         const std::string family = run.text.count("family") ? run.text["family"] : "?";
-        std::string scene = std::filesystem::path(run.text.count("scene") ? run.text["scene"] : "?").stem().string();
+        std::string scene = std::filesystem::path(run.text.count("scene") ? run.text["scene"] : "?")
+                                .stem()
+                                .string();
         std::string key = scene, title = scene;
-        if (family != "isosurface") {
-            const std::string size = (run.text.count("width") ? run.text["width"]
-                                                               : std::to_string(int(run.get("width")))) +
-                                     "x" + std::to_string(int(run.get("height")));
+        const plugin::FamilyInfo* info = registry.findFamily(family.substr(0, family.find('+')));
+        const bool volume = info && info->domain == plugin::FamilyDomain::Volume;
+        if (!volume) {
+            const std::string size =
+                (run.text.count("width") ? run.text["width"]
+                                         : std::to_string(int(run.get("width")))) +
+                "x" + std::to_string(int(run.get("height")));
             key += "_" + size;
             title += ", " + size;
         }
@@ -101,6 +94,7 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows)
             git->second.key = key;
             git->second.title = family + ": " + title;
             git->second.family = family;
+            git->second.columns = getFamilyColumns(registry, family);
             groupOrder.push_back(key);
         }
         git->second.runs.push_back(run);
@@ -131,19 +125,20 @@ std::string describeRun(const RunSummary& run, const std::vector<std::string>& v
         auto it = first.find(p);
         if (it == first.end())
             continue;
-        s += (s.empty() ? "" : " ") + (p.rfind("param.", 0) == 0 ? p.substr(6) : p) + "=" + it->second;
+        s += (s.empty() ? "" : " ") + (p.rfind("param.", 0) == 0 ? p.substr(6) : p) + "=" +
+             it->second;
     }
     return s;
 }
 
 } // namespace detail
 
-ReportSummary writeStudyReport(const std::string& directory)
+ReportSummary writeStudyReport(const std::string& directory, const plugin::Registry& registry)
 {
     const auto rows = experiment::loadResults(directory);
     if (rows.empty())
         throw Error(directory + ": no results (results.jsonl is missing or empty)");
-    const auto groups = detail::groupRuns(rows);
+    const auto groups = detail::groupRuns(rows, registry);
     std::set<std::string> techniqueSet;
     for (const auto& g : groups)
         for (const auto& r : g.runs)

@@ -26,11 +26,12 @@ struct Group {
     std::string key;    //!< file-name friendly: "ao_testbed_320x180"
     std::string title;  //!< "ao_testbed, 320x180"
     std::string family;
+    FamilyColumns columns; //!< what the family declares for its figures
     std::vector<RunSummary> runs;
     std::vector<std::string> varyingParams;  //!< param.* columns and "grid" with more than one value
 };
 
-std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows);
+std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows, const plugin::Registry& registry);
 //! "directions=36 steps=4" from the varying parameters of a run.
 std::string describeRun(const RunSummary& run, const std::vector<std::string>& varyingParams);
 

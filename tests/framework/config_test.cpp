@@ -174,7 +174,7 @@ TEST(ConfigValidation, UnknownFamilySuggestsClosest)
     EXPECT_NE(err.find("study.yaml:4:5:"), std::string::npos) << err;
     EXPECT_NE(err.find("unknown technique family 'isosurfase'; did you mean isosurface?"), std::string::npos)
         << err;
-    EXPECT_NE(err.find("Valid: occlusion, isosurface, voxel_gi"), std::string::npos) << err;
+    EXPECT_NE(err.find("Valid: isosurface, occlusion, voxel_gi"), std::string::npos) << err;
 }
 
 TEST(ConfigValidation, NotYaml)

@@ -170,5 +170,145 @@ TEST(FrameGraph, RejectsMalformedGraphs)
     EXPECT_THROW(graph.plan(FeatureSet{}, {"nothing_writes_this"}), Error);
 }
 
+// Typed resources: the graph checks types when the graph is built, owns the data, hands it to
+// passes, and releases it after its last reader.
+TEST(FrameGraph, RejectsAReaderWhoseTypeDiffersFromItsProducersNamingBothPassesAndTypes)
+{
+    FrameGraph graph;
+    const Resource<std::vector<float>> depth{"depth", ResourceType::cpuImage("float", 4, 4)};
+    graph.addPass({.name = "raster", .writes = {depth}}, [] { return PassOutcome{}; });
+    const Resource<std::vector<float>> asGpu{"depth", ResourceType::gpuImage("r32f", 4, 4)};
+    try {
+        graph.addPass({.name = "ao", .reads = {asGpu}, .writes = {"ao"}},
+                      [] { return PassOutcome{}; });
+        FAIL() << "a mismatched type must be refused";
+    } catch (const Error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("pass 'ao' reads 'depth' as gpu_image<r32f> 4x4"), std::string::npos) << m;
+        EXPECT_NE(m.find("pass 'raster' writes it as cpu_image<float> 4x4"), std::string::npos)
+            << m;
+    }
+    // Same declared type, other C++ type: also refused.
+    const Resource<std::vector<double>> asDouble{"depth", ResourceType::cpuImage("float", 4, 4)};
+    EXPECT_THROW(graph.addPass({.name = "ao2", .reads = {asDouble}, .writes = {"ao2"}},
+                               [] { return PassOutcome{}; }),
+                 Error);
+    // A token read only orders passes: it is accepted and gives no access to the data.
+    graph.addPass({.name = "order", .reads = {"depth"}, .writes = {"ordered"}},
+                  [] { return PassOutcome{}; });
+}
+
+TEST(FrameGraph, OwnsTheDataAndReleasesItAfterTheLastReader)
+{
+    FrameGraph graph;
+    const Resource<std::vector<int>> a{"a", ResourceType::table("ints")};
+    const Resource<std::vector<int>> b{"b", ResourceType::table("ints")};
+    const Resource<int> sum{"sum", ResourceType::value("int")};
+    graph.addPass({.name = "make_a", .writes = {a}}, [&](PassContext& ctx) {
+        ctx.write(a) = {1, 2, 3};
+        return PassOutcome{};
+    });
+    bool aHeldDuringB = false;
+    graph.addPass({.name = "make_b", .reads = {a}, .writes = {b}}, [&](PassContext& ctx) {
+        aHeldDuringB = graph.holds("a");
+        for (int v : ctx.read(a))
+            ctx.write(b).push_back(2 * v);
+        return PassOutcome{};
+    });
+    graph.addPass({.name = "add", .reads = {b}, .writes = {sum}}, [&](PassContext& ctx) {
+        EXPECT_FALSE(graph.holds("a")) << "'a' is released once its last reader (make_b) has run";
+        int total = 0;
+        for (int v : ctx.read(b))
+            total += v;
+        ctx.write(sum) = total;
+        EXPECT_THROW(ctx.read(a), Error) << "a pass reads only what it declares";
+        return PassOutcome{};
+    });
+    int seen = 0;
+    graph.addPass({.name = "show", .reads = {sum}, .writes = {"shown"}}, [&](PassContext& ctx) {
+        seen = ctx.read(sum);
+        return PassOutcome{};
+    });
+    const auto records = graph.execute(FeatureSet{}, {"shown"});
+    EXPECT_TRUE(aHeldDuringB);
+    EXPECT_EQ(seen, 12);
+    EXPECT_FALSE(graph.holds("b"));
+    EXPECT_FALSE(graph.holds("sum"));
+    EXPECT_EQ(graph.lastReleased(), (std::vector<std::string>{"a", "b", "sum"}));
+}
+
+TEST(FrameGraph, TimesEveryPassThatRunsAndOnlyThose)
+{
+    FrameGraph graph;
+    graph.addExternal("scene");
+    int calls = 0;
+    graph.addPass({.name = "once", .reads = {"scene"}, .writes = {"x"}},
+                  [] { return PassOutcome{}; });
+    graph.addPass(
+        {.name = "repeated", .reads = {"x"}, .writes = {"y"}, .timing = PassTiming::Repeated}, [&] {
+            ++calls;
+            return PassOutcome{};
+        });
+    graph.addPass({.name = "unread", .reads = {"x"}, .writes = {"z"}},
+                  [] { return PassOutcome{}; });
+    int gpuDrains = 0;
+    FrameOptions options;
+    options.outputs = {"y"};
+    options.timing = {.warmup = 2, .repeats = 3};
+    options.collectGpuTimes = [&] {
+        ++gpuDrains;
+        return metrics::GpuPassTimes{{"draw", 1.5}};
+    };
+    const auto records = graph.execute(options);
+    ASSERT_TRUE(records[0].time.has_value());
+    EXPECT_EQ(records[0].time->cpuMs.count, 1);
+    EXPECT_EQ(records[0].time->gpuMs.at("draw").median, 1.5);
+    ASSERT_TRUE(records[1].time.has_value());
+    EXPECT_EQ(calls, 1 + 2 + 3) << "first use, warm-up and repeats";
+    EXPECT_EQ(records[1].time->cpuMs.count, 3);
+    EXPECT_FALSE(records[2].time.has_value()) << "a skipped pass has no time";
+    EXPECT_GE(gpuDrains, 2 * 2);
+}
+
+TEST(FrameGraph, KeepsPersistentResourcesAcrossFramesAndReusesWorkUnlessCullingIsOff)
+{
+    FrameGraph graph;
+    const Resource<int> uploaded{"uploaded", ResourceType::value("int")};
+    int uploads = 0;
+    graph.addPass({.name = "upload",
+                   .writes = {uploaded},
+                   .persistent = {"uploaded"},
+                   .reuse =
+                       [&](const PassContext&) {
+                           return uploads > 0 ? std::string("unchanged") : std::string();
+                       }},
+                  [&](PassContext& ctx) {
+                      ctx.write(uploaded) = ++uploads;
+                      return PassOutcome{};
+                  });
+    int last = 0;
+    graph.addPass({.name = "draw", .reads = {uploaded}, .writes = {"image"}},
+                  [&](PassContext& ctx) {
+                      last = ctx.read(uploaded);
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "extra", .reads = {uploaded}, .writes = {"unused"}},
+                  [] { return PassOutcome{}; });
+    FrameOptions options;
+    options.outputs = {"image"};
+    graph.execute(options);
+    options.frame = 1;
+    const auto second = graph.execute(options);
+    EXPECT_EQ(uploads, 1);
+    EXPECT_EQ(last, 1) << "the persistent resource survives the frame";
+    EXPECT_EQ(formatPassRecords(second), "upload:skipped(unchanged);draw:run;extra:skipped(no "
+                                         "consumer: the run reads none of its outputs "
+                                         "(unused))");
+    options.culling = false;
+    const auto all = graph.execute(options);
+    EXPECT_EQ(uploads, 2) << "without culling nothing is reused";
+    EXPECT_EQ(formatPassRecords(all), "upload:run;draw:run;extra:run");
+}
+
 } // namespace
 } // namespace rtlab::pipeline

@@ -4,6 +4,7 @@
 // signed error is the mean occlusion of the reference, 1 - mean(reference AO).
 
 #include "experiment/analysis.h"
+#include "experiment/image_files.h"
 #include "experiment/runner.h"
 #include "plugin/occlusion.h"
 #include "test_registry.h"
@@ -21,7 +22,10 @@ namespace {
 
 class Unoccluded final : public plugin::OcclusionTechnique {
 public:
-    static plugin::TechniqueInfo describe() { return {.summary = "test double: no occlusion anywhere"}; }
+    static plugin::TechniqueInfo describe()
+    {
+        return {.summary = "test double: no occlusion anywhere"};
+    }
     static config::ParamSchema declareParams()
     {
         config::ParamSchema s;
@@ -69,7 +73,8 @@ base:
     const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_test";
     std::filesystem::remove_all(dir);
     const auto s = experiment::runExperiment(
-        e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
+        e, registry,
+        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     const auto rows = experiment::loadResults(dir.string());
     ASSERT_EQ(rows.size(), 1u);
     const auto& row = rows[0];
@@ -96,11 +101,13 @@ TEST(OcclusionDriver, AnAnalyticShapeIsARecordedFailure)
     auto registry = test::makeTestRegistry();
     plugin::registerTechnique<Unoccluded>(registry, "occlusion", "unoccluded");
     const auto e = experiment::parseExperiment(
-        "base: {scene: sphere, techniques: {occlusion: {technique: unoccluded}}}\n", "bad.yaml", registry);
+        "base: {scene: sphere, techniques: {occlusion: {technique: unoccluded}}}\n", "bad.yaml",
+        registry);
     const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_bad";
     std::filesystem::remove_all(dir);
     const auto s = experiment::runExperiment(
-        e, registry, {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
+        e, registry,
+        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     EXPECT_EQ(s.failed, 1u);
     const auto rows = experiment::loadResults(dir.string());
     ASSERT_EQ(rows.size(), 1u);
@@ -126,22 +133,147 @@ TEST(OcclusionDriver, RecordsSkippedPassesAndWhy)
   techniques: {occlusion: {technique: unoccluded}}
 )",
                                                (dir / "passes.yaml").string(), registry);
-    experiment::runExperiment(e, registry, {.outputDirectory = (dir / "out").string(), .quiet = true,
-                                            .queryVulkanForManifest = false});
+    experiment::runExperiment(e, registry,
+                              {.outputDirectory = (dir / "out").string(),
+                               .quiet = true,
+                               .queryVulkanForManifest = false});
     const auto rows = experiment::loadResults((dir / "out").string());
     ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
     const std::string& first = rows[0].at("passes");
-    EXPECT_NE(first.find("character_pose:skipped(the scene has no characters)"), std::string::npos) << first;
-    EXPECT_NE(first.find("assemble_geometry:run;scene_upload:run;gbuffer:run;view_inputs:run;occlusion:run"),
+    EXPECT_NE(first.find("character_pose:skipped(the scene has no characters)"), std::string::npos)
+        << first;
+    EXPECT_NE(first.find("assemble_geometry:run;scene_upload:run;gbuffer:run;gbuffer_readback:run;"
+                         "view_inputs:run;"
+                         "occlusion:run"),
               std::string::npos)
         << first;
-    EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped(geometry unchanged since frame 0"), std::string::npos)
+    // The graph timed the passes that ran: the repeated ones with their statistics, the others
+    // once.
+    EXPECT_TRUE(rows[0].count("gbuffer.cpu_ms_iqr")) << "gbuffer is timed with the run's repeats";
+    EXPECT_TRUE(rows[0].count("occlusion.cpu_ms_iqr"));
+    EXPECT_TRUE(rows[0].count("gbuffer_readback.cpu_ms"));
+    EXPECT_TRUE(rows[0].count("technique_ms"));
+    // A still camera over unchanged geometry: frame 1 neither redraws the G-buffer nor reads it
+    // back.
+    EXPECT_NE(rows[1].at("passes").find(
+                  "gbuffer:skipped(camera, geometry and size unchanged since frame 0"),
+              std::string::npos)
         << rows[1].at("passes");
-    EXPECT_NE(rows[1].at("passes").find("reference:skipped(read from the reference cache"), std::string::npos)
+    EXPECT_NE(rows[1].at("passes").find(
+                  "gbuffer_readback:skipped(the G-buffer is unchanged since frame 0"),
+              std::string::npos)
         << rows[1].at("passes");
-    EXPECT_NE(rows[1].at("passes").find("reference_bent:skipped(read from the reference cache"), std::string::npos)
+    EXPECT_FALSE(rows[1].count("gbuffer.cpu_ms")) << "a skipped pass has no time";
+    EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped(geometry unchanged since frame 0"),
+              std::string::npos)
+        << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("reference:skipped(read from the reference cache"),
+              std::string::npos)
+        << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("reference_bent:skipped(read from the reference cache"),
+              std::string::npos)
         << rows[1].at("passes");
     EXPECT_GT(experiment::getNumber(rows[0], "memory.peak_rss_mb"), 1.0);
+}
+
+TEST(OcclusionDriver, WithoutCullingEveryPassRunsAndTheImagesAreBitwiseTheSame)
+{
+    // frame: {culling: false} runs every pass of every frame (no reuse, no unread output dropped);
+    // the technique's and the reference's images must not change by a bit.
+    const auto& registry = plugin::builtinRegistry();
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_culling";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "still.yaml") << "scene: still\nbase: ao_testbed\nframes: 2\n";
+    auto run = [&](const std::string& culling) {
+        const auto e =
+            experiment::parseExperiment(R"(base:
+  scene: still.yaml
+  resolution: [24, 16]
+  frames: 2
+  metrics: [error]
+  frame: {culling: )" + culling + R"(}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.05, max_samples: 16}
+  techniques: {occlusion: {technique: gtao}}
+)",
+                                        (dir / ("culling_" + culling + ".yaml")).string(),
+                                        registry);
+        const auto out = dir / ("out_" + culling);
+        experiment::runExperiment(
+            e, registry,
+            {.outputDirectory = out.string(), .quiet = true, .queryVulkanForManifest = false});
+        return experiment::loadResults(out.string());
+    };
+    const auto culled = run("true");
+    const auto all = run("false");
+    ASSERT_EQ(culled.size(), 2u) << (culled.empty() ? "" : culled[0].at("error"));
+    ASSERT_EQ(all.size(), 2u) << (all.empty() ? "" : all[0].at("error"));
+    EXPECT_NE(culled[1].at("passes").find("gbuffer:skipped"), std::string::npos)
+        << culled[1].at("passes");
+    EXPECT_NE(culled[1].at("passes").find("metric.ssim:skipped(no consumer"), std::string::npos);
+    EXPECT_EQ(all[1].at("passes").find("no consumer"), std::string::npos) << all[1].at("passes");
+    EXPECT_EQ(all[1].at("passes").find("gbuffer:skipped"), std::string::npos)
+        << all[1].at("passes");
+    EXPECT_EQ(all[1].at("frame.culling"), "false");
+    for (int i = 0; i < 2; ++i)
+        for (const char* image : {"image.technique", "image.reference"}) {
+            EXPECT_EQ(experiment::readExrScalar(culled[std::size_t(i)].at(image)).pixels,
+                      experiment::readExrScalar(all[std::size_t(i)].at(image)).pixels)
+                << image << " of frame " << i;
+        }
+}
+
+TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
+{
+    // The Cornell box with a point light, two still frames, frame: {lighting: true}, and the
+    // bent-cone technique whose 16 cone visibilities attenuate the sky.
+    const auto& registry = plugin::builtinRegistry();
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_lit";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "lamp.yaml")
+        << "scene: lamp\nbase: cornell_box\nframes: 2\n"
+           "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n";
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: lamp.yaml
+  resolution: [32, 24]
+  frames: 2
+  metrics: [error]
+  frame: {lighting: true, tonemapper: reinhard, shadow_map_size: 64}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.05, target_rel_stderr: 0.1, max_samples: 32}
+  techniques: {occlusion: {technique: bentcone_ssdo}}
+)",
+                                               (dir / "lit.yaml").string(), registry);
+    experiment::runExperiment(e, registry,
+                              {.outputDirectory = (dir / "out").string(),
+                               .quiet = true,
+                               .queryVulkanForManifest = false});
+    const auto rows = experiment::loadResults((dir / "out").string());
+    ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
+    for (const auto& row : rows) {
+        ASSERT_EQ(row.at("status"), "ok") << row.at("error");
+        EXPECT_EQ(row.at("frame.visibility"), "cones")
+            << "bentcone_ssdo gives the 16 cone visibilities";
+        EXPECT_NE(row.at("frame.indirect").find("none"), std::string::npos)
+            << "no voxel_gi technique: recorded";
+        for (const char* column : {"frame.rmse", "frame.rel_mse", "frame.flip", "direct.rmse"}) {
+            const double v = experiment::getNumber(row, column);
+            EXPECT_TRUE(std::isfinite(v) && v >= 0.0) << column << " = " << v;
+        }
+        // The frame has no indirect light and no light from the emissive ceiling onto other
+        // surfaces: it is darker than the full radiance on average.
+        EXPECT_LT(experiment::getNumber(row, "frame.mean_signed_error"), 0.0);
+        EXPECT_TRUE(std::filesystem::exists(row.at("image.lit")));
+        EXPECT_TRUE(std::filesystem::exists(row.at("image.truth")));
+        EXPECT_TRUE(row.count("lighting.cpu_ms")) << "the graph times the compose passes";
+    }
+    EXPECT_EQ(rows[0].at("frame.shadow_maps_rendered"), "1");
+    EXPECT_NE(rows[1].at("passes").find(
+                  "shadow_maps:skipped(no light and no shadow caster moved since frame 0)"),
+              std::string::npos)
+        << rows[1].at("passes");
 }
 
 TEST(OcclusionDriver, ComputesOnlyTheMetricsTheRunAsksForAndTheGroundTruthTheyRead)
@@ -159,8 +291,9 @@ TEST(OcclusionDriver, ComputesOnlyTheMetricsTheRunAsksForAndTheGroundTruthTheyRe
   techniques: {occlusion: {technique: unoccluded}}
 )",
                                                (dir / "metrics.yaml").string(), registry);
-    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true,
-                                            .queryVulkanForManifest = false});
+    experiment::runExperiment(
+        e, registry,
+        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     const auto rows = experiment::loadResults(dir.string());
     ASSERT_EQ(rows.size(), 1u);
     ASSERT_EQ(rows[0].at("status"), "ok") << rows[0].at("error");
@@ -194,8 +327,9 @@ TEST(OcclusionDriver, MeasuresAgainstTheOverriddenQuantityAndSaysSo)
   techniques: {occlusion: {technique: unoccluded}}
 )",
                                                (dir / "override.yaml").string(), registry);
-    experiment::runExperiment(e, registry, {.outputDirectory = dir.string(), .quiet = true,
-                                            .queryVulkanForManifest = false});
+    experiment::runExperiment(
+        e, registry,
+        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
     const auto rows = experiment::loadResults(dir.string());
     ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
     EXPECT_EQ(rows[0].at("reference.quantity"), "ao_uniform");
@@ -204,16 +338,19 @@ TEST(OcclusionDriver, MeasuresAgainstTheOverriddenQuantityAndSaysSo)
     EXPECT_EQ(rows[0].at("camera_path"), "orbit");
     // The orbit moves the camera, not the geometry: frame 1 reuses the upload but draws anew,
     // and its ground truth is not a cache hit (the G-buffer changed).
-    EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped"), std::string::npos) << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("scene_upload:skipped"), std::string::npos)
+        << rows[1].at("passes");
     EXPECT_NE(rows[1].at("passes").find("gbuffer:run"), std::string::npos) << rows[1].at("passes");
-    EXPECT_NE(rows[1].at("passes").find("reference:run"), std::string::npos) << rows[1].at("passes");
+    EXPECT_NE(rows[1].at("passes").find("reference:run"), std::string::npos)
+        << rows[1].at("passes");
     // Flicker needs a previous frame; the screen-space split runs on every frame.
-    EXPECT_NE(rows[0].at("passes").find(
-                  "metric.flicker:skipped(input 'previous_frame' is not available: first frame of the run)"),
+    EXPECT_NE(rows[0].at("passes").find("metric.flicker:skipped(input 'previous_frame' is not "
+                                        "available: first frame of the run)"),
               std::string::npos)
         << rows[0].at("passes");
     EXPECT_TRUE(std::isfinite(experiment::getNumber(rows[1], "flicker.rms")));
-    EXPECT_GT(experiment::getNumber(rows[1], "flicker.used_share"), 0.5) << "a 45-degree orbit about the target keeps most pixels in view";
+    EXPECT_GT(experiment::getNumber(rows[1], "flicker.used_share"), 0.5)
+        << "a 45-degree orbit about the target keeps most pixels in view";
     for (const auto& row : rows) {
         EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "screen_truth.rmse")));
         EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "ao_vs_screen_truth.rmse")));

@@ -10,7 +10,7 @@ using namespace rtlab;
 TEST(Registry, BuiltinFamiliesArePresent)
 {
     const auto& r = plugin::builtinRegistry();
-    EXPECT_EQ(r.familyNames(), (std::vector<std::string>{"occlusion", "isosurface", "voxel_gi"}));
+    EXPECT_EQ(r.familyNames(), (std::vector<std::string>{"isosurface", "occlusion", "voxel_gi"}));
 }
 
 TEST(Registry, DuplicatesAndUnknownFamiliesAreRejected)

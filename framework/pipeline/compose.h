@@ -1,0 +1,113 @@
+#pragma once
+// The compose passes of the lit frame, on the GPU, after the families' passes:
+//
+//   shadow_maps     cube shadow maps of the point lights (needs point_lights). Re-rendered only
+//                   for lights that moved, and for all lights when a shadow caster moved (the
+//                   frame's geometry changed: characters, digs); skipped when neither happened.
+//   lighting        point lights with filtered shadows, the 16-lobe SRBF sky attenuated by the
+//                   frame's directional occlusion, emission, and the indirect slot
+//                   (render/lighting_pass.h). The occlusion family fills `occlusion.ambient`
+//                   and, when its technique gives them, the 16 per-direction cone visibilities
+//                   `occlusion.cone_visibility` (used instead, as the Tomorrow Children did:
+//                   shared/seeds/000_3da000e866ebc485.txt); `indirect_irradiance` is the voxel GI
+//                   family's slot. A slot no family fills is recorded as such.
+//   tonemap         exposure and the tonemapper (ACES fit or Reinhard), sRGB
+//   frame_readback  HDR, direct and tonemapped frames to the CPU (metrics and files)
+//
+// Resources a family writes for the frame use the slot names below with these types; a slot
+// nobody writes is an unavailable external, so the lighting pass reads it optionally.
+
+#include "core/image.h"
+#include "pipeline/frame_graph.h"
+#include "pipeline/frame_start.h"
+
+#include <glm/vec3.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rtlab::render {
+class LightingPass;
+class ShadowPass;
+} // namespace rtlab::render
+namespace rtlab::gpu {
+class Image;
+}
+
+namespace rtlab::pipeline {
+
+//! The lit frame on the CPU.
+struct LitFrame {
+    Image<glm::vec3> hdr;    //!< linear radiance: emission + direct + indirect
+    Image<glm::vec3> direct; //!< albedo/pi * (point lights + sky), no emission, no indirect
+    Image<glm::vec3> ldr;    //!< tonemapped, sRGB-encoded, [0, 1]
+};
+
+//! A GPU image of the frame (owned by the compose passes).
+struct GpuFrameImage {
+    const gpu::Image* image = nullptr;
+};
+
+struct ComposeOptions {
+    std::string tonemapper = "aces"; //!< "aces" or "reinhard" (render/lighting_pass.h)
+    double exposureEv = 0.0;
+    int shadowMapSize = 256; //!< texels per cube face
+};
+
+//! What the compose passes did in the last frame (columns of the row).
+struct ComposeStats {
+    int lights = 0;
+    int lightsRendered = 0; //!< shadow maps drawn this frame
+    std::string visibility; //!< "none", "ambient_occlusion", "cones"
+    std::string indirect;   //!< "none (...)" or the producer's slot
+};
+
+class Compose {
+public:
+    static constexpr const char* kAmbientOcclusion = "occlusion.ambient";
+    static constexpr const char* kConeVisibility = "occlusion.cone_visibility";
+    static constexpr const char* kIndirectIrradiance = "indirect_irradiance";
+    static constexpr const char* kLitFrame = "lit_frame";
+
+    Compose(FrameStart& start, ComposeOptions options);
+    ~Compose();
+
+    //! Adds the passes; call after every family has added its own (they fill the slots).
+    void addPasses(FrameGraph& graph);
+    const ComposeStats& getStats() const { return mStats; }
+    const ComposeOptions& getOptions() const { return mOptions; }
+
+    // The slots (typed as the families that fill them must write them) and the CPU frame.
+    static Resource<Image<float>> ambientOcclusionSlot(int width, int height)
+    {
+        return {kAmbientOcclusion, ResourceType::cpuImage("float", width, height)};
+    }
+    static Resource<std::vector<Image<float>>> coneVisibilitySlot(int width, int height)
+    {
+        return {kConeVisibility, ResourceType::cpuImage("16 x float", width, height)};
+    }
+    static Resource<Image<glm::vec3>> indirectIrradianceSlot(int width, int height)
+    {
+        return {kIndirectIrradiance, ResourceType::cpuImage("vec3", width, height)};
+    }
+    Resource<LitFrame> litFrame() const
+    {
+        return {kLitFrame, ResourceType::cpuImage("lit frame: hdr, direct, ldr", mWidth, mHeight)};
+    }
+
+private:
+    FrameStart& mStart;
+    ComposeOptions mOptions;
+    int mWidth = 0;
+    int mHeight = 0;
+    std::unique_ptr<render::ShadowPass> mShadows;
+    std::unique_ptr<render::LightingPass> mLighting;
+    ComposeStats mStats;
+    // What the shadow maps were rendered for.
+    std::string mShadowGeometryHash;
+    std::vector<glm::vec3> mShadowLightPositions;
+    int mShadowFrame = -1;
+};
+
+} // namespace rtlab::pipeline

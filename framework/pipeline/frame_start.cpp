@@ -1,0 +1,182 @@
+#include "pipeline/frame_start.h"
+
+#include "core/hash.h"
+#include "gpu/context.h"
+#include "render/gbuffer_pass.h"
+
+#include <glm/geometric.hpp>
+#include <glm/mat3x3.hpp>
+
+namespace rtlab::pipeline {
+
+namespace {
+
+std::string makeDrawKey(const std::string& geometryHash, const scene::Camera& c, int width,
+                        int height)
+{
+    Hasher h;
+    h.addBytes(geometryHash.data(), geometryHash.size())
+        .addValue(c.position)
+        .addValue(c.target)
+        .addValue(c.up)
+        .addValue(c.verticalFovDegrees)
+        .addValue(c.nearPlane)
+        .addValue(c.farPlane)
+        .addValue(width)
+        .addValue(height);
+    return h.hexDigest();
+}
+
+} // namespace
+
+FrameStart::FrameStart(const scene::Scene& scene, gpu::Context& gpu, FrameStartOptions options)
+    : mScene(scene), mFeatures(scene.computeFeatures()), mGpu(gpu), mOptions(options)
+{
+}
+
+FrameStart::~FrameStart() = default;
+
+void FrameStart::addPasses(FrameGraph& graph)
+{
+    const auto sceneRes =
+        graph.addExternal<scene::Scene>(kScene, ResourceType::value("scene"), &mScene);
+    const Resource<std::vector<scene::SdfMesh>> sdfMeshes{"sdf_meshes",
+                                                          ResourceType::mesh("sdf meshes")};
+    const Resource<std::vector<scene::PosedCapsule>> capsules{
+        "capsules", ResourceType::table("posed capsules")};
+    const auto geometryRes = geometry();
+    const Resource<GpuScene> gpuScene{"gpu_scene", ResourceType::value("uploaded scene")};
+    const auto gbufferRes = gbuffer();
+    const auto gbufferCpuRes = gbufferCpu();
+    const auto viewRes = viewInputs();
+
+    graph.addPass({.name = "sdf_remesh",
+                   .reads = {sceneRes},
+                   .writes = {sdfMeshes},
+                   .needs = {scene::SceneFeature::SdfModels},
+                   .persistent = {sdfMeshes.name},
+                   .reuse =
+                       [this](const PassContext& ctx) {
+                           if (mMeshedFrame >= 0 &&
+                               mScene.getEditStateKey(ctx.frame()) == mMeshedEditKey)
+                               return "no edit starts after frame " + std::to_string(mMeshedFrame) +
+                                      ": its SDF meshes are reused";
+                           return std::string();
+                       }},
+                  [this, sdfMeshes](PassContext& ctx) {
+                      ctx.write(sdfMeshes) = mScene.meshSdfModels(ctx.frame());
+                      mMeshedEditKey = mScene.getEditStateKey(ctx.frame());
+                      mMeshedFrame = ctx.frame();
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "character_pose",
+                   .reads = {sceneRes},
+                   .writes = {capsules},
+                   .needs = {scene::SceneFeature::Characters}},
+                  [this, capsules](PassContext& ctx) {
+                      ctx.write(capsules) = mScene.poseCharacters(ctx.frame());
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "assemble_geometry",
+                   .reads = {sceneRes},
+                   .optionalReads = {sdfMeshes, capsules},
+                   .writes = {geometryRes}},
+                  [this, sdfMeshes, capsules, geometryRes](PassContext& ctx) {
+                      static const std::vector<scene::SdfMesh> kNoMeshes;
+                      static const std::vector<scene::PosedCapsule> kNoCapsules;
+                      const auto* meshes = ctx.tryRead(sdfMeshes);
+                      const auto* posed = ctx.tryRead(capsules);
+                      ctx.write(geometryRes) = mScene.assembleRenderScene(
+                          meshes ? *meshes : kNoMeshes, posed ? *posed : kNoCapsules, ctx.frame());
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "scene_upload",
+                   .reads = {geometryRes},
+                   .writes = {gpuScene},
+                   .persistent = {gpuScene.name},
+                   .reuse =
+                       [this, geometryRes](const PassContext& ctx) {
+                           if (!mGBufferPass || !mGBufferPass->hasScene())
+                               return std::string();
+                           const std::string hash = ctx.read(geometryRes).computeContentHash();
+                           // The upload pass's own record of what it uploaded.
+                           return hash == mUploadedHash ? "geometry unchanged since frame " +
+                                                              std::to_string(mUploadedFrame)
+                                                        : std::string();
+                       }},
+                  [this, geometryRes, gpuScene](PassContext& ctx) {
+                      if (!mGBufferPass)
+                          mGBufferPass = std::make_unique<render::GBufferPass>(mGpu);
+                      const scene::RenderScene& g = ctx.read(geometryRes);
+                      mGBufferPass->setScene(g);
+                      mUploadedHash = g.computeContentHash();
+                      mUploadedFrame = ctx.frame();
+                      ctx.write(gpuScene) = GpuScene{mUploadedHash, ctx.frame()};
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "gbuffer",
+                   .reads = {gpuScene},
+                   .writes = {gbufferRes},
+                   .timing = PassTiming::Repeated,
+                   .persistent = {gbufferRes.name},
+                   .reuse =
+                       [this, gpuScene](const PassContext& ctx) {
+                           const std::string key =
+                               makeDrawKey(ctx.read(gpuScene).hash, mScene.getCameraAt(ctx.frame()),
+                                           mOptions.width, mOptions.height);
+                           return mDrawnFrame >= 0 && key == mDrawnKey
+                                      ? "camera, geometry and size unchanged since frame " +
+                                            std::to_string(mDrawnFrame) + ": its G-buffer is reused"
+                                      : std::string();
+                       }},
+                  [this, gpuScene, gbufferRes](PassContext& ctx) {
+                      const scene::Camera camera = mScene.getCameraAt(ctx.frame());
+                      mGBufferPass->draw(camera, mOptions.width, mOptions.height);
+                      GpuGBuffer& out = ctx.write(gbufferRes);
+                      out.target = &mGBufferPass->getTarget();
+                      out.width = mOptions.width;
+                      out.height = mOptions.height;
+                      out.camera = camera;
+                      out.view = camera.viewMatrix();
+                      out.projection = camera.projectionMatrix(
+                          float(mOptions.width) / float(mOptions.height), glm::vec2(0.0f),
+                          {mOptions.width, mOptions.height});
+                      mDrawnKey = makeDrawKey(ctx.read(gpuScene).hash, camera, mOptions.width,
+                                              mOptions.height);
+                      mDrawnFrame = ctx.frame();
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "gbuffer_readback",
+                   .reads = {gbufferRes},
+                   .writes = {gbufferCpuRes},
+                   .persistent = {gbufferCpuRes.name},
+                   .reuse =
+                       [this](const PassContext&) {
+                           return mReadFrame >= 0 && mReadKey == mDrawnKey
+                                      ? "the G-buffer is unchanged since frame " +
+                                            std::to_string(mReadFrame) + ": its CPU copy is reused"
+                                      : std::string();
+                       }},
+                  [this, gbufferCpuRes](PassContext& ctx) {
+                      ctx.write(gbufferCpuRes) = mGBufferPass->readBack();
+                      mReadKey = mDrawnKey;
+                      mReadFrame = ctx.frame();
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "view_inputs", .reads = {gbufferCpuRes}, .writes = {viewRes}},
+                  [gbufferCpuRes, viewRes](PassContext& ctx) {
+                      const scene::GBuffer& g = ctx.read(gbufferCpuRes);
+                      ViewInputs& v = ctx.write(viewRes);
+                      const glm::mat3 toView(g.view);
+                      v.normal = Image<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
+                      v.surface = Image<std::uint8_t>(g.width, g.height, 0);
+                      for (std::size_t i = 0; i < v.normal.pixels.size(); ++i)
+                          if (g.materialId.pixels[i] != scene::kNoMaterial) {
+                              v.normal.pixels[i] = glm::normalize(toView * g.normal.pixels[i]);
+                              v.surface.pixels[i] = 1;
+                          }
+                      return PassOutcome{};
+                  });
+}
+
+} // namespace rtlab::pipeline

@@ -1,0 +1,131 @@
+#pragma once
+// The shared start of a screen-space frame, as reusable passes of the frame graph. Every screen
+// family of a run (occlusion, voxel GI, ...) reads the resources these passes write, so a run
+// with several families rasterises its G-buffer once:
+//
+//   sdf_remesh         the scene's SDF models as triangles (needs sdf_models; reused while no
+//                      edit starts: the Dreams-style edit list,
+//                      shared/seeds/001_5c6096db92814698.txt)
+//   character_pose     the characters' capsules at this frame (needs characters)
+//   assemble_geometry  the frame's triangles, lights and sky (scene::RenderScene)
+//   scene_upload       to the GPU (reused while the geometry is unchanged)
+//   gbuffer            rasterised on Vulkan into GPU attachments (timed with the run's repeats;
+//                      not redrawn while camera, geometry, size and jitter are unchanged)
+//   gbuffer_readback   the attachments copied to the CPU, only when a pass that runs reads them
+//   view_inputs        view-space normals and the surface mask (CPU), for CPU-side readers
+//
+// The passes are added once per run; FrameStart keeps what they reuse between frames.
+
+#include "core/image.h"
+#include "pipeline/frame_graph.h"
+#include "scene/gbuffer.h"
+#include "scene/render_scene.h"
+#include "scene/scene.h"
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace rtlab::gpu {
+class Context;
+class RenderTarget;
+} // namespace rtlab::gpu
+namespace rtlab::render {
+class GBufferPass;
+}
+
+namespace rtlab::pipeline {
+
+//! The G-buffer's GPU attachments of the current frame (render/gbuffer_pass.h: 0 world position
+//! + linear depth, 1 normal, 2 albedo, 3 emission RGBA32F, 4 material id R32Uint, D32 depth).
+struct GpuGBuffer {
+    const gpu::RenderTarget* target = nullptr;
+    int width = 0;
+    int height = 0;
+    glm::mat4 view{1.0f};
+    glm::mat4 projection{1.0f};
+    scene::Camera camera;
+};
+
+//! View-space inputs that CPU readers need besides the G-buffer.
+struct ViewInputs {
+    Image<glm::vec3> normal;     //!< view-space unit normals, zero where no surface
+    Image<std::uint8_t> surface; //!< 1 where a surface was rasterised
+};
+
+//! Marks that the frame's geometry is on the GPU (content hash of what was uploaded).
+struct GpuScene {
+    std::string hash;
+    int frame = -1;
+};
+
+//! Options of the frame start.
+struct FrameStartOptions {
+    int width = 320;
+    int height = 180;
+};
+
+class FrameStart {
+public:
+    //! Names of the resources the frame start writes.
+    static constexpr const char* kScene = "scene";
+    static constexpr const char* kGeometry = "geometry";
+    static constexpr const char* kGBuffer = "gbuffer";
+    static constexpr const char* kGBufferCpu = "gbuffer_cpu";
+    static constexpr const char* kViewInputs = "view_inputs";
+
+    //! `scene` must outlive the FrameStart and the graph; the Vulkan device is opened through
+    //! `gpu` when the first pass needs it.
+    FrameStart(const scene::Scene& scene, gpu::Context& gpu, FrameStartOptions options);
+    ~FrameStart();
+
+    //! Adds the passes (see above) to `graph`.
+    void addPasses(FrameGraph& graph);
+
+    const scene::Scene& getScene() const { return mScene; }
+    const scene::FeatureSet& getFeatures() const { return mFeatures; }
+    gpu::Context& getGpu() const { return mGpu; }
+    const FrameStartOptions& getOptions() const { return mOptions; }
+
+    // Typed handles of the resources, for the families' passes.
+    Resource<scene::Scene> scene() const { return {kScene, ResourceType::value("scene")}; }
+    Resource<scene::RenderScene> geometry() const
+    {
+        return {kGeometry, ResourceType::mesh("render scene")};
+    }
+    Resource<GpuGBuffer> gbuffer() const
+    {
+        return {kGBuffer, ResourceType::gpuImage("gbuffer: 4 x rgba32f + r32ui", mOptions.width,
+                                                 mOptions.height)};
+    }
+    Resource<scene::GBuffer> gbufferCpu() const
+    {
+        return {kGBufferCpu, ResourceType::cpuImage("gbuffer", mOptions.width, mOptions.height)};
+    }
+    Resource<ViewInputs> viewInputs() const
+    {
+        return {kViewInputs, ResourceType::cpuImage("view normal + surface mask", mOptions.width,
+                                                    mOptions.height)};
+    }
+
+private:
+    const scene::Scene& mScene;
+    scene::FeatureSet mFeatures;
+    gpu::Context& mGpu;
+    FrameStartOptions mOptions;
+    std::unique_ptr<render::GBufferPass> mGBufferPass;
+    // What is reused between frames.
+    std::uint64_t mMeshedEditKey = 0;
+    int mMeshedFrame = -1;
+    std::string mUploadedHash;
+    int mUploadedFrame = -1;
+    std::string mDrawnKey;
+    int mDrawnFrame = -1;
+    std::string mReadKey;
+    int mReadFrame = -1;
+};
+
+} // namespace rtlab::pipeline

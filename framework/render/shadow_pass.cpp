@@ -1,0 +1,333 @@
+#include "render/shadow_pass.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/geometric.hpp>
+
+#include "core/error.h"
+#include "render/gbuffer_geometry.h"
+#include "render/gbuffer_pass.h"
+#include "render/image_transfer.h"
+
+namespace rtlab::render {
+
+namespace {
+
+// Face axis F, and the directions R and U whose components give s and t (Vulkan cube-map
+// table): direction(face, s, t) = F + s R + t U.
+struct FaceBasis {
+    glm::vec3 forward;
+    glm::vec3 right;
+    glm::vec3 up;
+};
+
+constexpr std::array<FaceBasis, kCubeFaceCount> kFaces = {{
+    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},  // +x: s = -z/|x|, t = -y/|x|
+    {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},  // -x: s = +z/|x|, t = -y/|x|
+    {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},    // +y: s = +x/|y|, t = +z/|y|
+    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},  // -y: s = +x/|y|, t = -z/|y|
+    {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},   // +z: s = +x/|z|, t = -y/|z|
+    {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}}, // -z: s = -x/|z|, t = -y/|z|
+}};
+
+gpu::GraphicsPipeline createPipeline(gpu::Context& context, const ShadowPassOptions& options)
+{
+    gpu::ShaderCompilerOptions compilerOptions = options.compiler;
+    compilerOptions.includeDirs.push_back(getRenderShaderDir());
+    const gpu::ShaderCompiler compiler(compilerOptions);
+    gpu::GraphicsPipelineDesc desc;
+    desc.name = "shadow";
+    desc.vertexSpirv = compiler.compileFile(getRenderShaderDir() / "shadow.vert").spirv;
+    desc.fragmentSpirv = compiler.compileFile(getRenderShaderDir() / "shadow.frag").spirv;
+    desc.vertexBindings = {{0, sizeof(glm::vec3)}};
+    desc.vertexAttributes = {{0, 0, gpu::VertexFormat::Float3, 0}};
+    desc.colorFormats = {gpu::Format::R32Float};
+    desc.depthTest = true;
+    desc.cullMode = gpu::CullMode::None;
+    desc.pushConstantSize = sizeof(ShadowFaceConstants);
+    return context.createGraphicsPipeline(desc);
+}
+
+gpu::RenderTargetDesc makeFaceTargetDesc(int size)
+{
+    gpu::RenderTargetDesc desc;
+    desc.width = static_cast<std::uint32_t>(size);
+    desc.height = static_cast<std::uint32_t>(size);
+    desc.name = "shadow face";
+    gpu::ColorAttachmentDesc color;
+    color.format = gpu::Format::R32Float;
+    color.name = "shadow face distance";
+    const float inf = std::numeric_limits<float>::infinity();
+    color.clearFloat = {inf, inf, inf, inf}; // no occluder
+    desc.colors.push_back(color);
+    desc.depth = true;
+    desc.depthClear = 1.0f;
+    return desc;
+}
+
+} // namespace
+
+int computeCubeFace(glm::vec3 d)
+{
+    const glm::vec3 a = glm::abs(d);
+    if (a.x >= a.y && a.x >= a.z)
+        return d.x >= 0.0f ? 0 : 1;
+    if (a.y >= a.z)
+        return d.y >= 0.0f ? 2 : 3;
+    return d.z >= 0.0f ? 4 : 5;
+}
+
+glm::vec2 computeCubeFaceCoords(glm::vec3 d, int face)
+{
+    const FaceBasis& f = kFaces[static_cast<std::size_t>(face)];
+    const float major = glm::dot(d, f.forward);
+    return glm::vec2(glm::dot(d, f.right), glm::dot(d, f.up)) / major;
+}
+
+glm::vec3 computeCubeFaceDirection(int face, glm::vec2 st)
+{
+    const FaceBasis& f = kFaces[static_cast<std::size_t>(face)];
+    return f.forward + st.x * f.right + st.y * f.up;
+}
+
+glm::mat4 computeCubeFaceProjection(int face, float nearPlane, float farPlane)
+{
+    const FaceBasis& f = kFaces[static_cast<std::size_t>(face)];
+    // Rows: clip.x = d.R, clip.y = d.U (framebuffer row t grows with it, row 0 at t = -1),
+    // clip.w = d.F, clip.z = a d.F + b so that depth = z / w runs from 0 (near) to 1 (far).
+    const float a = farPlane / (farPlane - nearPlane);
+    const float b = -farPlane * nearPlane / (farPlane - nearPlane);
+    glm::mat4 m(0.0f);
+    for (int c = 0; c < 3; ++c) {
+        m[c][0] = f.right[c];
+        m[c][1] = f.up[c];
+        m[c][2] = a * f.forward[c];
+        m[c][3] = f.forward[c];
+    }
+    m[3][2] = b;
+    return m;
+}
+
+struct ShadowPass::State {
+    gpu::Context* context = nullptr;
+    ShadowPassOptions options;
+    gpu::GraphicsPipeline pipeline;
+    gpu::RenderTarget faceTarget;
+    gpu::Image atlas;
+    gpu::Buffer vertices;
+    gpu::Buffer indices;
+    std::uint32_t indexCount = 0;
+    bool uploaded = false;
+    std::vector<glm::vec3> uploadedPositions; // what the buffers hold, to skip equal uploads
+    std::vector<std::uint32_t> uploadedIndices;
+    glm::vec3 boundsMin{0.0f};
+    glm::vec3 boundsMax{0.0f};
+    std::vector<ShadowLightState> lights;
+    std::optional<double> lastGpuMs;
+
+    void createAtlas(std::size_t lightCount)
+    {
+        const std::uint32_t slices =
+            static_cast<std::uint32_t>(std::max<std::size_t>(lightCount, 1) * kCubeFaceCount);
+        const std::uint32_t limit = context->getDeviceInfo().maxImageDimension3D;
+        if (slices > limit)
+            throw Error("ShadowPass: " + std::to_string(lightCount) +
+                        " lights need a 3D image of depth " + std::to_string(slices) +
+                        ", the device allows " + std::to_string(limit));
+        atlas = gpu::Image(); // free the old one first
+        gpu::ImageDesc desc;
+        desc.dimension = gpu::ImageDimension::Image3D;
+        desc.format = gpu::Format::R32Float;
+        desc.width = desc.height = static_cast<std::uint32_t>(options.faceSize);
+        desc.depth = slices;
+        desc.usage = gpu::ImageUsage::Storage;
+        desc.name = "shadow atlas";
+        atlas = context->createImage(desc);
+    }
+
+    void uploadGeometry(const scene::RenderScene& scene)
+    {
+        if (uploaded && scene.positions == uploadedPositions && scene.indices == uploadedIndices)
+            return;
+        validateRenderScene(scene);
+        uploaded = false;
+        // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
+        const std::size_t vertexSlots = std::max<std::size_t>(scene.positions.size(), 1);
+        const std::size_t indexSlots = std::max<std::size_t>(scene.indices.size(), 3);
+        vertices = context->createBuffer(
+            {vertexSlots * sizeof(glm::vec3), "shadow vertices", /*vertexIndexUsage=*/true});
+        indices = context->createBuffer(
+            {indexSlots * sizeof(std::uint32_t), "shadow indices", /*vertexIndexUsage=*/true});
+        if (!scene.positions.empty())
+            vertices.uploadSpan<glm::vec3>(scene.positions);
+        if (!scene.indices.empty())
+            indices.uploadSpan<std::uint32_t>(scene.indices);
+        indexCount = static_cast<std::uint32_t>(scene.indices.size());
+        uploadedPositions = scene.positions;
+        uploadedIndices = scene.indices;
+        boundsMin = glm::vec3(std::numeric_limits<float>::max());
+        boundsMax = glm::vec3(std::numeric_limits<float>::lowest());
+        for (const glm::vec3& p : scene.positions) {
+            boundsMin = glm::min(boundsMin, p);
+            boundsMax = glm::max(boundsMax, p);
+        }
+        if (scene.positions.empty())
+            boundsMin = boundsMax = glm::vec3(0.0f);
+        uploaded = true;
+    }
+};
+
+ShadowPass::ShadowPass(gpu::Context& context, ShadowPassOptions options)
+    : mState(std::make_unique<State>())
+{
+    if (options.faceSize < 1 || options.faceSize > 4096)
+        throw Error("ShadowPass: faceSize " + std::to_string(options.faceSize) +
+                    " is outside 1..4096");
+    if (!(options.nearPlaneScale > 0.0f && options.nearPlaneScale <= 0.1f))
+        throw Error("ShadowPass: nearPlaneScale " + std::to_string(options.nearPlaneScale) +
+                    " is outside (0, 0.1]");
+    State& s = *mState;
+    s.context = &context;
+    s.options = options;
+    s.pipeline = createPipeline(context, options);
+    s.faceTarget = context.createRenderTarget(makeFaceTargetDesc(options.faceSize));
+    s.createAtlas(0);
+}
+
+ShadowPass::~ShadowPass() = default;
+ShadowPass::ShadowPass(ShadowPass&&) noexcept = default;
+ShadowPass& ShadowPass::operator=(ShadowPass&&) noexcept = default;
+
+gpu::RunResult ShadowPass::render(const scene::RenderScene& scene)
+{
+    std::vector<std::size_t> all(scene.pointLights.size());
+    for (std::size_t i = 0; i < all.size(); ++i)
+        all[i] = i;
+    return render(scene, all);
+}
+
+gpu::RunResult ShadowPass::render(const scene::RenderScene& scene,
+                                  std::span<const std::size_t> lightIndices)
+{
+    State& s = *mState;
+    const std::size_t lightCount = scene.pointLights.size();
+    for (const std::size_t i : lightIndices)
+        if (i >= lightCount)
+            throw Error("ShadowPass::render: light " + std::to_string(i) + " of " +
+                        std::to_string(lightCount));
+    s.uploadGeometry(scene);
+
+    std::vector<bool> chosen(lightCount, false);
+    for (const std::size_t i : lightIndices)
+        chosen[i] = true;
+    if (lightCount != s.lights.size()) {
+        s.createAtlas(lightCount);
+        s.lights.assign(lightCount, ShadowLightState{});
+        chosen.assign(lightCount, true);
+    }
+
+    const float diagonal = glm::length(s.boundsMax - s.boundsMin);
+    const float scale = diagonal > 0.0f ? diagonal : 1.0f;
+    const float nearPlane = s.options.nearPlaneScale * scale;
+
+    struct FaceDraw {
+        std::uint32_t slice = 0;
+        ShadowFaceConstants constants;
+    };
+    std::vector<FaceDraw> draws;
+    for (std::size_t light = 0; light < lightCount; ++light) {
+        if (!chosen[light])
+            continue;
+        const glm::vec3 p = scene.pointLights[light].position;
+        float farthest = 0.0f;
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::vec3 c((corner & 1) ? s.boundsMax.x : s.boundsMin.x,
+                              (corner & 2) ? s.boundsMax.y : s.boundsMin.y,
+                              (corner & 4) ? s.boundsMax.z : s.boundsMin.z);
+            farthest = std::max(farthest, glm::length(c - p));
+        }
+        const float farPlane = std::max(farthest * 1.01f + nearPlane, 4.0f * nearPlane);
+        for (int face = 0; face < kCubeFaceCount; ++face) {
+            FaceDraw d;
+            d.slice = static_cast<std::uint32_t>(light * kCubeFaceCount + std::size_t(face));
+            d.constants.relativeFaceProjection =
+                computeCubeFaceProjection(face, nearPlane, farPlane);
+            d.constants.lightPosition = glm::vec4(p, 1.0f);
+            draws.push_back(d);
+        }
+        ShadowLightState& state = s.lights[light];
+        state.rendered = true;
+        state.position = p;
+        state.nearPlane = nearPlane;
+        state.farPlane = farPlane;
+        ++state.renderCount;
+    }
+
+    gpu::IndexedDraw drawCall;
+    drawCall.vertexBuffers = {&s.vertices};
+    drawCall.indexBuffer = &s.indices;
+    drawCall.indexCount = s.indexCount;
+    gpu::RunResult result = s.context->run([&](gpu::CommandList& cmd) {
+        for (const FaceDraw& d : draws) {
+            cmd.drawIndexed(s.pipeline, s.faceTarget, drawCall, gpu::PushConstants(d.constants),
+                            kDrawLabel);
+            copyAttachmentToImage(cmd, s.faceTarget, 0, s.atlas, d.slice, kCopyLabel);
+        }
+    });
+    const std::optional<double> drawMs = result.sumGpuMs(kDrawLabel);
+    const std::optional<double> copyMs = result.sumGpuMs(kCopyLabel);
+    s.lastGpuMs = drawMs && copyMs ? std::optional<double>(*drawMs + *copyMs) : std::nullopt;
+    return result;
+}
+
+int ShadowPass::getFaceSize() const
+{
+    return mState->options.faceSize;
+}
+
+std::size_t ShadowPass::getLightCount() const
+{
+    return mState->lights.size();
+}
+
+const ShadowLightState& ShadowPass::getLightState(std::size_t light) const
+{
+    if (light >= mState->lights.size())
+        throw Error("ShadowPass::getLightState: light " + std::to_string(light) + " of " +
+                    std::to_string(mState->lights.size()));
+    return mState->lights[light];
+}
+
+const gpu::Image& ShadowPass::getAtlas() const
+{
+    return mState->atlas;
+}
+
+Image<float> ShadowPass::readBackFace(std::size_t light, int face) const
+{
+    const State& s = *mState;
+    if (light >= s.lights.size() || face < 0 || face >= kCubeFaceCount)
+        throw Error("ShadowPass::readBackFace: no face " + std::to_string(face) + " of light " +
+                    std::to_string(light));
+    const std::vector<float> all = s.atlas.downloadVector<float>();
+    const int n = s.options.faceSize;
+    Image<float> result(n, n);
+    const std::size_t offset =
+        (light * kCubeFaceCount + std::size_t(face)) * std::size_t(n) * std::size_t(n);
+    std::copy(all.begin() + static_cast<std::ptrdiff_t>(offset),
+              all.begin() + static_cast<std::ptrdiff_t>(offset + result.pixels.size()),
+              result.pixels.begin());
+    return result;
+}
+
+std::optional<double> ShadowPass::getLastGpuMs() const
+{
+    return mState->lastGpuMs;
+}
+
+} // namespace rtlab::render
