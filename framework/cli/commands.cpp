@@ -151,6 +151,12 @@ int runExperimentCommand(const RunOptions& options)
                 size += " camera_path=" + r.cameraPath;
             if (!r.metrics.empty())
                 size += " metrics=" + joinList(r.metrics);
+            if (!r.culling)
+                size += " frame.culling=false";
+            if (!r.gbufferOnGpu)
+                size += " frame.gbuffer_on_gpu=false";
+            if (r.lighting)
+                size += fmt::format(" frame.lighting={}@{}EV", r.tonemapper, r.exposureEv);
             if (!r.reference.quantity.empty() || r.reference.radius > 0.0)
                 size += fmt::format(
                     " reference={}{}",

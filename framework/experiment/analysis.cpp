@@ -30,12 +30,14 @@ double getNumber(const Row& row, const std::string& column)
     return (ec == std::errc() && p == e) ? v : std::numeric_limits<double>::quiet_NaN();
 }
 
-std::vector<std::size_t> findParetoFront(const std::vector<Row>& rows, const std::string& costColumn,
+std::vector<std::size_t> findParetoFront(const std::vector<Row>& rows,
+                                         const std::string& costColumn,
                                          const std::string& errorColumn)
 {
     std::vector<std::size_t> candidates;
     for (std::size_t i = 0; i < rows.size(); ++i)
-        if (std::isfinite(getNumber(rows[i], costColumn)) && std::isfinite(getNumber(rows[i], errorColumn)))
+        if (std::isfinite(getNumber(rows[i], costColumn)) &&
+            std::isfinite(getNumber(rows[i], errorColumn)))
             candidates.push_back(i);
     // Sweep by increasing cost (ties: lower error first); keep rows that lower the best error.
     std::sort(candidates.begin(), candidates.end(), [&](std::size_t a, std::size_t b) {
@@ -97,8 +99,8 @@ double parseDurationMs(const std::string& text)
         if (c != ' ')
             s += c;
     double scale = 1.0;
-    for (const auto& [suffix, factor] : {std::pair<const char*, double>{"ms", 1.0}, {"us", 1e-3}, {"ns", 1e-6},
-                                         {"s", 1e3}}) {
+    for (const auto& [suffix, factor] :
+         {std::pair<const char*, double>{"ms", 1.0}, {"us", 1e-3}, {"ns", 1e-6}, {"s", 1e3}}) {
         const std::string suf = suffix;
         if (s.size() > suf.size() && s.ends_with(suf)) {
             s.resize(s.size() - suf.size());
@@ -108,8 +110,10 @@ double parseDurationMs(const std::string& text)
     }
     double v = 0;
     auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), v);
-    if (s.empty() || ec != std::errc() || p != s.data() + s.size() || !(v >= 0.0) || !std::isfinite(v))
-        throw std::invalid_argument("expected a duration like 5ms, 0.5s or 250us, found '" + text + "'");
+    if (s.empty() || ec != std::errc() || p != s.data() + s.size() || !(v >= 0.0) ||
+        !std::isfinite(v))
+        throw std::invalid_argument("expected a duration like 5ms, 0.5s or 250us, found '" + text +
+                                    "'");
     return v * scale;
 }
 

@@ -20,7 +20,8 @@ double getNumber(const Row& row, const std::string& column);
 //! Indices of the rows on the Pareto front of (cost, error), both minimised, ordered by cost.
 //! Rows where either value is not finite are ignored. A row is on the front when no other row
 //! is at least as good in both and strictly better in one.
-std::vector<std::size_t> findParetoFront(const std::vector<Row>& rows, const std::string& costColumn,
+std::vector<std::size_t> findParetoFront(const std::vector<Row>& rows,
+                                         const std::string& costColumn,
                                          const std::string& errorColumn);
 
 } // namespace rtlab::experiment
@@ -29,10 +30,10 @@ namespace rtlab::experiment {
 
 //! The answer to "which run is best under a constraint".
 struct BestQuery {
-    std::string costColumn = "extract.cpu_ms";  //!< minimised under --max-error
-    std::string errorColumn = "rms_deviation";  //!< minimised under --max-time
-    double maxCost = -1.0;   //!< >= 0: lowest error with cost <= maxCost
-    double maxError = -1.0;  //!< >= 0: lowest cost with error <= maxError
+    std::string costColumn = "extract.cpu_ms"; //!< minimised under --max-error
+    std::string errorColumn = "rms_deviation"; //!< minimised under --max-time
+    double maxCost = -1.0;                     //!< >= 0: lowest error with cost <= maxCost
+    double maxError = -1.0;                    //!< >= 0: lowest cost with error <= maxError
 };
 
 //! Index of the best ok row for the query, or -1 when no row satisfies the bound. Ties go to

@@ -46,7 +46,11 @@ std::string RunConfig::toJson() const
     if (reference.radius > 0.0)
         referenceJson.add("radius", reference.radius);
     JsonObject json;
-    json.add("scene", scene).add("grid", grid).add("width", width).add("height", height).add("frames", frames);
+    json.add("scene", scene)
+        .add("grid", grid)
+        .add("width", width)
+        .add("height", height)
+        .add("frames", frames);
     if (!cameraPath.empty())
         json.add("camera_path", cameraPath);
     if (!metrics.empty()) {
@@ -55,10 +59,12 @@ std::string RunConfig::toJson() const
             list += (list.empty() ? "" : ",") + m;
         json.add("metrics", list);
     }
-    if (!culling || lighting) {
+    if (!culling || lighting || !gbufferOnGpu) {
         JsonObject frame;
         if (!culling)
             frame.add("culling", false);
+        if (!gbufferOnGpu)
+            frame.add("gbuffer_on_gpu", false);
         if (lighting)
             frame.add("lighting", true)
                 .add("tonemapper", tonemapper)
@@ -67,7 +73,8 @@ std::string RunConfig::toJson() const
         json.addRaw("frame", frame.str());
     }
     return json.addRaw("reference", referenceJson.str())
-        .addRaw("timing", JsonObject().add("warmup", timing.warmup).add("repeats", timing.repeats).str())
+        .addRaw("timing",
+                JsonObject().add("warmup", timing.warmup).add("repeats", timing.repeats).str())
         .addRaw("techniques", techniquesJson.str())
         .str();
 }
@@ -97,7 +104,8 @@ constexpr const char* kTechniqueKey = "technique";
 struct Loader {
     const YamlFile& file;
     const plugin::Registry& registry;
-    mutable std::vector<std::pair<std::string, YAML::Node>> cameraPathNodes;  //!< non-built-in names, where
+    mutable std::vector<std::pair<std::string, YAML::Node>>
+        cameraPathNodes; //!< non-built-in names, where
 
     const plugin::TechniqueEntry& findTechnique(const YAML::Node& where, const std::string& family,
                                                 const std::string& name) const
@@ -117,20 +125,22 @@ struct Loader {
             if (std::filesystem::exists(beside))
                 run.scene = beside.lexically_normal().string();
             else if (!std::filesystem::exists(run.scene))
-                file.fail(node, "scene file '" + run.scene + "' does not exist (looked beside " + file.path() +
-                                    " and in the working folder)");
+                file.fail(node, "scene file '" + run.scene + "' does not exist (looked beside " +
+                                    file.path() + " and in the working folder)");
             return;
         }
         // An SDF model of a procedural scene, for the isosurface family: "csg_gallery/torus".
         if (const auto slash = run.scene.find('/'); slash != std::string::npos) {
             const std::string parent = run.scene.substr(0, slash);
-            config::checkName(file, node, parent, scene::getProceduralSceneNames(), "procedural scene");
+            config::checkName(file, node, parent, scene::getProceduralSceneNames(),
+                              "procedural scene");
             std::vector<std::string> models;
             for (const auto& m : scene::makeProceduralScene(parent).sdfModels)
                 models.push_back(m.name);
             if (models.empty())
                 file.fail(node, "scene '" + parent + "' has no SDF models to name after '/'");
-            config::checkName(file, node, run.scene.substr(slash + 1), models, "SDF model of '" + parent + "'");
+            config::checkName(file, node, run.scene.substr(slash + 1), models,
+                              "SDF model of '" + parent + "'");
             return;
         }
         std::vector<std::string> names = scene::analyticShapeNames();
@@ -142,7 +152,8 @@ struct Loader {
     void readResolution(const YAML::Node& node, RunConfig& run) const
     {
         if (!node.IsSequence() || node.size() != 2)
-            file.fail(node, "resolution: expected [width, height] in pixels, found " + config::describeNode(node));
+            file.fail(node, "resolution: expected [width, height] in pixels, found " +
+                                config::describeNode(node));
         run.width = int(config::readInt(file, node[0], "resolution width", 1, 8192));
         run.height = int(config::readInt(file, node[1], "resolution height", 1, 8192));
     }
@@ -150,7 +161,8 @@ struct Loader {
     void readReference(const YAML::Node& node, RunConfig& run) const
     {
         config::checkKeys(file, node,
-                          {"target_stderr", "target_rel_stderr", "max_samples", "seed", "quantity", "falloff", "radius"},
+                          {"target_stderr", "target_rel_stderr", "max_samples", "seed", "quantity",
+                           "falloff", "radius"},
                           {}, "reference");
         auto positive = [&](const char* key, double& out) {
             if (!node[key])
@@ -162,23 +174,27 @@ struct Loader {
         positive("target_stderr", run.reference.targetStdErr);
         positive("target_rel_stderr", run.reference.targetRelStdErr);
         if (node["max_samples"])
-            run.reference.maxSamples = int(config::readInt(file, node["max_samples"], "reference.max_samples", 1, 1 << 24));
+            run.reference.maxSamples = int(
+                config::readInt(file, node["max_samples"], "reference.max_samples", 1, 1 << 24));
         if (node["seed"])
-            run.reference.seed = std::uint64_t(config::readInt(file, node["seed"], "reference.seed", 0, INT64_MAX));
+            run.reference.seed =
+                std::uint64_t(config::readInt(file, node["seed"], "reference.seed", 0, INT64_MAX));
         if (node["quantity"]) {
-            run.reference.quantity = config::readString(file, node["quantity"], "reference.quantity");
-            config::checkName(file, node["quantity"], run.reference.quantity, {"ao", "ao_uniform", "obscurance"},
-                              "ground-truth quantity");
+            run.reference.quantity =
+                config::readString(file, node["quantity"], "reference.quantity");
+            config::checkName(file, node["quantity"], run.reference.quantity,
+                              {"ao", "ao_uniform", "obscurance"}, "ground-truth quantity");
         }
         if (node["falloff"]) {
             run.reference.falloff = config::readString(file, node["falloff"], "reference.falloff");
-            config::checkName(file, node["falloff"], run.reference.falloff, {"linear", "smoothstep"},
-                              "obscurance falloff");
+            config::checkName(file, node["falloff"], run.reference.falloff,
+                              {"linear", "smoothstep"}, "obscurance falloff");
         }
         if (node["radius"]) {
             run.reference.radius = config::readFloat(file, node["radius"], "reference.radius");
             if (!(run.reference.radius > 0.0) || !std::isfinite(run.reference.radius))
-                file.fail(node["radius"], "reference.radius: expected a finite number > 0 (world units)");
+                file.fail(node["radius"],
+                          "reference.radius: expected a finite number > 0 (world units)");
         }
     }
 
@@ -186,13 +202,15 @@ struct Loader {
     {
         run.cameraPath = config::readString(file, node, "camera_path");
         if (!scene::isBuiltinCameraPathName(run.cameraPath))
-            cameraPathNodes.emplace_back(run.cameraPath, node);  // checked against the scene after expansion
+            cameraPathNodes.emplace_back(run.cameraPath,
+                                         node); // checked against the scene after expansion
     }
 
     void readMetrics(const YAML::Node& node, RunConfig& run) const
     {
         if (!node.IsSequence() || node.size() == 0)
-            file.fail(node, "metrics: expected a non-empty list of metric names, found " + config::describeNode(node));
+            file.fail(node, "metrics: expected a non-empty list of metric names, found " +
+                                config::describeNode(node));
         std::vector<std::string> valid;
         for (const auto& [family, choice] : run.techniques)
             for (const auto& m : registry.findFamily(family)->metrics)
@@ -224,7 +242,8 @@ struct Loader {
             }
             for (const auto& [name, node] : cameraPathNodes)
                 if (name == run.cameraPath)
-                    config::checkName(file, node, name, it->second, "camera path of scene '" + run.scene + "'");
+                    config::checkName(file, node, name, it->second,
+                                      "camera path of scene '" + run.scene + "'");
         }
     }
 
@@ -239,7 +258,8 @@ struct Loader {
         if (node["warmup"])
             run.timing.warmup = int(config::readInt(file, node["warmup"], "timing.warmup", 0, 100));
         if (node["repeats"])
-            run.timing.repeats = int(config::readInt(file, node["repeats"], "timing.repeats", 1, 10000));
+            run.timing.repeats =
+                int(config::readInt(file, node["repeats"], "timing.repeats", 1, 10000));
     }
 
     bool readBool(const YAML::Node& node, const std::string& what) const
@@ -253,21 +273,28 @@ struct Loader {
     void readFrame(const YAML::Node& node, RunConfig& run) const
     {
         if (!node.IsMap())
-            file.fail(node, "frame: expected a mapping such as {culling: false}, found " + config::describeNode(node));
-        config::checkKeys(file, node, {"culling", "lighting", "tonemapper", "exposure_ev", "shadow_map_size"}, {},
-                          "frame");
+            file.fail(node, "frame: expected a mapping such as {culling: false}, found " +
+                                config::describeNode(node));
+        config::checkKeys(file, node,
+                          {"culling", "lighting", "gbuffer_on_gpu", "tonemapper", "exposure_ev",
+                           "shadow_map_size"},
+                          {}, "frame");
+        if (node["gbuffer_on_gpu"])
+            run.gbufferOnGpu = readBool(node["gbuffer_on_gpu"], "frame.gbuffer_on_gpu");
         if (node["culling"])
             run.culling = readBool(node["culling"], "frame.culling");
         if (node["lighting"])
             run.lighting = readBool(node["lighting"], "frame.lighting");
         if (node["tonemapper"]) {
             run.tonemapper = config::readString(file, node["tonemapper"], "frame.tonemapper");
-            config::checkName(file, node["tonemapper"], run.tonemapper, {"aces", "reinhard"}, "tonemapper");
+            config::checkName(file, node["tonemapper"], run.tonemapper, {"aces", "reinhard"},
+                              "tonemapper");
         }
         if (node["exposure_ev"])
             run.exposureEv = config::readFloat(file, node["exposure_ev"], "frame.exposure_ev");
         if (node["shadow_map_size"])
-            run.shadowMapSize = int(config::readInt(file, node["shadow_map_size"], "frame.shadow_map_size", 1, 4096));
+            run.shadowMapSize = int(
+                config::readInt(file, node["shadow_map_size"], "frame.shadow_map_size", 1, 4096));
     }
 
     // A run's families share one frame: screen families share the frame start, a volume family
@@ -276,27 +303,33 @@ struct Loader {
     {
         std::vector<std::string> screen, volume;
         for (const auto& [family, choice] : run.techniques)
-            (registry.findFamily(family)->domain == plugin::FamilyDomain::Volume ? volume : screen).push_back(family);
+            (registry.findFamily(family)->domain == plugin::FamilyDomain::Volume ? volume : screen)
+                .push_back(family);
         if (!volume.empty() && run.techniques.size() > 1)
-            file.fail(node, "techniques: family '" + volume.front() +
-                                "' works on a sampled volume and cannot share a run with other families (" +
-                                joinList(volume.size() > 1 ? volume : screen) +
-                                "); put it in a run of its own");
+            file.fail(
+                node,
+                "techniques: family '" + volume.front() +
+                    "' works on a sampled volume and cannot share a run with other families (" +
+                    joinList(volume.size() > 1 ? volume : screen) +
+                    "); put it in a run of its own");
     }
 
     void readTechniques(const YAML::Node& node, RunConfig& run) const
     {
         if (!node.IsMap() || node.size() == 0)
-            file.fail(node, "techniques: expected a mapping from family to {technique: name, params: {...}}, "
-                            "found " + config::describeNode(node) + ". Families: " +
-                                joinList(registry.familyNames()));
+            file.fail(
+                node,
+                "techniques: expected a mapping from family to {technique: name, params: {...}}, "
+                "found " +
+                    config::describeNode(node) + ". Families: " + joinList(registry.familyNames()));
         for (const auto& kv : node) {
             const std::string family = kv.first.Scalar();
             config::checkName(file, kv.first, family, registry.familyNames(), "technique family");
             const YAML::Node& choiceNode = kv.second;
             config::checkKeys(file, choiceNode, {kTechniqueKey, "params"}, {kTechniqueKey},
                               "techniques." + family);
-            const std::string name = config::readString(file, choiceNode[kTechniqueKey], "technique");
+            const std::string name =
+                config::readString(file, choiceNode[kTechniqueKey], "technique");
             const auto& entry = findTechnique(choiceNode[kTechniqueKey], family, name);
             TechniqueChoice choice{name, config::ParamSet::defaultsOf(entry.schema)};
             if (choiceNode["params"])
@@ -310,8 +343,8 @@ struct Loader {
     RunConfig readBase(const YAML::Node& node) const
     {
         config::checkKeys(file, node,
-                          {"scene", "grid", "resolution", "frames", "camera_path", "metrics", "timing", "reference",
-                           "frame", "techniques"},
+                          {"scene", "grid", "resolution", "frames", "camera_path", "metrics",
+                           "timing", "reference", "frame", "techniques"},
                           {"scene", "techniques"}, "base");
         RunConfig run;
         readScene(node["scene"], run);
@@ -357,10 +390,18 @@ struct Loader {
             run.culling = readBool(value, "frame.culling");
             return;
         }
+        if (key == "frame.gbuffer_on_gpu") {
+            run.gbufferOnGpu = readBool(value, "frame.gbuffer_on_gpu");
+            return;
+        }
         const auto dot = key.find('.');
         if (dot == std::string::npos)
-            file.fail(keyNode, "sweep: unknown axis '" + key + "'; valid axes: scene, grid, resolution, frames, camera_path, frame.culling, "
-                               "<family>.technique, <family>.<parameter>, zip");
+            file.fail(
+                keyNode,
+                "sweep: unknown axis '" + key +
+                    "'; valid axes: scene, grid, resolution, frames, camera_path, frame.culling, "
+                    "frame.gbuffer_on_gpu, "
+                    "<family>.technique, <family>.<parameter>, zip");
         const std::string family = key.substr(0, dot);
         const std::string field = key.substr(dot + 1);
         config::checkName(file, keyNode, family, registry.familyNames(), "technique family");
@@ -380,20 +421,23 @@ struct Loader {
         if (it == run.techniques.end())
             file.fail(keyNode, "sweep: axis '" + key + "' sets a parameter of family '" + family +
                                    "', but the run uses no technique of that family; add it under "
-                                   "base.techniques or sweep " + family + ".technique");
+                                   "base.techniques or sweep " +
+                                   family + ".technique");
         const auto& entry = *registry.findTechnique(family, it->second.technique);
         const config::ParamSpec* spec = entry.schema.find(field);
         if (!spec) {
-            std::string msg = "sweep: technique '" + it->second.technique + "' declares no parameter '" +
-                              field + "'";
+            std::string msg = "sweep: technique '" + it->second.technique +
+                              "' declares no parameter '" + field + "'";
             const auto close = closestNames(field, entry.schema.names());
             if (!close.empty())
                 msg += "; did you mean " + joinList(close, "or") + "?";
-            msg += " Its parameters: " + (entry.schema.empty() ? "none" : joinList(entry.schema.names())) + ".";
+            msg += " Its parameters: " +
+                   (entry.schema.empty() ? "none" : joinList(entry.schema.names())) + ".";
             file.fail(keyNode, msg);
         }
-        it->second.params.set(field, config::parseValue(file, value, *spec,
-                                                        "technique '" + it->second.technique + "'"));
+        it->second.params.set(
+            field,
+            config::parseValue(file, value, *spec, "technique '" + it->second.technique + "'"));
     }
 
     // Expands `sweep` on top of `runs`: the cross product of its axes (and zip groups), with
@@ -406,14 +450,16 @@ struct Loader {
         std::map<std::string, std::size_t> seen;
         for (std::size_t i = 0; i < runs.size(); ++i)
             if (!seen.emplace(runs[i].hash(), i).second)
-                file.fail(sweep, "sweep: runs " + std::to_string(seen[runs[i].hash()] + 1) + " and " +
-                                     std::to_string(i + 1) + " of the expansion are identical (" +
-                                     runs[i].id() + "); does an axis repeat a value?");
+                file.fail(sweep, "sweep: runs " + std::to_string(seen[runs[i].hash()] + 1) +
+                                     " and " + std::to_string(i + 1) +
+                                     " of the expansion are identical (" + runs[i].id() +
+                                     "); does an axis repeat a value?");
         return runs;
     }
 
-    std::vector<RunConfig> expandAxes(const YAML::Node& sweep, std::vector<RunConfig> runs, const RunConfig& base,
-                                      std::vector<std::string>& keys, bool topLevel) const
+    std::vector<RunConfig> expandAxes(const YAML::Node& sweep, std::vector<RunConfig> runs,
+                                      const RunConfig& base, std::vector<std::string>& keys,
+                                      bool topLevel) const
     {
         if (!sweep)
             return runs;
@@ -423,13 +469,14 @@ struct Loader {
         // An axis of the cross product: one key, or a zip group of keys whose lists move
         // together (value i of every key in the group goes into the same run).
         struct Axis {
-            std::vector<std::pair<YAML::Node, YAML::Node>> keys;  // (key node, list of values)
+            std::vector<std::pair<YAML::Node, YAML::Node>> keys; // (key node, list of values)
             std::size_t size = 0;
             bool switchesTechnique = false;
         };
         auto checkList = [&](const YAML::Node& keyNode, const YAML::Node& values) {
             if (!values.IsSequence() || values.size() == 0)
-                file.fail(values, "sweep: axis '" + keyNode.Scalar() + "' needs a non-empty list of values, found " +
+                file.fail(values, "sweep: axis '" + keyNode.Scalar() +
+                                      "' needs a non-empty list of values, found " +
                                       config::describeNode(values));
         };
         std::vector<Axis> axes;
@@ -442,28 +489,37 @@ struct Loader {
             }
             if (key != "zip") {
                 checkList(kv.first, kv.second);
-                axes.push_back({{{kv.first, kv.second}}, kv.second.size(), key.ends_with(".technique")});
+                axes.push_back(
+                    {{{kv.first, kv.second}}, kv.second.size(), key.ends_with(".technique")});
                 continue;
             }
             if (!kv.second.IsSequence() || kv.second.size() == 0)
-                file.fail(kv.second, "sweep: zip: expected a list of groups, each a mapping from axis to "
-                                     "lists of equal length, found " + config::describeNode(kv.second));
+                file.fail(kv.second,
+                          "sweep: zip: expected a list of groups, each a mapping from axis to "
+                          "lists of equal length, found " +
+                              config::describeNode(kv.second));
             for (const auto& group : kv.second) {
                 if (!group.IsMap() || group.size() < 2)
-                    file.fail(group, "sweep: zip: a group needs a mapping of at least two axes whose values "
-                                     "move together, found " + config::describeNode(group));
+                    file.fail(
+                        group,
+                        "sweep: zip: a group needs a mapping of at least two axes whose values "
+                        "move together, found " +
+                            config::describeNode(group));
                 Axis axis;
                 for (const auto& member : group) {
                     if (member.first.Scalar() == "zip")
                         file.fail(member.first, "sweep: zip groups cannot be nested");
                     checkList(member.first, member.second);
                     if (axis.size != 0 && member.second.size() != axis.size)
-                        file.fail(member.second, "sweep: zip: '" + member.first.Scalar() + "' has " +
-                                                     std::to_string(member.second.size()) + " values but '" +
-                                                     axis.keys.front().first.Scalar() + "' has " +
-                                                     std::to_string(axis.size) + "; zipped lists need equal lengths");
+                        file.fail(member.second,
+                                  "sweep: zip: '" + member.first.Scalar() + "' has " +
+                                      std::to_string(member.second.size()) + " values but '" +
+                                      axis.keys.front().first.Scalar() + "' has " +
+                                      std::to_string(axis.size) +
+                                      "; zipped lists need equal lengths");
                     axis.size = member.second.size();
-                    axis.switchesTechnique = axis.switchesTechnique || member.first.Scalar().ends_with(".technique");
+                    axis.switchesTechnique =
+                        axis.switchesTechnique || member.first.Scalar().ends_with(".technique");
                     axis.keys.emplace_back(member.first, member.second);
                 }
                 axes.push_back(std::move(axis));
@@ -479,10 +535,12 @@ struct Loader {
             std::stable_partition(order.begin(), order.end(), isTechnique);
             return order;
         };
-        for (std::size_t a : techniquesFirst(axes.size(), [&](std::size_t i) { return axes[i].switchesTechnique; })) {
+        for (std::size_t a : techniquesFirst(
+                 axes.size(), [&](std::size_t i) { return axes[i].switchesTechnique; })) {
             const Axis& axis = axes[a];
-            const auto keyOrder = techniquesFirst(
-                axis.keys.size(), [&](std::size_t i) { return axis.keys[i].first.Scalar().ends_with(".technique"); });
+            const auto keyOrder = techniquesFirst(axis.keys.size(), [&](std::size_t i) {
+                return axis.keys[i].first.Scalar().ends_with(".technique");
+            });
             std::string name;
             for (const auto& [keyNode, values] : axis.keys)
                 name += (name.empty() ? "" : "+") + keyNode.Scalar();
@@ -492,7 +550,8 @@ struct Loader {
                 for (std::size_t i = 0; i < axis.size; ++i) {
                     RunConfig r = run;
                     for (std::size_t k : keyOrder)
-                        applyAxis(axis.keys[k].first.Scalar(), axis.keys[k].first, axis.keys[k].second[i], base, r);
+                        applyAxis(axis.keys[k].first.Scalar(), axis.keys[k].first,
+                                  axis.keys[k].second[i], base, r);
                     next.push_back(std::move(r));
                 }
             runs = std::move(next);
@@ -502,8 +561,10 @@ struct Loader {
         const YAML::Node variants = sweep["variants"];
         if (topLevel && variants) {
             if (!variants.IsSequence() || variants.size() == 0)
-                file.fail(variants, "sweep: variants: expected a list of sub-sweeps (mappings of axes), found " +
-                                        config::describeNode(variants));
+                file.fail(
+                    variants,
+                    "sweep: variants: expected a list of sub-sweeps (mappings of axes), found " +
+                        config::describeNode(variants));
             std::vector<RunConfig> all;
             for (const auto& variant : variants) {
                 std::vector<std::string> variantKeys;
@@ -539,7 +600,8 @@ Experiment parseExperiment(const std::string& text, const std::string& label,
     auto markVolume = [&](RunConfig& run) {
         run.volume = false;
         for (const auto& [family, choice] : run.techniques)
-            run.volume = run.volume || registry.findFamily(family)->domain == plugin::FamilyDomain::Volume;
+            run.volume =
+                run.volume || registry.findFamily(family)->domain == plugin::FamilyDomain::Volume;
     };
     markVolume(e.base);
     for (auto& run : e.runs)

@@ -20,6 +20,7 @@
 //     timing: {warmup: 1, repeats: 5}
 //     frame: {culling: true,            # false: run every pass (frame graph ablation)
 //             lighting: false,          # true: compose the lit frame, measure it against Embree
+//             gbuffer_on_gpu: true,     # false: techniques read the G-buffer's CPU copy (ablation)
 //             tonemapper: aces, exposure_ev: 0, shadow_map_size: 256}
 //     techniques:                       # one technique per family; several screen families
 //                                       # share one frame
@@ -52,30 +53,30 @@ struct TechniqueChoice {
 
 //! How the ground truth of screen-space families is computed (reference/reference.h).
 struct ReferenceOptions {
-    double targetStdErr = 0.01;     //!< absolute per-pixel standard error to reach
-    double targetRelStdErr = 0.02;  //!< relative part of the stopping rule
-    int maxSamples = 1024;          //!< per pixel
+    double targetStdErr = 0.01;    //!< absolute per-pixel standard error to reach
+    double targetRelStdErr = 0.02; //!< relative part of the stopping rule
+    int maxSamples = 1024;         //!< per pixel
     std::uint64_t seed = 0;
     //! Ground-truth quantity override ("ao", "ao_uniform", "obscurance"); "" = the quantity the
     //! technique declares. An override measures a technique against a quantity it does not claim
     //! (rows then say reference.matches_technique = false).
     std::string quantity;
-    std::string falloff;  //!< "linear", "smoothstep"; "" = the technique's
-    double radius = 0.0;  //!< world units; 0 = the technique's
+    std::string falloff; //!< "linear", "smoothstep"; "" = the technique's
+    double radius = 0.0; //!< world units; 0 = the technique's
 };
 
 //! One fully expanded run.
 struct RunConfig {
-    std::string scene;             //!< analytic shape, procedural scene, or scene file path
-    int grid = 64;                 //!< SDF samples per axis (isosurface)
-    int width = 320;               //!< image size in pixels (screen-space families)
+    std::string scene; //!< analytic shape, procedural scene, or scene file path
+    int grid = 64;     //!< SDF samples per axis (isosurface)
+    int width = 320;   //!< image size in pixels (screen-space families)
     int height = 180;
-    int frames = 1;                //!< frames 0..frames-1 of the scene's animation
-    std::string cameraPath;        //!< "" = the scene's own (scene/camera_paths.h)
-    std::vector<std::string> metrics;  //!< metric names of the run's families; empty = all
+    int frames = 1;                   //!< frames 0..frames-1 of the scene's animation
+    std::string cameraPath;           //!< "" = the scene's own (scene/camera_paths.h)
+    std::vector<std::string> metrics; //!< metric names of the run's families; empty = all
     metrics::TimingOptions timing;
     ReferenceOptions reference;
-    std::map<std::string, TechniqueChoice> techniques;  //!< family -> choice
+    std::map<std::string, TechniqueChoice> techniques; //!< family -> choice
     //! `frame: {culling: false}` runs every pass of the frame graph (no pass is skipped for having
     //! no consumer or for reusing earlier work): the ablation that proves culling changes nothing.
     bool culling = true;
@@ -84,6 +85,9 @@ struct RunConfig {
     //! term against `direct`); with its tonemapper ("aces", "reinhard"), exposure in stops and
     //! shadow-map size (texels per cube face).
     bool lighting = false;
+    //! `frame: {gbuffer_on_gpu: false}` makes Vulkan techniques read the CPU copy of the G-buffer
+    //! (read back, then uploaded again by the technique): the ablation of keeping it on the GPU.
+    bool gbufferOnGpu = true;
     std::string tonemapper = "aces";
     double exposureEv = 0.0;
     int shadowMapSize = 256;
@@ -106,8 +110,8 @@ struct Experiment {
     std::string name;
     std::string description;
     RunConfig base;
-    std::vector<std::string> sweepKeys;  //!< axes in file order
-    std::vector<RunConfig> runs;         //!< the expanded cross product (just `base` without sweep)
+    std::vector<std::string> sweepKeys; //!< axes in file order
+    std::vector<RunConfig> runs;        //!< the expanded cross product (just `base` without sweep)
 };
 
 //! Loads, validates and expands an experiment file.

@@ -14,7 +14,8 @@ GpuTimeSource chooseGpuTimeSource(const gpu::DeviceInfo& device)
 
 const char* toString(GpuTimeSource source)
 {
-    return source == GpuTimeSource::Timestamps ? "timestamps" : "submit-to-fence wall time (CPU Vulkan device)";
+    return source == GpuTimeSource::Timestamps ? "timestamps"
+                                               : "submit-to-fence wall time (CPU Vulkan device)";
 }
 
 metrics::GpuPassTimes collectGpuPassTimes(gpu::Context& context)

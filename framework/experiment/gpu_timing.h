@@ -15,13 +15,13 @@
 namespace rtlab::gpu {
 class Context;
 struct DeviceInfo;
-}
+} // namespace rtlab::gpu
 
 namespace rtlab::experiment {
 
 enum class GpuTimeSource {
-    Timestamps,      //!< per command, from timestamp queries
-    SubmitWallTime,  //!< per submission, submit to fence, on the CPU
+    Timestamps,     //!< per command, from timestamp queries
+    SubmitWallTime, //!< per submission, submit to fence, on the CPU
 };
 
 GpuTimeSource chooseGpuTimeSource(const gpu::DeviceInfo& device);

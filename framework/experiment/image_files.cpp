@@ -42,13 +42,16 @@ void writePng(const Image<glm::vec3>& display, const std::string& path)
     for (std::size_t i = 0; i < display.pixels.size(); ++i)
         for (int c = 0; c < 3; ++c) {
             const float v = display.pixels[i][c];
-            bytes[3 * i + std::size_t(c)] = (unsigned char)(std::isfinite(v) ? std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f) : 0);
+            bytes[3 * i + std::size_t(c)] =
+                (unsigned char)(std::isfinite(v) ? std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)
+                                                 : 0);
         }
     auto out = OIIO::ImageOutput::create(path);
     if (!out)
         throw Error(path + ": cannot create an image writer: " + OIIO::geterror());
     OIIO::ImageSpec spec(display.width, display.height, 3, OIIO::TypeDesc::UINT8);
-    if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, bytes.data()) || !out->close())
+    if (!out->open(path, spec) || !out->write_image(OIIO::TypeDesc::UINT8, bytes.data()) ||
+        !out->close())
         throw Error(path + ": cannot write: " + out->geterror());
 }
 

@@ -73,7 +73,7 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
         const reference::Quantity q = quantity;
         const auto out = resource;
         graph.addPass(
-            {.name = pass, .reads = {geometry, gbuffer}, .writes = {out}},
+            {.name = pass, .reads = {geometry, gbuffer}, .writes = {out}, .measurement = true},
             [this, pass, q, out, geometry, gbuffer, fromCache](pipeline::PassContext& ctx) {
                 reference::ReferenceResult& t = ctx.write(out);
                 t = reference::computeReference(ctx.read(geometry), ctx.read(gbuffer),
@@ -85,17 +85,22 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
                                          : pipeline::PassOutcome{};
             });
     }
+    graph.addPass({.name = "metric.frame",
+                   .reads = {lit, full, direct, view},
+                   .writes = {"metric.frame"},
+                   .measurement = true},
+                  [this, lit, full, direct, view](pipeline::PassContext& ctx) {
+                      const pipeline::LitFrame& f = ctx.read(lit);
+                      addRadianceErrors(*mRow, "frame", f.hdr, ctx.read(full).radiance, nullptr);
+                      addRadianceErrors(*mRow, "direct", f.direct, ctx.read(direct).radiance,
+                                        &ctx.read(view).surface);
+                      return pipeline::PassOutcome{};
+                  });
     graph.addPass(
-        {.name = "metric.frame", .reads = {lit, full, direct, view}, .writes = {"metric.frame"}},
-        [this, lit, full, direct, view](pipeline::PassContext& ctx) {
-            const pipeline::LitFrame& f = ctx.read(lit);
-            addRadianceErrors(*mRow, "frame", f.hdr, ctx.read(full).radiance, nullptr);
-            addRadianceErrors(*mRow, "direct", f.direct, ctx.read(direct).radiance,
-                              &ctx.read(view).surface);
-            return pipeline::PassOutcome{};
-        });
-    graph.addPass(
-        {.name = "frame_images", .reads = {lit, full}, .writes = {"frame_images"}},
+        {.name = "frame_images",
+         .reads = {lit, full},
+         .writes = {"frame_images"},
+         .measurement = true},
         [this, lit, full](pipeline::PassContext& ctx) {
             const std::string dir =
                 mContext.runDirectory() + "/frame" + std::to_string(ctx.frame());

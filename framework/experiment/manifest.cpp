@@ -5,10 +5,10 @@
 #include "gpu/context.h"
 
 #include <CLI/Version.hpp>
+#include <OpenImageIO/oiioversion.h>
 #include <embree3/rtcore_config.h>
 #include <fmt/core.h>
 #include <glm/detail/setup.hpp>
-#include <OpenImageIO/oiioversion.h>
 #include <tbb/version.h>
 #include <vulkan/vulkan_core.h>
 
@@ -27,7 +27,8 @@ namespace {
 // Output of a shell command (stdout), trimmed; "" when it fails.
 std::string runCommand(const std::string& command, int* status = nullptr)
 {
-    std::unique_ptr<FILE, int (*)(FILE*)> pipe(::popen((command + " 2>/dev/null").c_str(), "r"), ::pclose);
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(::popen((command + " 2>/dev/null").c_str(), "r"),
+                                               ::pclose);
     if (!pipe)
         return "";
     std::string out;
@@ -90,7 +91,8 @@ BuildInfo collectBuildInfo(bool queryVulkan)
     if (status != 0 || info.gitRevision.empty()) {
         info.gitRevision = "unknown (not a git checkout)";
     } else {
-        info.gitDirty = !runCommand("git -C '" + src + "' status --porcelain --untracked-files=no").empty();
+        info.gitDirty =
+            !runCommand("git -C '" + src + "' status --porcelain --untracked-files=no").empty();
     }
     info.cpuModel = readCpuModel();
     info.hardwareThreads = std::thread::hardware_concurrency();
@@ -117,17 +119,21 @@ BuildInfo collectBuildInfo(bool queryVulkan)
     return info;
 }
 
-void writeManifest(const Experiment& experiment, const BuildInfo& info, const std::string& directory,
-                   const std::string& shard)
+void writeManifest(const Experiment& experiment, const BuildInfo& info,
+                   const std::string& directory, const std::string& shard)
 {
     std::vector<std::string> runs;
     for (const auto& r : experiment.runs)
-        runs.push_back(JsonObject().add("id", r.id()).add("config_hash", r.hash()).addRaw("config", r.toJson()).str());
+        runs.push_back(JsonObject()
+                           .add("id", r.id())
+                           .add("config_hash", r.hash())
+                           .addRaw("config", r.toJson())
+                           .str());
     std::string experimentText;
     try {
         experimentText = readTextFile(experiment.path);
     } catch (const std::exception&) {
-        experimentText = "";  // parsed from memory (tests)
+        experimentText = ""; // parsed from memory (tests)
     }
     const std::string json = JsonObject()
                                  .add("experiment", experiment.name)

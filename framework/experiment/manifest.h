@@ -11,13 +11,13 @@
 namespace rtlab::experiment {
 
 struct BuildInfo {
-    std::string gitRevision;  //!< "unknown" outside a git checkout
-    bool gitDirty = false;    //!< uncommitted changes in the checkout at run time
+    std::string gitRevision; //!< "unknown" outside a git checkout
+    bool gitDirty = false;   //!< uncommitted changes in the checkout at run time
     std::string cpuModel;
     unsigned hardwareThreads = 0;
-    std::string vulkanDevice;  //!< "" when no Vulkan device could be opened
+    std::string vulkanDevice; //!< "" when no Vulkan device could be opened
     std::string vulkanDriver;
-    std::string dependencies;  //!< JSON object name -> version
+    std::string dependencies; //!< JSON object name -> version
 };
 
 //! Collects the information once (git is asked in the source tree rtlab was built from, or in
@@ -25,7 +25,7 @@ struct BuildInfo {
 BuildInfo collectBuildInfo(bool queryVulkan = true);
 
 //! Writes directory/manifest.json atomically (temporary file + rename).
-void writeManifest(const Experiment& experiment, const BuildInfo& info, const std::string& directory,
-                   const std::string& shard = "");
+void writeManifest(const Experiment& experiment, const BuildInfo& info,
+                   const std::string& directory, const std::string& shard = "");
 
 } // namespace rtlab::experiment

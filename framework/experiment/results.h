@@ -46,7 +46,8 @@ public:
     std::size_t writeCsv() const;
     //! Rows of results.jsonl as (column, text) pairs; lines that are not complete JSON objects
     //! (a crash mid-write) are skipped and counted in `skippedLines`.
-    std::vector<std::vector<std::pair<std::string, std::string>>> readRows(std::size_t* skippedLines = nullptr) const;
+    std::vector<std::vector<std::pair<std::string, std::string>>>
+    readRows(std::size_t* skippedLines = nullptr) const;
 
 private:
     std::string mDirectory;

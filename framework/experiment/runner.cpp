@@ -43,10 +43,19 @@ gpu::Context& DriverContext::getGpu()
 void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& records)
 {
     std::int64_t ran = 0, skipped = 0;
+    double frameCpu = 0.0, frameGpu = 0.0;
+    std::string framePasses;
     for (const auto& r : records) {
         (r.ran ? ran : skipped) += 1;
+        if (!r.measurement)
+            framePasses += (framePasses.empty() ? "" : ";") + r.name;
         if (!r.ran || !r.time)
             continue;
+        if (!r.measurement) {
+            frameCpu += r.time->cpuMs.median;
+            if (!r.time->gpuMs.empty())
+                frameGpu += r.time->gpuTotalMedianMs();
+        }
         if (r.timing == pipeline::PassTiming::Repeated) {
             addTimingColumns(row, r.name, *r.time);
         } else {
@@ -182,8 +191,7 @@ std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
             .set("scene_features", start->getFeatures().toString())
             .set("gpu_time_source",
                  std::string(toString(chooseGpuTimeSource(context.getGpu().getDeviceInfo()))));
-        if (!run.culling)
-            base.set("frame.culling", false);
+        base.set("frame.culling", run.culling).set("frame.gbuffer_on_gpu", run.gbufferOnGpu);
     }
     std::vector<ResultRow> rows;
     for (int frame = 0; frame < frames; ++frame) {

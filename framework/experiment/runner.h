@@ -73,7 +73,8 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
 //! Writes a frame's pass log: the columns "passes" ("gbuffer:run;reference:skipped(read from the
 //! cache)"), "passes_run", "passes_skipped", and the time of every pass that ran: for passes timed
 //! with the run's repeats the columns of addTimingColumns, for the others <pass>.cpu_ms (and
-//! <pass>.gpu_ms when the pass ran GPU work).
+//! <pass>.gpu_ms when the pass ran GPU work), and the frame's time: frame.cpu_ms and frame.gpu_ms,
+//! the sums over the passes that ran and make the frame (not measurement passes).
 void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& records);
 
 //! Current and peak resident memory of the process: columns memory.rss_mb, memory.peak_rss_mb.

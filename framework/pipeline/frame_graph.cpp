@@ -200,6 +200,7 @@ std::vector<PassRecord> FrameGraph::plan(const scene::FeatureSet& features,
         const PassDesc& pass = mPasses[i];
         records[i].name = pass.name;
         records[i].timing = pass.timing;
+        records[i].measurement = pass.measurement;
         for (scene::SceneFeature f : pass.needs)
             if (!features.has(f)) {
                 possible[i] = false;

@@ -142,6 +142,9 @@ struct PassDesc {
     //! outputs (persistent ones) are still valid, and the pass is skipped with that reason
     //! (unchanged geometry, an unchanged camera). Not timed.
     std::function<std::string(const PassContext&)> reuse;
+    //! True for passes that measure the frame rather than make it (ground truths, metrics, image
+    //! files): they are left out of the frame's time.
+    bool measurement = false;
 };
 
 //! How a pass ended in one frame.
@@ -150,6 +153,7 @@ struct PassRecord {
     bool ran = false;
     std::string reason; //!< why it was skipped; empty when it ran
     PassTiming timing = PassTiming::Once;
+    bool measurement = false; //!< from PassDesc
     //! When it ran: the CPU wall time (and GPU pass times) the graph measured.
     std::optional<metrics::TimingReport> time;
 };

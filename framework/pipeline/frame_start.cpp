@@ -2,7 +2,9 @@
 
 #include "core/hash.h"
 #include "gpu/context.h"
+#include "render/frame_matrices.h"
 #include "render/gbuffer_pass.h"
+#include "render/view_inputs_pass.h"
 
 #include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
@@ -137,10 +139,12 @@ void FrameStart::addPasses(FrameGraph& graph)
                       out.width = mOptions.width;
                       out.height = mOptions.height;
                       out.camera = camera;
-                      out.view = camera.viewMatrix();
-                      out.projection = camera.projectionMatrix(
-                          float(mOptions.width) / float(mOptions.height), glm::vec2(0.0f),
-                          {mOptions.width, mOptions.height});
+                      // The matrices the rasteriser used (render/frame_matrices.h), as the
+                      // read-back has them.
+                      const render::FrameMatrices m = render::computeFrameMatrices(
+                          camera, mOptions.width, mOptions.height, glm::vec2(0.0f));
+                      out.view = m.view;
+                      out.projection = m.projection;
                       mDrawnKey = makeDrawKey(ctx.read(gpuScene).hash, camera, mOptions.width,
                                               mOptions.height);
                       mDrawnFrame = ctx.frame();
@@ -175,6 +179,31 @@ void FrameStart::addPasses(FrameGraph& graph)
                               v.normal.pixels[i] = glm::normalize(toView * g.normal.pixels[i]);
                               v.surface.pixels[i] = 1;
                           }
+                      return PassOutcome{};
+                  });
+    const auto viewGpuRes = viewInputsGpu();
+    graph.addPass({.name = "view_inputs_gpu",
+                   .reads = {gbufferRes},
+                   .writes = {viewGpuRes},
+                   .persistent = {viewGpuRes.name},
+                   .reuse =
+                       [this](const PassContext&) {
+                           return mViewGpuFrame >= 0 && mViewGpuKey == mDrawnKey
+                                      ? "the G-buffer is unchanged since frame " +
+                                            std::to_string(mViewGpuFrame) +
+                                            ": its view inputs are reused"
+                                      : std::string();
+                       }},
+                  [this, gbufferRes, viewGpuRes](PassContext& ctx) {
+                      const GpuGBuffer& g = ctx.read(gbufferRes);
+                      if (!mViewInputsPass)
+                          mViewInputsPass = std::make_unique<render::ViewInputsPass>(mGpu);
+                      mViewInputsPass->run(*g.target, g.view);
+                      ctx.write(viewGpuRes) =
+                          GpuViewInputs{&mViewInputsPass->getDepth(), &mViewInputsPass->getNormal(),
+                                        g.view, g.projection};
+                      mViewGpuKey = mDrawnKey;
+                      mViewGpuFrame = ctx.frame();
                       return PassOutcome{};
                   });
 }

@@ -13,6 +13,8 @@
 //                      not redrawn while camera, geometry, size and jitter are unchanged)
 //   gbuffer_readback   the attachments copied to the CPU, only when a pass that runs reads them
 //   view_inputs        view-space normals and the surface mask (CPU), for CPU-side readers
+//   view_inputs_gpu    linear depth and view-space normals on the GPU, for Vulkan techniques
+//                      (the G-buffer stays on the GPU: no read-back unless a CPU reader runs)
 //
 // The passes are added once per run; FrameStart keeps what they reuse between frames.
 
@@ -31,11 +33,13 @@
 
 namespace rtlab::gpu {
 class Context;
+class Image;
 class RenderTarget;
 } // namespace rtlab::gpu
 namespace rtlab::render {
 class GBufferPass;
-}
+class ViewInputsPass;
+} // namespace rtlab::render
 
 namespace rtlab::pipeline {
 
@@ -54,6 +58,15 @@ struct GpuGBuffer {
 struct ViewInputs {
     Image<glm::vec3> normal;     //!< view-space unit normals, zero where no surface
     Image<std::uint8_t> surface; //!< 1 where a surface was rasterised
+};
+
+//! View-space inputs on the GPU (render/view_inputs_pass.h): R32Float linear depth and
+//! RGBA32Float view-space normals, for Vulkan techniques that bind them.
+struct GpuViewInputs {
+    const gpu::Image* linearDepth = nullptr;
+    const gpu::Image* normal = nullptr;
+    glm::mat4 view{1.0f};
+    glm::mat4 projection{1.0f};
 };
 
 //! Marks that the frame's geometry is on the GPU (content hash of what was uploaded).
@@ -76,6 +89,7 @@ public:
     static constexpr const char* kGBuffer = "gbuffer";
     static constexpr const char* kGBufferCpu = "gbuffer_cpu";
     static constexpr const char* kViewInputs = "view_inputs";
+    static constexpr const char* kViewInputsGpu = "view_inputs_gpu";
 
     //! `scene` must outlive the FrameStart and the graph; the Vulkan device is opened through
     //! `gpu` when the first pass needs it.
@@ -111,12 +125,19 @@ public:
                                                     mOptions.height)};
     }
 
+    Resource<GpuViewInputs> viewInputsGpu() const
+    {
+        return {kViewInputsGpu, ResourceType::gpuImage("r32f depth + rgba32f view normal",
+                                                       mOptions.width, mOptions.height)};
+    }
+
 private:
     const scene::Scene& mScene;
     scene::FeatureSet mFeatures;
     gpu::Context& mGpu;
     FrameStartOptions mOptions;
     std::unique_ptr<render::GBufferPass> mGBufferPass;
+    std::unique_ptr<render::ViewInputsPass> mViewInputsPass;
     // What is reused between frames.
     std::uint64_t mMeshedEditKey = 0;
     int mMeshedFrame = -1;
@@ -126,6 +147,8 @@ private:
     int mDrawnFrame = -1;
     std::string mReadKey;
     int mReadFrame = -1;
+    std::string mViewGpuKey;
+    int mViewGpuFrame = -1;
 };
 
 } // namespace rtlab::pipeline

@@ -14,41 +14,46 @@
 
 namespace rtlab::gpu {
 class Context;
-}
+class Image;
+} // namespace rtlab::gpu
 namespace rtlab::scene {
 struct RenderScene;
 struct GBuffer;
-}
+} // namespace rtlab::scene
 
 namespace rtlab::plugin {
 
 //! Which integral a technique estimates; the ground truth integrates the same one.
 enum class OcclusionQuantity {
-    CosineAo,    //!< 1/pi * integral of V(w) cos(theta) over the hemisphere, V=1 if unoccluded in radius
-    UniformAo,   //!< 1/(2 pi) * integral of V(w) over the hemisphere
-    Obscurance,  //!< cosine-weighted, occluders at distance d weighted by falloff(d / radius)
+    CosineAo,   //!< 1/pi * integral of V(w) cos(theta) over the hemisphere, V=1 if unoccluded in
+                //!< radius
+    UniformAo,  //!< 1/(2 pi) * integral of V(w) over the hemisphere
+    Obscurance, //!< cosine-weighted, occluders at distance d weighted by falloff(d / radius)
 };
 
 //! Obscurance falloff rho(x), x = distance / radius: 1 (unoccluded) for x >= 1 and for no hit.
 enum class OcclusionFalloff {
-    Linear,      //!< rho(x) = x
-    Smoothstep,  //!< rho(x) = 3x^2 - 2x^3
+    Linear,     //!< rho(x) = x
+    Smoothstep, //!< rho(x) = 3x^2 - 2x^3
 };
 
 struct OcclusionDefinition {
     OcclusionQuantity quantity = OcclusionQuantity::CosineAo;
-    double radius = 1.0;  //!< world units; occluders farther than this do not count
-    OcclusionFalloff falloff = OcclusionFalloff::Linear;  //!< Obscurance only
+    double radius = 1.0; //!< world units; occluders farther than this do not count
+    OcclusionFalloff falloff = OcclusionFalloff::Linear; //!< Obscurance only
 };
 
 //! A view of the G-buffer. View space: camera at the origin looking down -z, y up, x right; row 0
 //! of the images is the top of the screen.
 struct OcclusionInput {
-    const Image<float>* linearDepth = nullptr;  //!< view-space distance along -z, world units; inf = sky
-    const Image<glm::vec3>* normal = nullptr;   //!< view-space unit normals facing the camera (zero where no surface)
-    glm::mat4 projection{1.0f};                 //!< view -> Vulkan clip space (gbuffer.h), jitter included
-    glm::mat4 view{1.0f};                       //!< world -> view (to bring world directions, e.g. the 16 cones, to view space)
-    int frameIndex = 0;                          //!< for techniques that rotate samples over frames
+    const Image<float>* linearDepth =
+        nullptr; //!< view-space distance along -z, world units; inf = sky
+    const Image<glm::vec3>* normal =
+        nullptr; //!< view-space unit normals facing the camera (zero where no surface)
+    glm::mat4 projection{1.0f}; //!< view -> Vulkan clip space (gbuffer.h), jitter included
+    glm::mat4 view{
+        1.0f}; //!< world -> view (to bring world directions, e.g. the 16 cones, to view space)
+    int frameIndex = 0; //!< for techniques that rotate samples over frames
     //! The Vulkan device to run on. Null: run the plain C++ version (parity tests, CPU studies).
     //! GPU work goes through gpu::Context::run with labelled dispatches; the harness reads their
     //! timestamps from the context's run log, so a technique never reports its own time.
@@ -58,11 +63,18 @@ struct OcclusionInput {
     //! longer screen space. May be null (family suites, synthetic inputs).
     const scene::RenderScene* scene = nullptr;
     const scene::GBuffer* gbuffer = nullptr;
+    //! The same view on the GPU, when the frame keeps its G-buffer there (pipeline/frame_start.h):
+    //! R32Float linear depth and RGBA32Float view-space normals (w unused), storage images of the
+    //! G-buffer's size, made by the frame's `view_inputs_gpu` pass. A technique whose
+    //! acceptsGpuInputs() is true binds them instead of uploading linearDepth and normal, which
+    //! are then null; the others always get the CPU images.
+    const gpu::Image* gpuLinearDepth = nullptr;
+    const gpu::Image* gpuNormal = nullptr;
 };
 
 struct OcclusionOutput {
-    Image<float> ambient;            //!< AO or obscurance in [0, 1], 1 = unoccluded; 1 where no surface
-    Image<glm::vec3> bentNormal;     //!< view space, unit length; zero where no surface
+    Image<float> ambient;        //!< AO or obscurance in [0, 1], 1 = unoccluded; 1 where no surface
+    Image<glm::vec3> bentNormal; //!< view space, unit length; zero where no surface
     //! Half-angle in radians, [0, pi/2], in the cosine convention of the ground truth:
     //! sin^2(aperture) = cosine-weighted visible fraction (reference.h, "bent").
     Image<float> coneAperture;
@@ -80,6 +92,10 @@ public:
     //! Whether compute() fills bentNormal and coneAperture. The frame graph skips the ray-traced
     //! bent-cone ground truth for techniques that do not (nothing would read it).
     virtual bool outputsBentCone() const { return true; }
+    //! Whether compute() with OcclusionInput::gpu set reads gpuLinearDepth and gpuNormal (and
+    //! needs no CPU copy of the G-buffer). The frame graph then skips the G-buffer read-back unless
+    //! another pass reads it.
+    virtual bool acceptsGpuInputs() const { return false; }
 };
 
 } // namespace rtlab::plugin

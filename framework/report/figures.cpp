@@ -17,8 +17,6 @@
 
 namespace rtlab::report::detail {
 
-namespace {
-
 std::string makeFileName(std::string s)
 {
     for (char& c : s)
@@ -26,6 +24,8 @@ std::string makeFileName(std::string s)
             c = '_';
     return s;
 }
+
+namespace {
 
 Image<glm::vec3> toGrey(const Image<float>& image)
 {
@@ -353,6 +353,9 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             " (frame 0), over their absolute error maps; the crop is the region of the "
             "largest error, magnified.");
     }
+    Figures lit = writeLitFrameFigures(group, directory, colors);
+    figures.plots.insert(figures.plots.end(), lit.plots.begin(), lit.plots.end());
+    figures.captions.insert(figures.captions.end(), lit.captions.begin(), lit.captions.end());
     return figures;
 }
 

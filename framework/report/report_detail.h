@@ -4,6 +4,7 @@
 #include "report/report.h"
 
 #include "experiment/analysis.h"
+#include "plot/color.h"
 
 #include <map>
 #include <string>
@@ -42,6 +43,12 @@ struct Figures {
 
 //! Writes every figure of `group` under directory/plots; returns them with captions.
 Figures writeGroupFigures(const Group& group, const std::string& directory, const std::vector<std::string>& techniques);
+
+//! `s` with every character but letters, digits, '_' and '-' replaced by '_'.
+std::string makeFileName(std::string s);
+
+//! The lit frame's figures of `group` (runs with frame.rmse), or none.
+Figures writeLitFrameFigures(const Group& group, const std::string& directory, const plot::ColorTable& colors);
 
 //! technique.png, reference.png and error.png (|error| through viridis over [0, errorRange])
 //! beside every run frame's EXRs that lacks them; returns how many frames were written.

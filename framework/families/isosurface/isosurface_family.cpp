@@ -214,7 +214,7 @@ private:
                           return pipeline::PassOutcome{};
                       });
         graph.addPass(
-            {.name = "surface_samples", .reads = {model}, .writes = {"surface_points"}}, [this] {
+            {.name = "surface_samples", .reads = {model}, .writes = {"surface_points"}, .measurement = true}, [this] {
                 mSurfacePoints = metrics::sampleSdfSurface(mSubject.distance, mSubject.gradient,
                                                            mSubject.boundsMin, mSubject.boundsMax,
                                                            kSurfacePoints);
@@ -223,7 +223,7 @@ private:
         auto metricPass = [&](const std::string& name, std::vector<pipeline::ResourceRef> reads,
                               std::function<void()> compute) {
             graph.addPass(
-                {.name = "metric." + name, .reads = std::move(reads), .writes = {"metric." + name}},
+                {.name = "metric." + name, .reads = std::move(reads), .writes = {"metric." + name}, .measurement = true},
                 [compute] {
                     compute();
                     return pipeline::PassOutcome{};
@@ -287,7 +287,7 @@ private:
             mRow->set("self_intersections",
                       std::int64_t(metrics::findSelfIntersections(mMesh).pairs));
         });
-        graph.addPass({.name = "export", .reads = {"mesh", "field"}, .writes = {"exports"}},
+        graph.addPass({.name = "export", .reads = {"mesh", "field"}, .writes = {"exports"}, .measurement = true},
                       [this] {
                           const std::string& runDirectory = mContext.runDirectory();
                           for (const char* extension : {"obj", "ply", "vtp"})

@@ -254,35 +254,63 @@ private:
         std::vector<pipeline::ResourceRef> techniqueWrites = {ambient};
         if (mTechnique->outputsBentCone())
             techniqueWrites.push_back("technique_bent_cone");
-        graph.addPass(
-            {.name = "occlusion",
-             .reads = {gbuffer, view, geometry},
-             .writes = techniqueWrites,
-             .timing = pipeline::PassTiming::Repeated},
-            [this, gbuffer, view, geometry, ambient](pipeline::PassContext& ctx) {
-                const scene::GBuffer& g = ctx.read(gbuffer);
-                plugin::OcclusionInput input;
-                input.linearDepth = &g.depth;
-                input.normal = &ctx.read(view).normal;
-                input.projection = g.projection;
-                input.view = g.view;
-                input.frameIndex = ctx.frame();
-                input.gpu = &mContext.getGpu();
-                input.scene =
-                    &ctx.read(geometry); // for ray-traced baselines only (plugin/occlusion.h)
-                input.gbuffer = &g;
-                plugin::OcclusionOutput& out = ctx.write(ambient);
-                mTechnique->compute(input, out);
-                for (const auto& [name, value] : mTechnique->counters())
-                    mRow->set("counter." + name, value);
-                if (out.ambient.width != g.width || out.ambient.height != g.height)
-                    throw Error("technique '" + mTechniqueName + "' returned an ambient image of " +
-                                std::to_string(out.ambient.width) + "x" +
-                                std::to_string(out.ambient.height) + " for a " +
-                                std::to_string(g.width) + "x" + std::to_string(g.height) +
-                                " G-buffer");
-                return pipeline::PassOutcome{};
-            });
+        auto checkSize = [this, w, h](const plugin::OcclusionOutput& out) {
+            if (out.ambient.width != w || out.ambient.height != h)
+                throw Error("technique '" + mTechniqueName + "' returned an ambient image of " +
+                            std::to_string(out.ambient.width) + "x" +
+                            std::to_string(out.ambient.height) + " for a " + std::to_string(w) +
+                            "x" + std::to_string(h) + " G-buffer");
+        };
+        if (mTechnique->acceptsGpuInputs() && mRun.gbufferOnGpu) {
+            // The G-buffer stays on the GPU: the technique binds the view inputs made there, and
+            // the frame reads the G-buffer back only if another pass that runs needs it.
+            const auto viewGpu = start.viewInputsGpu();
+            graph.addPass({.name = "occlusion",
+                           .reads = {viewGpu},
+                           .writes = techniqueWrites,
+                           .timing = pipeline::PassTiming::Repeated},
+                          [this, viewGpu, ambient, checkSize](pipeline::PassContext& ctx) {
+                              const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
+                              plugin::OcclusionInput input;
+                              input.projection = v.projection;
+                              input.view = v.view;
+                              input.frameIndex = ctx.frame();
+                              input.gpu = &mContext.getGpu();
+                              input.gpuLinearDepth = v.linearDepth;
+                              input.gpuNormal = v.normal;
+                              plugin::OcclusionOutput& out = ctx.write(ambient);
+                              mTechnique->compute(input, out);
+                              for (const auto& [name, value] : mTechnique->counters())
+                                  mRow->set("counter." + name, value);
+                              checkSize(out);
+                              return pipeline::PassOutcome{};
+                          });
+        } else {
+            graph.addPass(
+                {.name = "occlusion",
+                 .reads = {gbuffer, view, geometry},
+                 .writes = techniqueWrites,
+                 .timing = pipeline::PassTiming::Repeated},
+                [this, gbuffer, view, geometry, ambient, checkSize](pipeline::PassContext& ctx) {
+                    const scene::GBuffer& g = ctx.read(gbuffer);
+                    plugin::OcclusionInput input;
+                    input.linearDepth = &g.depth;
+                    input.normal = &ctx.read(view).normal;
+                    input.projection = g.projection;
+                    input.view = g.view;
+                    input.frameIndex = ctx.frame();
+                    input.gpu = &mContext.getGpu();
+                    input.scene =
+                        &ctx.read(geometry); // ray-traced baselines only (plugin/occlusion.h)
+                    input.gbuffer = &g;
+                    plugin::OcclusionOutput& out = ctx.write(ambient);
+                    mTechnique->compute(input, out);
+                    for (const auto& [name, value] : mTechnique->counters())
+                        mRow->set("counter." + name, value);
+                    checkSize(out);
+                    return pipeline::PassOutcome{};
+                });
+        }
         // The frame's slots (pipeline/compose.h): the lit frame reads them when it runs.
         const auto aoSlot = pipeline::Compose::ambientOcclusionSlot(w, h);
         const auto conesSlot = pipeline::Compose::coneVisibilitySlot(w, h);
@@ -297,7 +325,10 @@ private:
         const std::string fromCache =
             "read from the reference cache (same scene, G-buffer and settings)";
         graph.addPass(
-            {.name = "reference", .reads = {geometry, gbuffer, view}, .writes = {truth}},
+            {.name = "reference",
+             .reads = {geometry, gbuffer, view},
+             .writes = {truth},
+             .measurement = true},
             [this, geometry, gbuffer, view, truth, fromCache](pipeline::PassContext& ctx) {
                 reference::ReferenceResult& t = ctx.write(truth);
                 t = reference::computeReference(ctx.read(geometry), ctx.read(gbuffer), mSettings);
@@ -313,21 +344,26 @@ private:
                 return t.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache)
                                          : pipeline::PassOutcome{};
             });
+        graph.addPass({.name = "reference_bent",
+                       .reads = {geometry, gbuffer},
+                       .writes = {truthBent},
+                       .measurement = true},
+                      [this, geometry, gbuffer, truthBent, fromCache](pipeline::PassContext& ctx) {
+                          reference::ReferenceSettings bentSettings = mSettings;
+                          bentSettings.quantity = reference::Quantity::Bent;
+                          if (!std::isfinite(bentSettings.radius) || bentSettings.radius <= 0.0)
+                              bentSettings.radius = std::numeric_limits<double>::infinity();
+                          reference::ReferenceResult& b = ctx.write(truthBent);
+                          b = reference::computeReference(ctx.read(geometry), ctx.read(gbuffer),
+                                                          bentSettings);
+                          return b.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache)
+                                                   : pipeline::PassOutcome{};
+                      });
         graph.addPass(
-            {.name = "reference_bent", .reads = {geometry, gbuffer}, .writes = {truthBent}},
-            [this, geometry, gbuffer, truthBent, fromCache](pipeline::PassContext& ctx) {
-                reference::ReferenceSettings bentSettings = mSettings;
-                bentSettings.quantity = reference::Quantity::Bent;
-                if (!std::isfinite(bentSettings.radius) || bentSettings.radius <= 0.0)
-                    bentSettings.radius = std::numeric_limits<double>::infinity();
-                reference::ReferenceResult& b = ctx.write(truthBent);
-                b = reference::computeReference(ctx.read(geometry), ctx.read(gbuffer),
-                                                bentSettings);
-                return b.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache)
-                                         : pipeline::PassOutcome{};
-            });
-        graph.addPass(
-            {.name = "screen_space_reference", .reads = {gbuffer, view}, .writes = {truthScreen}},
+            {.name = "screen_space_reference",
+             .reads = {gbuffer, view},
+             .writes = {truthScreen},
+             .measurement = true},
             [this, gbuffer, view, truthScreen](pipeline::PassContext& ctx) {
                 // The same quantity, seed and stopping rule, traced against the depth
                 // buffer as a height field (reference/screen_space_reference.h).
@@ -345,12 +381,14 @@ private:
         // (nor for a ground truth only it reads).
         auto metricPass = [&](const std::string& name, std::vector<pipeline::ResourceRef> reads,
                               std::function<void(pipeline::PassContext&)> compute) {
-            graph.addPass(
-                {.name = "metric." + name, .reads = std::move(reads), .writes = {"metric." + name}},
-                [compute](pipeline::PassContext& ctx) {
-                    compute(ctx);
-                    return pipeline::PassOutcome{};
-                });
+            graph.addPass({.name = "metric." + name,
+                           .reads = std::move(reads),
+                           .writes = {"metric." + name},
+                           .measurement = true},
+                          [compute](pipeline::PassContext& ctx) {
+                              compute(ctx);
+                              return pipeline::PassOutcome{};
+                          });
         };
         metricPass("error", {ambient, truth, view}, [=, this](pipeline::PassContext& ctx) {
             addErrorColumns(*mRow, "ao", ctx.read(ambient).ambient, ctx.read(truth).occlusion,
@@ -464,7 +502,8 @@ private:
         // What the flicker metric of the next frame compares with (only when it is asked for).
         graph.addPass({.name = "remember_frame",
                        .reads = {ambient, truth, gbuffer},
-                       .writes = {"frame_memory"}},
+                       .writes = {"frame_memory"},
+                       .measurement = true},
                       [=, this](pipeline::PassContext& ctx) {
                           const scene::GBuffer& g = ctx.read(gbuffer);
                           const reference::ReferenceResult& t = ctx.read(truth);
@@ -477,7 +516,10 @@ private:
                           return pipeline::PassOutcome{};
                       });
         // Images: numbers in EXR (the report makes the PNGs).
-        graph.addPass({.name = "images", .reads = {ambient, truth, view}, .writes = {"images"}},
+        graph.addPass({.name = "images",
+                       .reads = {ambient, truth, view},
+                       .writes = {"images"},
+                       .measurement = true},
                       [=, this](pipeline::PassContext& ctx) {
                           const std::string dir =
                               mContext.runDirectory() + "/frame" + std::to_string(ctx.frame());

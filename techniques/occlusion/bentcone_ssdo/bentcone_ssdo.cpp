@@ -158,8 +158,15 @@ public:
         return {plugin::OcclusionQuantity::CosineAo, mRadius};
     }
 
+    bool acceptsGpuInputs() const override { return true; }
+
     void compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out) override
     {
+        if (input.gpu != nullptr && input.gpuLinearDepth != nullptr && input.gpuNormal != nullptr) {
+            mGpu.compute(*input.gpu, makeFrameSetup(mSettings, mPattern, mApertureTable, input),
+                         input, out);
+            return;
+        }
         if (input.linearDepth == nullptr || input.normal == nullptr)
             throw std::invalid_argument("bentcone_ssdo: the input needs depth and normals");
         if (input.linearDepth->width != input.normal->width ||

@@ -11,7 +11,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "gpu/resources.h"
 #include <cmath>
+
 #include <limits>
 #include <numbers>
 
@@ -23,8 +25,11 @@ FrameSetup makeFrameSetup(const Settings& settings, const std::vector<glm::vec4>
 {
     FrameSetup frame;
     frame.settings = settings;
-    frame.width = input.linearDepth->width;
-    frame.height = input.linearDepth->height;
+    // The size of whichever view the technique reads: the GPU images when it binds them.
+    const bool onGpu =
+        input.gpu != nullptr && input.gpuLinearDepth != nullptr && input.gpuNormal != nullptr;
+    frame.width = onGpu ? int(input.gpuLinearDepth->getDesc().width) : input.linearDepth->width;
+    frame.height = onGpu ? int(input.gpuLinearDepth->getDesc().height) : input.linearDepth->height;
     frame.projection =
         plugin::ScreenProjection::fromMatrix(input.projection, frame.width, frame.height);
     frame.pattern = pattern;

@@ -123,17 +123,23 @@ void GpuPath::compute(gpu::Context& context, const FrameSetup& frame,
     frameData.insert(frameData.end(), frame.apertureTable.begin(), frame.apertureTable.end());
     s.frameBuffer.upload(frameData.data(), frameData.size() * sizeof(glm::vec4));
 
-    s.depth.upload(input.linearDepth->pixels.data(),
-                   input.linearDepth->pixels.size() * sizeof(float));
-    s.normalTexels.resize(std::size_t(w) * h * 4);
-    for (std::size_t i = 0; i < input.normal->pixels.size(); ++i) {
-        const glm::vec3& n = input.normal->pixels[i];
-        s.normalTexels[i * 4 + 0] = n.x;
-        s.normalTexels[i * 4 + 1] = n.y;
-        s.normalTexels[i * 4 + 2] = n.z;
-        s.normalTexels[i * 4 + 3] = 0.0f;
+    // The frame's G-buffer stays on the GPU when the input has it there: bind it, upload nothing.
+    const bool onGpu = input.gpuLinearDepth != nullptr && input.gpuNormal != nullptr;
+    if (!onGpu) {
+        s.depth.upload(input.linearDepth->pixels.data(),
+                       input.linearDepth->pixels.size() * sizeof(float));
+        s.normalTexels.resize(std::size_t(w) * h * 4);
+        for (std::size_t i = 0; i < input.normal->pixels.size(); ++i) {
+            const glm::vec3& n = input.normal->pixels[i];
+            s.normalTexels[i * 4 + 0] = n.x;
+            s.normalTexels[i * 4 + 1] = n.y;
+            s.normalTexels[i * 4 + 2] = n.z;
+            s.normalTexels[i * 4 + 3] = 0.0f;
+        }
+        s.normal.upload(s.normalTexels.data(), s.normalTexels.size() * sizeof(float));
     }
-    s.normal.upload(s.normalTexels.data(), s.normalTexels.size() * sizeof(float));
+    const gpu::Image& depthImage = onGpu ? *input.gpuLinearDepth : s.depth;
+    const gpu::Image& normalImage = onGpu ? *input.gpuNormal : s.normal;
 
     const Cap coneCap = getDirectionCap();
     const PushData push{{frame.projection.scale.x, frame.projection.scale.y},
@@ -148,8 +154,8 @@ void GpuPath::compute(gpu::Context& context, const FrameSetup& frame,
                         {coneCap.angle, coneCap.cosine, coneCap.sine, coneCap.versine}};
     context.run([&](gpu::CommandList& cmd) {
         cmd.dispatch(s.pipeline,
-                     {gpu::Binding::storageImage(0, s.depth),
-                      gpu::Binding::storageImage(1, s.normal),
+                     {gpu::Binding::storageImage(0, depthImage),
+                      gpu::Binding::storageImage(1, normalImage),
                       gpu::Binding::storageBuffer(2, s.frameBuffer),
                       gpu::Binding::storageImage(3, s.bentAmbient),
                       gpu::Binding::storageImage(4, s.aperture),

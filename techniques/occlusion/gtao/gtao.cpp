@@ -209,6 +209,16 @@ plugin::OcclusionDefinition Gtao::definition() const
 
 void Gtao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out)
 {
+    if (input.gpu != nullptr && input.gpuLinearDepth != nullptr && input.gpuNormal != nullptr) {
+        // The frame's G-buffer stays on the GPU: bind it, upload nothing.
+        const int width = int(input.gpuLinearDepth->getDesc().width);
+        const int height = int(input.gpuLinearDepth->getDesc().height);
+        if (!mGpu)
+            mGpu = std::make_unique<GtaoGpu>();
+        mGpu->compute(*input.gpu, makeGtaoFrameConstants(mSettings, input, width, height),
+                      *input.gpuLinearDepth, *input.gpuNormal, out);
+        return;
+    }
     if (input.linearDepth == nullptr || input.normal == nullptr)
         throw std::invalid_argument("gtao: OcclusionInput needs linearDepth and normal");
     const Image<float>& depth = *input.linearDepth;

@@ -43,8 +43,10 @@ public:
 
     config::ParamSet effectiveParams() const override;
     plugin::OcclusionDefinition definition() const override;
-    //! Throws std::invalid_argument when linearDepth or normal is null or their sizes differ.
+    //! With input.gpu, gpuLinearDepth and gpuNormal set: binds those (no upload). Otherwise
+    //! throws std::invalid_argument when linearDepth or normal is null or their sizes differ.
     void compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out) override;
+    bool acceptsGpuInputs() const override { return true; }
 
     const GtaoSettings& settings() const { return mSettings; }
 

@@ -72,10 +72,28 @@ void GtaoGpu::compute(gpu::Context& context, const GtaoFrameConstants& constants
         mStaging[4 * i + 3] = 0.0f;
     }
     mNormal.upload(mStaging.data(), count * 4 * sizeof(float));
+    dispatch(context, constants, mDepth, mNormal, width, height, out);
+}
 
+void GtaoGpu::compute(gpu::Context& context, const GtaoFrameConstants& constants,
+                      const gpu::Image& depth, const gpu::Image& normal,
+                      plugin::OcclusionOutput& out)
+{
+    const int width = int(depth.getDesc().width);
+    const int height = int(depth.getDesc().height);
+    prepare(context, width, height);
+    dispatch(context, constants, depth, normal, width, height, out);
+}
+
+void GtaoGpu::dispatch(gpu::Context& context, const GtaoFrameConstants& constants,
+                       const gpu::Image& depth, const gpu::Image& normal, int width, int height,
+                       plugin::OcclusionOutput& out)
+{
+    const std::size_t count = std::size_t(width) * std::size_t(height);
+    mStaging.resize(count * 4);
     context.run([&](gpu::CommandList& cmd) {
         cmd.dispatch(mPipeline,
-                     {gpu::Binding::storageImage(0, mDepth), gpu::Binding::storageImage(1, mNormal),
+                     {gpu::Binding::storageImage(0, depth), gpu::Binding::storageImage(1, normal),
                       gpu::Binding::storageImage(2, mAmbient),
                       gpu::Binding::storageImage(3, mBentNormal),
                       gpu::Binding::storageImage(4, mAperture)},

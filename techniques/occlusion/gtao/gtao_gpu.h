@@ -21,6 +21,11 @@ public:
                  const Image<float>& depth, const Image<glm::vec3>& normal,
                  plugin::OcclusionOutput& out);
 
+    //! The same from depth and normals already on the GPU (R32Float and RGBA32Float storage
+    //! images of one size): nothing is uploaded.
+    void compute(gpu::Context& context, const GtaoFrameConstants& constants,
+                 const gpu::Image& depth, const gpu::Image& normal, plugin::OcclusionOutput& out);
+
     //! Label of the dispatch in the Context's run log.
     static constexpr const char* kDispatchLabel = "gtao.main";
 
@@ -29,6 +34,9 @@ public:
 
 private:
     void prepare(gpu::Context& context, int width, int height);
+    void dispatch(gpu::Context& context, const GtaoFrameConstants& constants,
+                  const gpu::Image& depth, const gpu::Image& normal, int width, int height,
+                  plugin::OcclusionOutput& out);
 
     gpu::Context* mContext = nullptr;
     gpu::ComputePipeline mPipeline;

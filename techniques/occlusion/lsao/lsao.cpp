@@ -196,6 +196,18 @@ plugin::OcclusionDefinition Lsao::definition() const
 
 void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out)
 {
+    if (input.gpu != nullptr && input.gpuLinearDepth != nullptr && input.gpuNormal != nullptr) {
+        // The frame's G-buffer stays on the GPU: bind it, upload nothing.
+        const int w = int(input.gpuLinearDepth->getDesc().width);
+        const int h = int(input.gpuLinearDepth->getDesc().height);
+        const plugin::ScreenProjection projection =
+            plugin::ScreenProjection::fromMatrix(input.projection, w, h);
+        const Layout layout = buildLayout(w, h, projection, mParams, input.frameIndex);
+        if (!mGpu || &mGpu->getContext() != input.gpu)
+            mGpu = std::make_unique<GpuRunner>(*input.gpu);
+        mGpu->run(layout, projection, mParams, *input.gpuLinearDepth, *input.gpuNormal, out);
+        return;
+    }
     if (input.linearDepth == nullptr || input.normal == nullptr)
         throw std::invalid_argument("lsao: OcclusionInput needs linearDepth and normal");
     const Image<float>& depth = *input.linearDepth;

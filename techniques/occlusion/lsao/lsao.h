@@ -24,6 +24,7 @@ public:
     plugin::OcclusionDefinition definition() const override;
     //! GPU when input.gpu is set (pipelines and images kept across calls), else C++.
     void compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out) override;
+    bool acceptsGpuInputs() const override { return true; }
 
     const Params& getParams() const { return mParams; }
 

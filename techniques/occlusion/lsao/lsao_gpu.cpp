@@ -103,6 +103,16 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
         mStaging[4 * i + 3] = 0.0f;
     }
     mNormal.upload(mStaging.data(), count * 4 * sizeof(float));
+    run(layout, projection, params, mDepth, mNormal, out);
+}
+
+void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projection,
+                    const Params& params, const gpu::Image& depth, const gpu::Image& normal,
+                    plugin::OcclusionOutput& out)
+{
+    prepare(layout);
+    const int w = layout.width, h = layout.height;
+    const std::size_t count = std::size_t(w) * std::size_t(h);
     mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));
 
     std::vector<Constants> constants;
@@ -113,18 +123,18 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
             const Batch& batch = layout.batches[b];
             cmd.dispatch(
                 mSweep,
-                {gpu::Binding::storageImage(0, mDepth), gpu::Binding::storageBuffer(1, mDirections),
+                {gpu::Binding::storageImage(0, depth), gpu::Binding::storageBuffer(1, mDirections),
                  gpu::Binding::storageBuffer(2, mSweepBuffer),
-                 gpu::Binding::storageImage(3, mNormal)},
+                 gpu::Binding::storageImage(3, normal)},
                 gpu::PushConstants(constants[b]),
                 gpu::GroupCount{gpu::computeGroupCount(layout.maxLineCount, kSweepGroupSize),
                                 batch.end - batch.begin, 1},
                 "lsao.sweep");
             cmd.dispatch(
                 mGather,
-                {gpu::Binding::storageImage(0, mDepth), gpu::Binding::storageBuffer(1, mDirections),
+                {gpu::Binding::storageImage(0, depth), gpu::Binding::storageBuffer(1, mDirections),
                  gpu::Binding::storageBuffer(2, mSweepBuffer),
-                 gpu::Binding::storageImage(3, mNormal), gpu::Binding::storageImage(4, mAccumA),
+                 gpu::Binding::storageImage(3, normal), gpu::Binding::storageImage(4, mAccumA),
                  gpu::Binding::storageImage(5, mAccumB)},
                 gpu::PushConstants(constants[b]),
                 gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), kGatherGroupSize),

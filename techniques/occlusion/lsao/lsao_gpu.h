@@ -31,6 +31,10 @@ public:
     void run(const Layout& layout, const plugin::ScreenProjection& projection, const Params& params,
              const Image<float>& depth, const Image<glm::vec3>& normal,
              plugin::OcclusionOutput& out);
+    //! The same from depth (R32Float) and normals (RGBA32Float) already on the GPU: nothing is
+    //! uploaded but the direction table.
+    void run(const Layout& layout, const plugin::ScreenProjection& projection, const Params& params,
+             const gpu::Image& depth, const gpu::Image& normal, plugin::OcclusionOutput& out);
 
     //! The sweep buffer of the last batch of the last run (for tests).
     std::vector<std::uint32_t> downloadSweep(std::size_t entryCount) const;

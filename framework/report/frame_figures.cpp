@@ -1,0 +1,250 @@
+// Figures of the lit frame (runs with `frame: {lighting: true}`, experiment/lit_frame.h): frame
+// time against final-frame error, the stacked time of every pass per frame, a filmstrip (frames x
+// technique with the truth and error maps), and culling on against off, with the check that the
+// final frames are bitwise the same.
+
+#include "report/report_detail.h"
+
+#include "experiment/image_files.h"
+#include "plot/charts.h"
+#include "plot/image_grid.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace rtlab::report::detail {
+
+namespace {
+
+std::string getText(const experiment::Row& row, const std::string& column)
+{
+    auto it = row.find(column);
+    return it == row.end() ? std::string() : it->second;
+}
+
+bool isCullingOff(const RunSummary& run)
+{
+    return getText(run.frames.front(), "frame.culling") == "false";
+}
+
+std::vector<std::string> splitList(const std::string& text)
+{
+    std::vector<std::string> out;
+    std::stringstream in(text);
+    for (std::string item; std::getline(in, item, ';');)
+        if (!item.empty())
+            out.push_back(item);
+    return out;
+}
+
+std::string formatMs(double ms)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.1f", ms);
+    return text;
+}
+
+} // namespace
+
+Figures writeLitFrameFigures(const Group& group, const std::string& directory,
+                             const plot::ColorTable& colors)
+{
+    Figures figures;
+    bool lit = false;
+    for (const auto& run : group.runs)
+        lit = lit || std::isfinite(run.get("frame.rmse"));
+    if (!lit)
+        return figures;
+    const std::string plots = directory + "/plots";
+    const std::string stem = makeFileName(group.key);
+    std::map<std::string, std::vector<const RunSummary*>> byTechnique;
+    for (const auto& run : group.runs)
+        byTechnique[run.technique].push_back(&run);
+
+    // 1. Frame time against final-frame error, Pareto front per technique.
+    plot::ScatterSpec scatter;
+    scatter.title = group.title + ": lit frame, time against error";
+    scatter.xLabel = "time of the frame's passes (ms per frame, CPU wall time, median of repeats)";
+    scatter.yLabel = "final frame RMSE against Embree full radiance";
+    scatter.colors = colors;
+    for (const auto& [technique, runs] : byTechnique) {
+        plot::Series s{technique};
+        for (const RunSummary* run : runs) {
+            s.x.push_back(run->get("frame.cpu_ms"));
+            s.y.push_back(run->get("frame.rmse"));
+            s.pointLabels.push_back(std::string(isCullingOff(*run) ? "culling off " : "") +
+                                    describeRun(*run, group.varyingParams));
+        }
+        scatter.series.push_back(std::move(s));
+    }
+    plot::writeScatter(scatter, plots + "/frame_time_vs_error_" + stem);
+    figures.plots.push_back(plots + "/frame_time_vs_error_" + stem);
+    figures.captions.push_back(
+        "Lit frame on " + group.title +
+        ": mean time of the passes that make a frame against the final frame's RMSE "
+        "(HDR radiance) against the Embree full radiance, averaged over the frames.");
+
+    // 2. Per technique (its first run with culling on): every frame's passes, stacked.
+    for (const auto& [technique, runs] : byTechnique) {
+        const RunSummary* run = nullptr;
+        for (const RunSummary* r : runs)
+            if (!run && !isCullingOff(*r))
+                run = r;
+        if (!run)
+            continue;
+        plot::StackedBarSpec bars;
+        bars.title = group.title + ": " + technique + ", time of each pass per frame";
+        bars.yLabel = "CPU wall time (ms, median of repeats; 0 = skipped)";
+        std::vector<std::string> passes;
+        for (const auto& frame : run->frames)
+            for (const auto& p : splitList(getText(frame, "frame_passes")))
+                if (std::find(passes.begin(), passes.end(), p) == passes.end())
+                    passes.push_back(p);
+        bars.passes = passes;
+        for (const auto& frame : run->frames) {
+            bars.bars.push_back("frame " + getText(frame, "frame"));
+            std::vector<double> values;
+            for (const auto& p : passes) {
+                const double v = experiment::getNumber(frame, p + ".cpu_ms");
+                values.push_back(std::isfinite(v) ? v : 0.0);
+            }
+            bars.values.push_back(values);
+        }
+        if (bars.bars.empty() || passes.empty())
+            continue;
+        const std::string path = plots + "/frame_passes_" + makeFileName(technique) + "_" + stem;
+        plot::writeStackedBars(bars, path);
+        figures.plots.push_back(path);
+        figures.captions.push_back(
+            "Time of every pass that makes the frame, per frame, for " + technique + " on " +
+            group.title + ". A pass that was skipped (reused work, nothing changed) is 0.");
+    }
+
+    // 3. Culling on against off: total time, and whether the final frames are bitwise the same.
+    {
+        plot::StackedBarSpec bars;
+        bars.title = group.title + ": culling on against off";
+        bars.yLabel = "time of all frames (ms, sum over frames)";
+        bars.passes = {"frames"};
+        std::string notes;
+        for (const auto& [technique, runs] : byTechnique) {
+            const RunSummary* on = nullptr;
+            const RunSummary* off = nullptr;
+            for (const RunSummary* r : runs) {
+                if (isCullingOff(*r)) {
+                    if (!off)
+                        off = r;
+                } else if (!on) {
+                    on = r;
+                }
+            }
+            if (!on || !off)
+                continue;
+            auto total = [](const RunSummary& r) {
+                double sum = 0.0;
+                for (const auto& f : r.frames) {
+                    const double v = experiment::getNumber(f, "frame.cpu_ms");
+                    sum += std::isfinite(v) ? v : 0.0;
+                }
+                return sum;
+            };
+            const double tOn = total(*on), tOff = total(*off);
+            bars.bars.push_back(technique + "\nculling on");
+            bars.values.push_back({tOn});
+            bars.bars.push_back(technique + "\nculling off");
+            bars.values.push_back({tOff});
+            // Bitwise comparison of the final HDR frames, frame by frame.
+            int same = 0, compared = 0;
+            for (std::size_t k = 0; k < std::min(on->frames.size(), off->frames.size()); ++k) {
+                const std::string a = getText(on->frames[k], "image.lit_hdr");
+                const std::string b = getText(off->frames[k], "image.lit_hdr");
+                if (a.empty() || b.empty() || !std::filesystem::exists(a) ||
+                    !std::filesystem::exists(b))
+                    continue;
+                ++compared;
+                const auto ia = experiment::readExrRgb(a), ib = experiment::readExrRgb(b);
+                same += ia.width == ib.width && ia.height == ib.height &&
+                        std::memcmp(ia.pixels.data(), ib.pixels.data(),
+                                    ia.pixels.size() * sizeof(glm::vec3)) == 0;
+            }
+            notes += (notes.empty() ? "" : "; ") + technique + ": " + formatMs(tOn) +
+                     " ms with culling, " + formatMs(tOff) + " ms without (" +
+                     formatMs(100.0 * (1.0 - tOn / tOff)) + " % saved), " + std::to_string(same) +
+                     " of " + std::to_string(compared) + " final frames bitwise identical";
+        }
+        if (!bars.bars.empty()) {
+            const std::string path = plots + "/frame_culling_" + stem;
+            plot::writeStackedBars(bars, path);
+            figures.plots.push_back(path);
+            figures.captions.push_back("Culling on against off on " + group.title +
+                                       " (sum of the frames' pass times): " + notes + ".");
+        }
+    }
+
+    // 4. Filmstrip: the truth and each technique's tonemapped frames (culling on), then each
+    //    technique's |HDR error| per frame.
+    plot::ImageGridSpec grid;
+    grid.title = group.title + ": lit frames (tonemapped) and |error| against Embree full";
+    grid.encodeSrgb = false; // the PNGs are display values already
+    grid.errorLabel = "mean |HDR error| over channels (radiance)";
+    std::vector<std::vector<plot::GridCell>> imageRows, errorRows;
+    std::vector<std::string> imageTitles, errorTitles;
+    std::size_t frameCount = 0;
+    for (const auto& [technique, runs] : byTechnique) {
+        const RunSummary* run = nullptr;
+        for (const RunSummary* r : runs)
+            if (!run && !isCullingOff(*r))
+                run = r;
+        if (!run)
+            continue;
+        std::vector<plot::GridCell> images, errors, truths;
+        for (const auto& frame : run->frames) {
+            const std::string png = getText(frame, "image.lit"),
+                              hdr = getText(frame, "image.lit_hdr");
+            const std::string truthPng = getText(frame, "image.truth"),
+                              truthHdr = getText(frame, "image.truth_hdr");
+            if (png.empty() || !std::filesystem::exists(png) || !std::filesystem::exists(truthHdr))
+                break;
+            images.push_back(plot::makeColorCell(experiment::readExrRgb(png)));
+            errors.push_back(plot::makeErrorCell(plot::computeAbsoluteErrorMap(
+                experiment::readExrRgb(hdr), experiment::readExrRgb(truthHdr))));
+            if (imageRows.empty())
+                truths.push_back(plot::makeColorCell(experiment::readExrRgb(truthPng)));
+        }
+        if (images.empty() || (frameCount && images.size() != frameCount))
+            continue;
+        frameCount = images.size();
+        if (imageRows.empty()) {
+            imageRows.push_back(truths);
+            imageTitles.push_back("Embree full");
+        }
+        imageRows.push_back(images);
+        imageTitles.push_back(technique);
+        errorRows.push_back(errors);
+        errorTitles.push_back("|error| " + technique);
+    }
+    if (imageRows.size() > 1) {
+        for (std::size_t k = 0; k < frameCount; ++k)
+            grid.columnTitles.push_back("frame " + std::to_string(k));
+        grid.rows = imageRows;
+        grid.rows.insert(grid.rows.end(), errorRows.begin(), errorRows.end());
+        grid.rowTitles = imageTitles;
+        grid.rowTitles.insert(grid.rowTitles.end(), errorTitles.begin(), errorTitles.end());
+        const std::string path = plots + "/filmstrip_" + stem;
+        plot::writeImageGrid(grid, path);
+        figures.plots.push_back(path);
+        figures.captions.push_back(
+            "Filmstrip of " + group.title +
+            ": the Embree full radiance and each technique's lit frame (tonemapped), "
+            "then each technique's absolute HDR error, frame by frame.");
+    }
+    return figures;
+}
+
+} // namespace rtlab::report::detail
