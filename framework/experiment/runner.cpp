@@ -67,6 +67,10 @@ void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& r
     row.set("passes", pipeline::formatPassRecords(records))
         .set("passes_run", ran)
         .set("passes_skipped", skipped);
+    // The frame's own time: every pass that makes it (not the ground truths, metrics and files).
+    row.set("frame.cpu_ms", frameCpu)
+        .set("frame.gpu_ms", frameGpu)
+        .set("frame_passes", framePasses);
 }
 
 void addParamColumns(ResultRow& row, const plugin::Technique& technique, const std::string& prefix)

@@ -97,6 +97,14 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows,
             git->second.columns = getFamilyColumns(registry, family);
             groupOrder.push_back(key);
         }
+        // Runs of the lit frame (frame: {lighting: true}) add its columns to the tables.
+        if (std::isfinite(run.get("frame.rmse")) &&
+            std::find(git->second.columns.tableColumns.begin(),
+                      git->second.columns.tableColumns.end(),
+                      "frame.rmse") == git->second.columns.tableColumns.end())
+            for (const char* c : {"frame.cpu_ms", "frame.rmse", "frame.flip",
+                                  "frame.mean_signed_error", "direct.rmse", "frame.culling"})
+                git->second.columns.tableColumns.push_back(c);
         git->second.runs.push_back(run);
     }
     std::vector<Group> out;

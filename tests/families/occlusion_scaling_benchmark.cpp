@@ -17,7 +17,7 @@
 #include "experiment/gpu_timing.h"
 #include "gpu/context.h"
 #include "metrics/timing.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "plugin/screen_space.h"
 #include "scene/camera.h"
 

@@ -8,7 +8,7 @@
 // surface), apertures are finite and in [0, pi/2], and more radius never brightens the image.
 
 #include "gpu/context.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "plugin/screen_space.h"
 #include "scene/camera.h"
 

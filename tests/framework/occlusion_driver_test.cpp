@@ -6,7 +6,7 @@
 #include "experiment/analysis.h"
 #include "experiment/image_files.h"
 #include "experiment/runner.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "test_registry.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +15,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 using namespace rtlab;
 
@@ -268,6 +269,18 @@ TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
         EXPECT_TRUE(std::filesystem::exists(row.at("image.lit")));
         EXPECT_TRUE(std::filesystem::exists(row.at("image.truth")));
         EXPECT_TRUE(row.count("lighting.cpu_ms")) << "the graph times the compose passes";
+        // The frame's time sums the passes that make it, not the ground truths and metrics.
+        const double frameMs = experiment::getNumber(row, "frame.cpu_ms");
+        double sum = 0.0;
+        std::stringstream framePasses(row.at("frame_passes"));
+        for (std::string pass; std::getline(framePasses, pass, ';');)
+            if (row.count(pass + ".cpu_ms"))
+                sum += experiment::getNumber(row, pass + ".cpu_ms");
+        EXPECT_GT(frameMs, 0.0);
+        EXPECT_NEAR(frameMs, sum, 1e-6 * sum) << "frame.cpu_ms is the sum over frame_passes";
+        EXPECT_NE(row.at("frame_passes").find("lighting"), std::string::npos);
+        EXPECT_EQ(row.at("frame_passes").find("reference"), std::string::npos)
+            << row.at("frame_passes");
     }
     EXPECT_EQ(rows[0].at("frame.shadow_maps_rendered"), "1");
     EXPECT_NE(rows[1].at("passes").find(

@@ -10,7 +10,7 @@
 //   images             technique, reference, error and noise floor as EXR
 // and one row per frame, with each pass recorded as run or skipped and why.
 
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -301,7 +301,7 @@ private:
                     input.frameIndex = ctx.frame();
                     input.gpu = &mContext.getGpu();
                     input.scene =
-                        &ctx.read(geometry); // ray-traced baselines only (plugin/occlusion.h)
+                        &ctx.read(geometry); // ray-traced baselines only (families/occlusion/occlusion.h)
                     input.gbuffer = &g;
                     plugin::OcclusionOutput& out = ctx.write(ambient);
                     mTechnique->compute(input, out);

@@ -1,9 +1,9 @@
 // The voxel_gi family: voxel scene structures (cascades, sparse octree, 64-ary adaptive tree)
-// cone traced for indirect diffuse light. The technique interface is plugin/voxel_gi.h; the family
+// cone traced for indirect diffuse light. The technique interface is families/voxel_gi/voxel_gi.h; the family
 // has no passes yet (no technique is registered), so its runs are refused with that reason.
 
 #include "experiment/family.h"
-#include "plugin/voxel_gi.h"
+#include "families/voxel_gi/voxel_gi.h"
 
 namespace rtlab::families {
 namespace {

@@ -74,7 +74,7 @@
 #include "bentcone_ssdo_cpu.h"
 #include "bentcone_ssdo_gpu.h"
 
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <algorithm>
 #include <stdexcept>

@@ -4,7 +4,7 @@
 #include "bentcone_ssdo_math.h"
 
 #include "core/image.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "plugin/screen_space.h"
 
 #include <glm/vec3.hpp>

@@ -7,7 +7,7 @@
 
 #include "core/error.h"
 #include "gpu/context.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>

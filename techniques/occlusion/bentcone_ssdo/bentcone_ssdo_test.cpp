@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "gpu/context.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "scene/sky.h"
 
 #include <glm/geometric.hpp>

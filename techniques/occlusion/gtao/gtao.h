@@ -2,7 +2,7 @@
 // Technique occlusion/gtao: see gtao.cpp for the doc block.
 
 #include "config/param.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <memory>
 

@@ -6,7 +6,7 @@
 #include "gtao.h"
 
 #include "core/image.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>

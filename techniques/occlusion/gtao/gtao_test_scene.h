@@ -3,7 +3,7 @@
 // intersected exactly with a floor, an optional infinite vertical wall and optional boxes.
 
 #include "core/image.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "plugin/screen_space.h"
 #include "scene/camera.h"
 

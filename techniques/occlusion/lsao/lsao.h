@@ -3,7 +3,7 @@
 
 #include "lsao_core.h"
 
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <memory>
 

@@ -5,7 +5,7 @@
 #include "lsao_core.h"
 
 #include "core/image.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <cstdint>
 #include <vector>

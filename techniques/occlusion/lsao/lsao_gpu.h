@@ -8,7 +8,7 @@
 
 #include "core/image.h"
 #include "gpu/context.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <cstdint>
 #include <filesystem>

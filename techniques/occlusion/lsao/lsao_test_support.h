@@ -7,7 +7,7 @@
 #include "lsao.h"
 
 #include "core/image.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 #include "plugin/screen_space.h"
 #include "scene/camera.h"
 

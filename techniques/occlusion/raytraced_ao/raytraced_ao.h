@@ -2,7 +2,7 @@
 // Technique occlusion/raytraced_ao: see raytraced_ao.cpp for the doc block.
 
 #include "config/param.h"
-#include "plugin/occlusion.h"
+#include "families/occlusion/occlusion.h"
 
 #include <cstdint>
 
