@@ -51,6 +51,7 @@ std::string ResourceRef::describe() const
 struct FrameGraph::Slot {
     std::string name;
     std::type_index type = typeid(void);
+    std::string poolKey; //!< non-empty for GPU images and buffers: released ones are reused
     std::shared_ptr<void> data;
     const void* external = nullptr;
     bool persistent = false;
@@ -143,6 +144,8 @@ void FrameGraph::addPass(PassDesc desc, std::function<PassOutcome(PassContext&)>
     for (const auto& w : desc.writes) {
         Slot& s = slot(w.name);
         s.type = w.cppType;
+        if (w.type.kind == ResourceKind::GpuImage || w.type.kind == ResourceKind::GpuBuffer)
+            s.poolKey = w.type.describe() + " " + w.cppType.name();
         s.persistent = std::find(desc.persistent.begin(), desc.persistent.end(), w.name) !=
                        desc.persistent.end();
     }
@@ -302,6 +305,8 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
 {
     std::vector<PassRecord> records = plan(options.features, options.outputs, options.culling);
     mReleased.clear();
+    mGpuAllocations = 0;
+    mGpuReuses = 0;
     const std::size_t n = records.size();
     // The last running pass that reads each resource; outputs and persistent ones are kept.
     std::map<std::string, std::size_t> lastUse;
@@ -315,10 +320,13 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
                 lastUse[r.name] = std::max(lastUse[r.name], i);
     }
     const std::set<std::string> kept(options.outputs.begin(), options.outputs.end());
-    // Non-persistent data left from the previous frame is gone.
+    // Non-persistent data left from the previous frame is gone (GPU resources to the pool).
     for (auto& s : mSlots)
-        if (!s->persistent)
+        if (!s->persistent && s->data) {
+            if (!s->poolKey.empty())
+                mPool.emplace_back(s->poolKey, std::move(s->data));
             s->data.reset();
+        }
 
     auto collect = [&] {
         return options.collectGpuTimes ? options.collectGpuTimes() : metrics::GpuPassTimes{};
@@ -334,10 +342,11 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
             if (!reused.empty()) {
                 outcome = PassOutcome::skipped(reused);
             } else if (mPasses[i].timing == PassTiming::Repeated) {
-                const auto report = metrics::measure(options.timing, [&] {
-                    outcome = mCallbacks[i](context);
-                    return collect();
-                });
+                const auto report =
+                    metrics::measure(mPasses[i].timingOptions.value_or(options.timing), [&] {
+                        outcome = mCallbacks[i](context);
+                        return collect();
+                    });
                 records[i].time = report;
             } else {
                 const auto start = std::chrono::steady_clock::now();
@@ -359,6 +368,8 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
                 continue;
             auto it = lastUse.find(s->name);
             if (it == lastUse.end() || it->second <= i) {
+                if (!s->poolKey.empty())
+                    mPool.emplace_back(s->poolKey, std::move(s->data));
                 s->data.reset();
                 mReleased.push_back(s->name);
             }
@@ -403,8 +414,21 @@ void* PassContext::getForWrite(const std::string& name, std::type_index type)
                 throw Error("frame graph: pass '" + pass.name + "' writes '" + name + "' as C++ " +
                             type.name() + ", declared as " + w.cppType.name());
             FrameGraph::Slot& s = mGraph.slot(name);
-            if (!s.data)
+            if (!s.data && !s.poolKey.empty()) {
+                auto& pool = mGraph.mPool;
+                for (auto it = pool.begin(); it != pool.end(); ++it)
+                    if (it->first == s.poolKey) {
+                        s.data = std::move(it->second);
+                        pool.erase(it);
+                        ++mGraph.mGpuReuses;
+                        break;
+                    }
+            }
+            if (!s.data) {
                 s.data = w.make();
+                if (!s.poolKey.empty())
+                    ++mGraph.mGpuAllocations;
+            }
             return s.data.get();
         }
     throw Error("frame graph: pass '" + pass.name + "' writes '" + name +

@@ -20,7 +20,8 @@
 // names both passes and both types when they differ. The graph creates a resource's storage when
 // its producer first writes it and releases it after the last pass of the frame that reads it,
 // unless the resource is persistent (kept across frames: caches, uploaded scenes) or an output the
-// run asked for.
+// run asked for. Released GPU images and buffers go to a pool and serve the next writer of the
+// same type (the next frame's, or a later pass's), so a frame allocates no GPU memory once warm.
 //
 // The graph is built once per run and executed once per frame:
 //
@@ -101,15 +102,21 @@ struct ResourceRef {
     std::string describe() const;
 };
 
-//! A typed handle: the name and type of a resource whose data is a T.
+//! A typed handle: the name and type of a resource whose data is a T. The graph creates the data
+//! with `create` when the producer first writes it (default-constructed when unset: CPU data; GPU
+//! images and buffers give a function that allocates them on the device, pipeline/gpu_resources.h).
 template <class T> struct Resource {
     std::string name;
     ResourceType type;
+    std::function<std::shared_ptr<T>()> create;
 
     operator ResourceRef() const
     {
-        return ResourceRef(name, type, typeid(T),
-                           [] { return std::static_pointer_cast<void>(std::make_shared<T>()); });
+        auto make = create;
+        return ResourceRef(name, type, typeid(T), [make]() -> std::shared_ptr<void> {
+            return make ? std::static_pointer_cast<void>(make())
+                        : std::static_pointer_cast<void>(std::make_shared<T>());
+        });
     }
 };
 
@@ -145,6 +152,9 @@ struct PassDesc {
     //! True for passes that measure the frame rather than make it (ground truths, metrics, image
     //! files): they are left out of the frame's time.
     bool measurement = false;
+    //! PassTiming::Repeated with other warm-up and repeats than the run's (e.g. an expensive
+    //! preparation timed once).
+    std::optional<metrics::TimingOptions> timingOptions;
 };
 
 //! How a pass ended in one frame.
@@ -260,6 +270,11 @@ public:
     bool holds(const std::string& resource) const;
     //! Resources released during the last execute() (their names), for tests and logs.
     const std::vector<std::string>& lastReleased() const { return mReleased; }
+    //! GPU images and buffers the last execute() allocated, and those it took from the pool of
+    //! released ones of the same type (a released GPU resource is kept for the next writer of
+    //! its type instead of being freed; a pass writing one overwrites all of it).
+    int lastGpuAllocations() const { return mGpuAllocations; }
+    int lastGpuReuses() const { return mGpuReuses; }
 
 private:
     friend class PassContext;
@@ -280,6 +295,10 @@ private:
     std::vector<std::function<PassOutcome(PassContext&)>> mCallbacks;
     std::vector<std::unique_ptr<Slot>> mSlots;
     std::vector<std::string> mReleased;
+    //! Released GPU resources by type (ResourceType::describe() + C++ type), for reuse.
+    std::vector<std::pair<std::string, std::shared_ptr<void>>> mPool;
+    int mGpuAllocations = 0;
+    int mGpuReuses = 0;
 };
 
 //! "gbuffer:run;reference:skipped(read from the cache)" (the results table's `passes` column).

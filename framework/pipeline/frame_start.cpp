@@ -2,6 +2,7 @@
 
 #include "core/hash.h"
 #include "gpu/context.h"
+#include "pipeline/gpu_resources.h"
 #include "render/frame_matrices.h"
 #include "render/gbuffer_pass.h"
 #include "render/view_inputs_pass.h"
@@ -37,6 +38,18 @@ FrameStart::FrameStart(const scene::Scene& scene, gpu::Context& gpu, FrameStartO
 }
 
 FrameStart::~FrameStart() = default;
+
+Resource<gpu::Image> FrameStart::viewDepthGpu() const
+{
+    return makeGpuImageResource(mGpu, "view_depth_gpu", gpu::Format::R32Float, mOptions.width,
+                                mOptions.height);
+}
+
+Resource<gpu::Image> FrameStart::viewNormalGpu() const
+{
+    return makeGpuImageResource(mGpu, "view_normal_gpu", gpu::Format::RGBA32Float, mOptions.width,
+                                mOptions.height);
+}
 
 void FrameStart::addPasses(FrameGraph& graph)
 {
@@ -182,28 +195,18 @@ void FrameStart::addPasses(FrameGraph& graph)
                       return PassOutcome{};
                   });
     const auto viewGpuRes = viewInputsGpu();
+    const auto depthGpu = viewDepthGpu();
+    const auto normalGpu = viewNormalGpu();
     graph.addPass({.name = "view_inputs_gpu",
                    .reads = {gbufferRes},
-                   .writes = {viewGpuRes},
-                   .persistent = {viewGpuRes.name},
-                   .reuse =
-                       [this](const PassContext&) {
-                           return mViewGpuFrame >= 0 && mViewGpuKey == mDrawnKey
-                                      ? "the G-buffer is unchanged since frame " +
-                                            std::to_string(mViewGpuFrame) +
-                                            ": its view inputs are reused"
-                                      : std::string();
-                       }},
-                  [this, gbufferRes, viewGpuRes](PassContext& ctx) {
+                   .writes = {viewGpuRes, depthGpu, normalGpu}},
+                  [this, gbufferRes, viewGpuRes, depthGpu, normalGpu](PassContext& ctx) {
                       const GpuGBuffer& g = ctx.read(gbufferRes);
                       if (!mViewInputsPass)
                           mViewInputsPass = std::make_unique<render::ViewInputsPass>(mGpu);
-                      mViewInputsPass->run(*g.target, g.view);
-                      ctx.write(viewGpuRes) =
-                          GpuViewInputs{&mViewInputsPass->getDepth(), &mViewInputsPass->getNormal(),
-                                        g.view, g.projection};
-                      mViewGpuKey = mDrawnKey;
-                      mViewGpuFrame = ctx.frame();
+                      mViewInputsPass->run(*g.target, g.view, ctx.write(depthGpu),
+                                           ctx.write(normalGpu));
+                      ctx.write(viewGpuRes) = GpuViewInputs{g.view, g.projection};
                       return PassOutcome{};
                   });
 }

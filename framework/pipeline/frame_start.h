@@ -60,11 +60,9 @@ struct ViewInputs {
     Image<std::uint8_t> surface; //!< 1 where a surface was rasterised
 };
 
-//! View-space inputs on the GPU (render/view_inputs_pass.h): R32Float linear depth and
-//! RGBA32Float view-space normals, for Vulkan techniques that bind them.
+//! The matrices of the view inputs on the GPU (their images: FrameStart::viewDepthGpu(),
+//! viewNormalGpu()).
 struct GpuViewInputs {
-    const gpu::Image* linearDepth = nullptr;
-    const gpu::Image* normal = nullptr;
     glm::mat4 view{1.0f};
     glm::mat4 projection{1.0f};
 };
@@ -127,9 +125,12 @@ public:
 
     Resource<GpuViewInputs> viewInputsGpu() const
     {
-        return {kViewInputsGpu, ResourceType::gpuImage("r32f depth + rgba32f view normal",
-                                                       mOptions.width, mOptions.height)};
+        return {kViewInputsGpu, ResourceType::value("view and projection of the GPU view inputs")};
     }
+    //! Linear depth (R32Float) and view-space normals (RGBA32Float) on the GPU, created by the
+    //! graph (pipeline/gpu_resources.h): Vulkan techniques bind them.
+    Resource<gpu::Image> viewDepthGpu() const;
+    Resource<gpu::Image> viewNormalGpu() const;
 
 private:
     const scene::Scene& mScene;
@@ -147,8 +148,6 @@ private:
     int mDrawnFrame = -1;
     std::string mReadKey;
     int mReadFrame = -1;
-    std::string mViewGpuKey;
-    int mViewGpuFrame = -1;
 };
 
 } // namespace rtlab::pipeline

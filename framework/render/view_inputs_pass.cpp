@@ -22,7 +22,6 @@ struct ViewInputsPass::State {
     gpu::Context* context = nullptr;
     gpu::ComputePipeline pipeline;
     gpu::Image positionDepth, normal; // copies of the attachments (storage-bindable)
-    gpu::Image depth, viewNormal;     // the outputs
     std::uint32_t width = 0, height = 0;
 };
 
@@ -45,19 +44,25 @@ ViewInputsPass::ViewInputsPass(gpu::Context& context) : mState(std::make_unique<
 
 ViewInputsPass::~ViewInputsPass() = default;
 
-gpu::RunResult ViewInputsPass::run(const gpu::RenderTarget& gbuffer, const glm::mat4& view)
+gpu::RunResult ViewInputsPass::run(const gpu::RenderTarget& gbuffer, const glm::mat4& view,
+                                   const gpu::Image& depth, const gpu::Image& normal)
 {
     State& s = *mState;
     const std::uint32_t w = gbuffer.getDesc().width, h = gbuffer.getDesc().height;
-    if (w != s.width || h != s.height || !s.depth.isValid()) {
-        auto make = [&](gpu::Format format, const char* name) {
-            return s.context->createImage({gpu::ImageDimension::Image2D, format, w, h, 1,
-                                           gpu::ImageUsage::StorageAndSampled, name});
+    const gpu::ImageDesc& d = depth.getDesc();
+    const gpu::ImageDesc& n = normal.getDesc();
+    if (d.width != w || d.height != h || n.width != w || n.height != h ||
+        d.format != gpu::Format::R32Float || n.format != gpu::Format::RGBA32Float)
+        throw Error("view inputs: expected an R32Float depth and an RGBA32Float normal image of " +
+                    std::to_string(w) + "x" + std::to_string(h) + ", found '" + d.name + "' and '" +
+                    n.name + "'");
+    if (w != s.width || h != s.height || !s.positionDepth.isValid()) {
+        auto make = [&](const char* name) {
+            return s.context->createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float,
+                                           w, h, 1, gpu::ImageUsage::StorageAndSampled, name});
         };
-        s.positionDepth = make(gpu::Format::RGBA32Float, "view_inputs.position_depth");
-        s.normal = make(gpu::Format::RGBA32Float, "view_inputs.world_normal");
-        s.depth = make(gpu::Format::R32Float, "view_inputs.depth");
-        s.viewNormal = make(gpu::Format::RGBA32Float, "view_inputs.normal");
+        s.positionDepth = make("view_inputs.position_depth");
+        s.normal = make("view_inputs.world_normal");
         s.width = w;
         s.height = h;
     }
@@ -70,24 +75,13 @@ gpu::RunResult ViewInputsPass::run(const gpu::RenderTarget& gbuffer, const glm::
         gpu::copyAttachmentToImage(cmd, gbuffer, 1, s.normal, 0, "view_inputs copy");
         cmd.dispatch(s.pipeline,
                      {gpu::Binding::storageImage(0, s.positionDepth),
-                      gpu::Binding::storageImage(1, s.normal),
-                      gpu::Binding::storageImage(2, s.depth),
-                      gpu::Binding::storageImage(3, s.viewNormal)},
+                      gpu::Binding::storageImage(1, s.normal), gpu::Binding::storageImage(2, depth),
+                      gpu::Binding::storageImage(3, normal)},
                      gpu::PushConstants(push),
                      gpu::GroupCount{gpu::computeGroupCount(w, kGroupSize),
                                      gpu::computeGroupCount(h, kGroupSize), 1},
                      std::string(kLabel));
     });
-}
-
-const gpu::Image& ViewInputsPass::getDepth() const
-{
-    return mState->depth;
-}
-
-const gpu::Image& ViewInputsPass::getNormal() const
-{
-    return mState->viewNormal;
 }
 
 } // namespace rtlab::render

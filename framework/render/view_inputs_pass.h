@@ -5,8 +5,7 @@
 // (plugin::OcclusionInput::gpuLinearDepth, gpuNormal). No CPU copy of the G-buffer is made.
 //
 //   render::ViewInputsPass pass(ctx);
-//   pass.run(gbufferPass.getTarget(), viewMatrix);
-//   bind pass.getDepth() and pass.getNormal()
+//   pass.run(gbufferPass.getTarget(), viewMatrix, depthImage, normalImage);
 
 #include "gpu/context.h"
 
@@ -24,11 +23,11 @@ public:
     explicit ViewInputsPass(gpu::Context& context);
     ~ViewInputsPass();
 
-    //! Copies attachments 0 (position + linear depth) and 1 (normal) of `gbuffer` and writes the
-    //! two images (created or resized to the target's size). `view` is world -> view.
-    gpu::RunResult run(const gpu::RenderTarget& gbuffer, const glm::mat4& view);
-    const gpu::Image& getDepth() const;
-    const gpu::Image& getNormal() const;
+    //! Copies attachments 0 (position + linear depth) and 1 (normal) of `gbuffer` and writes
+    //! `depth` (R32Float) and `normal` (RGBA32Float), storage images of the target's size.
+    //! `view` is world -> view. Throws rtlab::Error for another size or format.
+    gpu::RunResult run(const gpu::RenderTarget& gbuffer, const glm::mat4& view,
+                       const gpu::Image& depth, const gpu::Image& normal);
 
 private:
     struct State;

@@ -270,6 +270,40 @@ TEST(FrameGraph, TimesEveryPassThatRunsAndOnlyThose)
     EXPECT_GE(gpuDrains, 2 * 2);
 }
 
+TEST(FrameGraph, ReleasedGpuResourcesServeTheNextWriterOfTheSameType)
+{
+    // A GPU buffer (here a stand-in whose creation is counted) is allocated once: the next
+    // frame's writer gets the released one back from the graph's pool.
+    FrameGraph graph;
+    int created = 0;
+    const Resource<std::vector<float>> buffer{"buffer", ResourceType::gpuBuffer("floats", 64), [&] {
+                                                  ++created;
+                                                  return std::make_shared<std::vector<float>>(16,
+                                                                                              0.0f);
+                                              }};
+    graph.addPass({.name = "fill", .writes = {buffer}}, [&](PassContext& ctx) {
+        ctx.write(buffer).assign(16, float(ctx.frame()));
+        return PassOutcome{};
+    });
+    float seen = -1.0f;
+    graph.addPass({.name = "use", .reads = {buffer}, .writes = {"used"}}, [&](PassContext& ctx) {
+        seen = ctx.read(buffer)[3];
+        return PassOutcome{};
+    });
+    FrameOptions options;
+    options.outputs = {"used"};
+    graph.execute(options);
+    EXPECT_EQ(graph.lastGpuAllocations(), 1);
+    EXPECT_EQ(graph.lastGpuReuses(), 0);
+    EXPECT_FALSE(graph.holds("buffer")) << "released after its last reader";
+    options.frame = 1;
+    graph.execute(options);
+    EXPECT_EQ(graph.lastGpuAllocations(), 0);
+    EXPECT_EQ(graph.lastGpuReuses(), 1);
+    EXPECT_EQ(created, 1);
+    EXPECT_EQ(seen, 1.0f) << "the writer overwrites what it reuses";
+}
+
 TEST(FrameGraph, KeepsPersistentResourcesAcrossFramesAndReusesWorkUnlessCullingIsOff)
 {
     FrameGraph graph;

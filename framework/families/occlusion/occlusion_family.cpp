@@ -17,6 +17,7 @@
 #include "experiment/family.h"
 #include "experiment/image_files.h"
 #include "experiment/runner.h"
+#include "gpu/resources.h"
 #include "metrics/image_metrics.h"
 #include "metrics/temporal_metrics.h"
 #include "pipeline/compose.h"
@@ -265,19 +266,22 @@ private:
             // The G-buffer stays on the GPU: the technique binds the view inputs made there, and
             // the frame reads the G-buffer back only if another pass that runs needs it.
             const auto viewGpu = start.viewInputsGpu();
+            const auto depthGpu = start.viewDepthGpu();
+            const auto normalGpu = start.viewNormalGpu();
             graph.addPass({.name = "occlusion",
-                           .reads = {viewGpu},
+                           .reads = {viewGpu, depthGpu, normalGpu},
                            .writes = techniqueWrites,
                            .timing = pipeline::PassTiming::Repeated},
-                          [this, viewGpu, ambient, checkSize](pipeline::PassContext& ctx) {
+                          [this, viewGpu, depthGpu, normalGpu, ambient,
+                           checkSize](pipeline::PassContext& ctx) {
                               const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
                               plugin::OcclusionInput input;
                               input.projection = v.projection;
                               input.view = v.view;
                               input.frameIndex = ctx.frame();
                               input.gpu = &mContext.getGpu();
-                              input.gpuLinearDepth = v.linearDepth;
-                              input.gpuNormal = v.normal;
+                              input.gpuLinearDepth = &ctx.read(depthGpu);
+                              input.gpuNormal = &ctx.read(normalGpu);
                               plugin::OcclusionOutput& out = ctx.write(ambient);
                               mTechnique->compute(input, out);
                               for (const auto& [name, value] : mTechnique->counters())
@@ -300,8 +304,8 @@ private:
                     input.view = g.view;
                     input.frameIndex = ctx.frame();
                     input.gpu = &mContext.getGpu();
-                    input.scene =
-                        &ctx.read(geometry); // ray-traced baselines only (families/occlusion/occlusion.h)
+                    input.scene = &ctx.read(
+                        geometry); // ray-traced baselines only (families/occlusion/occlusion.h)
                     input.gbuffer = &g;
                     plugin::OcclusionOutput& out = ctx.write(ambient);
                     mTechnique->compute(input, out);
