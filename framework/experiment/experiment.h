@@ -65,6 +65,16 @@ struct ReferenceOptions {
     double radius = 0.0; //!< world units; 0 = the technique's
 };
 
+} // namespace rtlab::experiment
+namespace rtlab::reference {
+struct ReferenceSettings;
+}
+namespace rtlab::experiment {
+
+//! Copies the run's sampling options (target standard errors, sample cap, seed) into the
+//! settings of a ground truth, whatever quantity it computes.
+void applySamplingOptions(const ReferenceOptions& options, reference::ReferenceSettings& settings);
+
 //! One fully expanded run.
 struct RunConfig {
     std::string scene; //!< analytic shape, procedural scene, or scene file path

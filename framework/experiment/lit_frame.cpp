@@ -22,11 +22,7 @@ reference::ReferenceSettings makeRadianceSettings(const RunConfig& run,
     reference::ReferenceSettings s;
     s.quantity = quantity;
     s.bounces = 2; // the Tomorrow Children's light: direct, first and second bounce
-    s.targetStdErr = run.reference.targetStdErr;
-    s.targetRelStdErr = run.reference.targetRelStdErr;
-    s.maxSamples = run.reference.maxSamples;
-    s.batchSize = std::min(s.batchSize, s.maxSamples);
-    s.seed = run.reference.seed;
+    applySamplingOptions(run.reference, s);
     return s;
 }
 

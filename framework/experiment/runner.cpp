@@ -11,6 +11,7 @@
 #include "pipeline/frame_graph.h"
 #include "pipeline/frame_start.h"
 #include "plugin/technique.h"
+#include "reference/reference.h"
 #include "scene/camera_paths.h"
 #include "scene/scene_file.h"
 #include "scene/sdf_shapes.h"
@@ -71,6 +72,15 @@ void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& r
     row.set("frame.cpu_ms", frameCpu)
         .set("frame.gpu_ms", frameGpu)
         .set("frame_passes", framePasses);
+}
+
+void applySamplingOptions(const ReferenceOptions& options, reference::ReferenceSettings& settings)
+{
+    settings.targetStdErr = options.targetStdErr;
+    settings.targetRelStdErr = options.targetRelStdErr;
+    settings.maxSamples = options.maxSamples;
+    settings.batchSize = std::min(settings.batchSize, settings.maxSamples);
+    settings.seed = options.seed;
 }
 
 void addParamColumns(ResultRow& row, const plugin::Technique& technique, const std::string& prefix)

@@ -65,11 +65,7 @@ reference::ReferenceSettings makeReferenceSettings(const plugin::OcclusionDefini
         s.falloff = reference::parseFalloff(run.reference.falloff);
     if (run.reference.radius > 0.0)
         s.radius = run.reference.radius;
-    s.targetStdErr = run.reference.targetStdErr;
-    s.targetRelStdErr = run.reference.targetRelStdErr;
-    s.maxSamples = run.reference.maxSamples;
-    s.batchSize = std::min(s.batchSize, s.maxSamples);
-    s.seed = run.reference.seed;
+    experiment::applySamplingOptions(run.reference, s);
     return s;
 }
 
@@ -255,12 +251,18 @@ private:
         std::vector<pipeline::ResourceRef> techniqueWrites = {ambient};
         if (mTechnique->outputsBentCone())
             techniqueWrites.push_back("technique_bent_cone");
-        auto checkSize = [this, w, h](const plugin::OcclusionOutput& out) {
+        // The technique's call, the same whichever view it reads.
+        auto runTechnique = [this, w, h](const plugin::OcclusionInput& input,
+                                         plugin::OcclusionOutput& out) {
+            mTechnique->compute(input, out);
+            for (const auto& [name, value] : mTechnique->counters())
+                mRow->set("counter." + name, value);
             if (out.ambient.width != w || out.ambient.height != h)
                 throw Error("technique '" + mTechniqueName + "' returned an ambient image of " +
                             std::to_string(out.ambient.width) + "x" +
                             std::to_string(out.ambient.height) + " for a " + std::to_string(w) +
                             "x" + std::to_string(h) + " G-buffer");
+            return pipeline::PassOutcome{};
         };
         if (mTechnique->acceptsGpuInputs() && mRun.gbufferOnGpu) {
             // The G-buffer stays on the GPU: the technique binds the view inputs made there, and
@@ -273,7 +275,7 @@ private:
                            .writes = techniqueWrites,
                            .timing = pipeline::PassTiming::Repeated},
                           [this, viewGpu, depthGpu, normalGpu, ambient,
-                           checkSize](pipeline::PassContext& ctx) {
+                           runTechnique](pipeline::PassContext& ctx) {
                               const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
                               plugin::OcclusionInput input;
                               input.projection = v.projection;
@@ -282,12 +284,7 @@ private:
                               input.gpu = &mContext.getGpu();
                               input.gpuLinearDepth = &ctx.read(depthGpu);
                               input.gpuNormal = &ctx.read(normalGpu);
-                              plugin::OcclusionOutput& out = ctx.write(ambient);
-                              mTechnique->compute(input, out);
-                              for (const auto& [name, value] : mTechnique->counters())
-                                  mRow->set("counter." + name, value);
-                              checkSize(out);
-                              return pipeline::PassOutcome{};
+                              return runTechnique(input, ctx.write(ambient));
                           });
         } else {
             graph.addPass(
@@ -295,7 +292,7 @@ private:
                  .reads = {gbuffer, view, geometry},
                  .writes = techniqueWrites,
                  .timing = pipeline::PassTiming::Repeated},
-                [this, gbuffer, view, geometry, ambient, checkSize](pipeline::PassContext& ctx) {
+                [this, gbuffer, view, geometry, ambient, runTechnique](pipeline::PassContext& ctx) {
                     const scene::GBuffer& g = ctx.read(gbuffer);
                     plugin::OcclusionInput input;
                     input.linearDepth = &g.depth;
@@ -307,12 +304,7 @@ private:
                     input.scene = &ctx.read(
                         geometry); // ray-traced baselines only (families/occlusion/occlusion.h)
                     input.gbuffer = &g;
-                    plugin::OcclusionOutput& out = ctx.write(ambient);
-                    mTechnique->compute(input, out);
-                    for (const auto& [name, value] : mTechnique->counters())
-                        mRow->set("counter." + name, value);
-                    checkSize(out);
-                    return pipeline::PassOutcome{};
+                    return runTechnique(input, ctx.write(ambient));
                 });
         }
         // The frame's slots (pipeline/compose.h): the lit frame reads them when it runs.
