@@ -77,15 +77,20 @@ int listTechniques(const ListOptions& options)
             std::vector<std::string> metricsJson;
             for (const auto& m : info->metrics)
                 metricsJson.push_back(JsonObject().add("name", m.name).add("doc", m.doc).str());
-            familyJson.push_back(JsonObject()
-                                     .add("name", f)
-                                     .add("summary", info->summary)
-                                     .add("input", info->input)
-                                     .add("output", info->output)
-                                     .add("ground_truth", info->groundTruth)
-                                     .addRaw("metrics", jsonArray(metricsJson))
-                                     .addRaw("techniques", jsonArray(techniques))
-                                     .str());
+            familyJson.push_back(
+                JsonObject()
+                    .add("name", f)
+                    .add("summary", info->summary)
+                    .add("input", info->input)
+                    .add("output", info->output)
+                    .add("ground_truth", info->groundTruth)
+                    .add("domain",
+                         std::string(info->domain == plugin::FamilyDomain::Volume ? "volume"
+                                                                                  : "screen"))
+                    .add("runnable", bool(info->runtime))
+                    .addRaw("metrics", jsonArray(metricsJson))
+                    .addRaw("techniques", jsonArray(techniques))
+                    .str());
         }
         fmt::print("{}\n", JsonObject().addRaw("families", jsonArray(familyJson)).str());
         return kExitOk;
@@ -95,6 +100,12 @@ int listTechniques(const ListOptions& options)
         fmt::print("{}: {}\n", f, info->summary);
         fmt::print("  input:        {}\n  output:       {}\n  ground truth: {}\n", info->input,
                    info->output, info->groundTruth);
+        fmt::print("  runs on:      {}\n", info->domain == plugin::FamilyDomain::Volume
+                                               ? "a sampled volume (`grid`), in a run of its own"
+                                               : "the shared screen-space frame (`resolution`, "
+                                                 "`frames`), with any other screen family");
+        if (!info->runtime)
+            fmt::print("  (cannot run in experiments yet: the family registers no passes)\n");
         if (!info->metrics.empty()) {
             fmt::print("  metrics (experiment key `metrics:`; default all):\n");
             for (const auto& m : info->metrics)
