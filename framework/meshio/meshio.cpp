@@ -146,7 +146,7 @@ void writeMesh(const TriangleMesh& mesh, const std::string& path)
                          "unknown mesh file extension '" + ext + "'; expected .obj, .ply or .vtp");
 }
 
-void writeFieldVti(const plugin::SampledField& field, const std::string& path)
+void writeFieldVti(const SampledField& field, const std::string& path)
 {
     if (getLowerExtension(path) != ".vti")
         throw InputError(SourceLocation{path}, "a sampled field is written as VTK XML image data; "

@@ -2,7 +2,7 @@
 // Mesh and field exports for inspection in ParaView, Blender, MeshLab: OBJ, binary PLY, VTK XML.
 
 #include "core/mesh.h"
-#include "plugin/isosurface.h"
+#include "core/sampled_field.h"
 
 #include <string>
 
@@ -20,6 +20,6 @@ void writeMesh(const TriangleMesh& mesh, const std::string& path);
 //! counts, origin and spacing of the field, point scalars "sdf" (float). `path` must end in .vti
 //! (else rtlab::InputError); std::invalid_argument when the value count does not match the sample
 //! counts; rtlab::Error when the file cannot be written.
-void writeFieldVti(const plugin::SampledField& field, const std::string& path);
+void writeFieldVti(const SampledField& field, const std::string& path);
 
 } // namespace rtlab::meshio

@@ -179,7 +179,7 @@ inline bool isInside(float v)
 
 inline glm::dvec3 getSamplePosition(const GridSpec& g, int x, int y, int z)
 {
-    // Written as plugin::SampledField::position, so that positions are bit-identical.
+    // Written as SampledField::position, so that positions are bit-identical.
     return g.origin + g.spacing * glm::dvec3(x, y, z);
 }
 
@@ -225,16 +225,16 @@ struct Counters {
 };
 
 struct Outputs {
-    plugin::SampledField* field = nullptr;
+    SampledField* field = nullptr;
     std::vector<std::uint32_t>* materials = nullptr;  // null unless computed
     std::vector<double>* exactValues = nullptr;       // null unless kept
 };
 
 // Edge crossings of the samples [first, last] (each sample's +x, +y, +z edges inside the grid),
 // solved on `ops`, which must be exact on the box [first, min(last + 1, samples - 1)].
-void findCrossings(const std::vector<Op>& ops, const GridSpec& grid, const plugin::SampledField& field,
+void findCrossings(const std::vector<Op>& ops, const GridSpec& grid, const SampledField& field,
                    const glm::ivec3& first, const glm::ivec3& last, const EvaluationOptions& options,
-                   std::vector<plugin::HermiteEdge>& out, std::uint64_t& evaluations)
+                   std::vector<HermiteEdge>& out, std::uint64_t& evaluations)
 {
     const double tolerance = options.crossingPrecisionCells;  // along t, where an edge is 1 cell
     const double step = options.gradientStepCells * grid.spacing;
@@ -287,7 +287,7 @@ void findCrossings(const std::vector<Op>& ops, const GridSpec& grid, const plugi
                             lastSide = 1;
                         }
                     }
-                    plugin::HermiteEdge edge;
+                    HermiteEdge edge;
                     edge.sample = s;
                     edge.axis = axis;
                     edge.t = 0.5 * (ta + tb);
@@ -461,7 +461,7 @@ private:
     void fill(const glm::ivec3& first, const glm::ivec3& last, double value)
     {
         const float v = toFieldValue(value);
-        plugin::SampledField& f = *outputs.field;
+        SampledField& f = *outputs.field;
         for (int z = first.z; z <= last.z; ++z)
             for (int y = first.y; y <= last.y; ++y) {
                 const std::size_t row = f.index(0, y, z);
@@ -497,7 +497,7 @@ private:
         c.sampleEvaluations += count * ops.size();
         c.samplesEvaluated += count;
         ++c.leavesEvaluated;
-        plugin::SampledField& f = *outputs.field;
+        SampledField& f = *outputs.field;
         i = 0;
         for (int z = first.z; z <= last.z; ++z)
             for (int y = first.y; y <= last.y; ++y)
@@ -702,7 +702,7 @@ EvaluationResult evaluateModel(const SdfModel& model, const GridSpec& grid, int 
         for (const auto& list : h.leaves)
             for (const auto& leaf : list)
                 records.push_back(&leaf);
-        tbb::enumerable_thread_specific<std::vector<plugin::HermiteEdge>> edges;
+        tbb::enumerable_thread_specific<std::vector<HermiteEdge>> edges;
         tbb::enumerable_thread_specific<std::uint64_t> evaluations(0);
         runInArena(options.threadCount, [&] {
             tbb::parallel_for(std::size_t(0), records.size(), [&](std::size_t i) {
@@ -760,7 +760,7 @@ EvaluationResult evaluateModelBruteForce(const SdfModel& model, const GridSpec& 
     if (options.computeHermite) {
         const auto hermiteStart = std::chrono::steady_clock::now();
         const std::vector<Op> ops = getActiveOps(model, frame);
-        tbb::enumerable_thread_specific<std::vector<plugin::HermiteEdge>> edges;
+        tbb::enumerable_thread_specific<std::vector<HermiteEdge>> edges;
         tbb::enumerable_thread_specific<std::uint64_t> evaluations(0);
         runInArena(options.threadCount, [&] {
             tbb::parallel_for(0, grid.samples.z, [&](int z) {

@@ -51,7 +51,7 @@
 // Assumptions: rotations are unit quaternions and sizes are >= 0 (otherwise the edit is never
 // culled, which stays exact); blend radii are finite.
 
-#include "plugin/isosurface.h"
+#include "core/sampled_field.h"
 #include "scene/csg.h"
 
 #include <glm/vec3.hpp>
@@ -116,8 +116,8 @@ struct EvaluationStats {
 };
 
 struct EvaluationResult {
-    plugin::SampledField field;         //!< clamped to [-band, band]; see toFieldValue()
-    plugin::HermiteData hermite;        //!< sorted; empty unless computeHermite
+    SampledField field;         //!< clamped to [-band, band]; see toFieldValue()
+    HermiteData hermite;        //!< sorted; empty unless computeHermite
     std::vector<std::uint32_t> materials;  //!< per sample, same layout; empty unless computeMaterials
     std::vector<double> exactValues;    //!< clamped doubles, same layout; empty unless keepExactValues
     double band = 0.0;                  //!< world units

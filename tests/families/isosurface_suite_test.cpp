@@ -19,7 +19,7 @@
 
 #include "core/mesh.h"
 #include "isosurface_test_support.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 #include "plugin/technique.h"
 
 #include <glm/geometric.hpp>

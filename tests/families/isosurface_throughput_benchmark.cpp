@@ -12,7 +12,7 @@
 // repeat (the ctest that keeps it compiling and running).
 
 #include "metrics/timing.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 #include "plugin/technique.h"
 #include "scene/procedural.h"
 #include "sdf/evaluator.h"

@@ -2,7 +2,7 @@
 // A registry with the built-in families and one fake technique per family, so framework tests do
 // not depend on which real techniques are compiled in.
 
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 #include "plugin/technique.h"
 
 namespace rtlab::test {

@@ -165,7 +165,7 @@ TEST(Meshio, UnknownExtensionIsAnInputErrorNamingPathAndChoices)
                 EXPECT_NE(what.find(ext), std::string::npos) << what;
         }
     }
-    plugin::SampledField field;
+    SampledField field;
     EXPECT_THROW(meshio::writeFieldVti(field, makeTempPath("field.vtk")), InputError);
 }
 
@@ -177,7 +177,7 @@ TEST(Meshio, UnwritablePathIsAnError)
 
 TEST(Meshio, FieldVtiRoundTripThroughVtkXmlImageDataReader)
 {
-    plugin::SampledField field;
+    SampledField field;
     field.samples = glm::ivec3(5, 4, 3);
     field.origin = glm::dvec3(1e6, -2.5, 1.0 / 3.0);
     field.spacing = 1e-3 / 3.0;

@@ -37,7 +37,7 @@ bool isSameFloat(float a, float b)
 }
 
 // Brute force with nothing of the evaluator: SdfModel::evaluate at SampledField::position.
-std::vector<double> evaluateRaw(const SdfModel& model, const plugin::SampledField& f, int frame)
+std::vector<double> evaluateRaw(const SdfModel& model, const SampledField& f, int frame)
 {
     std::vector<double> out(f.values.size());
     for (int z = 0; z < f.samples.z; ++z)
@@ -134,7 +134,7 @@ GridSpec makeCubeGrid(double lo, double hi, int samples)
 }
 
 // Sign-change edges of a field, by definition (inside when <= 0).
-std::size_t countSignChanges(const plugin::SampledField& f)
+std::size_t countSignChanges(const SampledField& f)
 {
     std::size_t n = 0;
     for (int z = 0; z < f.samples.z; ++z)
@@ -148,7 +148,7 @@ std::size_t countSignChanges(const plugin::SampledField& f)
     return n;
 }
 
-void expectSameHermite(const plugin::HermiteData& a, const plugin::HermiteData& b, const std::string& what)
+void expectSameHermite(const HermiteData& a, const HermiteData& b, const std::string& what)
 {
     ASSERT_EQ(a.edges.size(), b.edges.size()) << what;
     std::size_t different = 0;

@@ -5,7 +5,7 @@
 
 #include "config/param.h"
 #include "core/mesh.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 #include <glm/geometric.hpp>
 #include <glm/vec2.hpp>

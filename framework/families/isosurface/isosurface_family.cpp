@@ -20,7 +20,7 @@
 #include "meshio/meshio.h"
 #include "metrics/mesh_metrics.h"
 #include "pipeline/frame_graph.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 #include "scene/procedural.h"
 #include "scene/sdf_shapes.h"
 #include "sdf/evaluator.h"

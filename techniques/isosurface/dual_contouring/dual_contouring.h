@@ -124,7 +124,7 @@
 #include "extraction.h"
 
 #include "config/param.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 #include <string>
 #include <utility>

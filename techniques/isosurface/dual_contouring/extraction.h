@@ -4,7 +4,7 @@
 // dual_contouring.h for the doc block.
 
 #include "core/mesh.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 #include <cstddef>
 #include <cstdint>

@@ -4,7 +4,7 @@
 #include "case_table.h"
 
 #include "core/mesh.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 namespace rtlab::isosurface::mc {
 

@@ -4,7 +4,7 @@
 #include "extraction.h"
 
 #include "config/param.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 namespace rtlab::isosurface {
 

@@ -2,7 +2,7 @@
 // Technique isosurface/openvdb_volume_to_mesh: see openvdb_volume_to_mesh.cpp for the doc block.
 
 #include "config/param.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 #include <string>
 #include <utility>

@@ -2,7 +2,7 @@
 // Technique isosurface/vtk_flying_edges: see vtk_flying_edges.cpp for the doc block.
 
 #include "config/param.h"
-#include "plugin/isosurface.h"
+#include "families/isosurface/isosurface.h"
 
 #include <string>
 #include <utility>

@@ -1,8 +1,8 @@
-#include "plugin/isosurface.h"
+#include "core/sampled_field.h"
 
 #include <algorithm>
 
-namespace rtlab::plugin {
+namespace rtlab {
 
 const HermiteEdge* HermiteData::find(const glm::ivec3& s, int axis) const
 {
@@ -22,4 +22,4 @@ void HermiteData::sort()
     });
 }
 
-} // namespace rtlab::plugin
+} // namespace rtlab
