@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <set>
 
 void rtlabRegisterTechnique_occlusion_gtao(rtlab::plugin::Registry&);
 void rtlabRegisterTechnique_isosurface_marching_cubes(rtlab::plugin::Registry&);
@@ -150,6 +151,30 @@ TEST(MultiFamily, TwoScreenFamiliesShareOneFrameAndMeetThroughASlot)
     EXPECT_GT(meanAo, 0.0);
     EXPECT_LT(meanAo, 1.0) << "ao_testbed has creases and occluders";
     EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "ao.rmse")));
+}
+
+TEST(MultiFamily, SweepsCrossTheParametersOfBothFamilies)
+{
+    const auto registry = makeRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: ao_testbed
+  techniques:
+    occlusion: {technique: gtao}
+    probe: {technique: probe_a}
+sweep:
+  occlusion.radius: [0.5, 1.0]
+  probe.radius: [1.0, 2.0, 3.0]
+)",
+                                               "sweep.yaml", registry);
+    ASSERT_EQ(e.runs.size(), 6u);
+    std::set<std::string> hashes;
+    for (const auto& run : e.runs) {
+        hashes.insert(run.hash());
+        EXPECT_EQ(run.techniques.size(), 2u);
+    }
+    EXPECT_EQ(hashes.size(), 6u);
+    EXPECT_EQ(e.runs[5].techniques.at("occlusion").params.getFloat("radius"), 1.0);
+    EXPECT_EQ(e.runs[5].techniques.at("probe").params.getFloat("radius"), 3.0);
 }
 
 TEST(MultiFamily, AVolumeFamilyCannotShareARunAndTheErrorSaysWhere)
