@@ -225,6 +225,8 @@ std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
         if (screen)
             options.collectGpuTimes = [&] { return collectGpuPassTimes(context.getGpu()); };
         const auto records = graph.execute(options);
+        row.set("frame.gpu_images_created", std::int64_t(graph.lastGpuAllocations()))
+            .set("frame.gpu_images_reused", std::int64_t(graph.lastGpuReuses()));
         for (const auto& family : familyRuns)
             family->endFrame(frame, records, row);
         if (litFrame)

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "gpu/context.h"
+#include "pipeline/gpu_resources.h"
 #include "render/image_transfer.h"
 #include "render/lighting_pass.h"
 #include "render/shadow_pass.h"
@@ -35,10 +36,14 @@ void Compose::addPasses(FrameGraph& graph)
     const Resource<const render::ShadowPass*> shadowMaps{
         "shadow_maps",
         ResourceType::gpuImage("r32f cube atlas", mOptions.shadowMapSize, mOptions.shadowMapSize)};
-    const Resource<GpuFrameImage> hdr{"lit_hdr",
-                                      ResourceType::gpuImage("rgba32f", mWidth, mHeight)};
-    const Resource<GpuFrameImage> ldr{"lit_ldr",
-                                      ResourceType::gpuImage("rgba8 srgb", mWidth, mHeight)};
+    // The frame's images are the graph's: created on first use, pooled between frames.
+    gpu::Context& gpuContext = mStart.getGpu();
+    const auto hdr =
+        makeGpuImageResource(gpuContext, "lit_hdr", gpu::Format::RGBA32Float, mWidth, mHeight);
+    const auto direct =
+        makeGpuImageResource(gpuContext, "lit_direct", gpu::Format::RGBA32Float, mWidth, mHeight);
+    const auto ldr =
+        makeGpuImageResource(gpuContext, "lit_ldr", gpu::Format::RGBA8Unorm, mWidth, mHeight);
 
     // Slots that no family of the run fills.
     if (!graph.declares(kAmbientOcclusion))
@@ -103,9 +108,9 @@ void Compose::addPasses(FrameGraph& graph)
         {.name = "lighting",
          .reads = {gbuffer, geometry},
          .optionalReads = {shadowMaps, ao, cones, indirect},
-         .writes = {hdr},
+         .writes = {hdr, direct},
          .timing = PassTiming::Repeated},
-        [this, gbuffer, geometry, shadowMaps, ao, cones, indirect, hdr](PassContext& ctx) {
+        [this, gbuffer, geometry, shadowMaps, ao, cones, indirect, hdr, direct](PassContext& ctx) {
             gpu::Context& gpu = mStart.getGpu();
             if (!mLighting) {
                 render::LightingPassOptions options;
@@ -147,23 +152,25 @@ void Compose::addPasses(FrameGraph& graph)
                 indirectImage = render::createImageFrom(gpu, *e, "indirect irradiance");
                 inputs.indirectIrradiance = &indirectImage;
             }
+            inputs.outHdr = &ctx.write(hdr);
+            inputs.outDirect = &ctx.write(direct);
             mLighting->draw(g, inputs);
-            ctx.write(hdr) = GpuFrameImage{&mLighting->getHdr()};
             return PassOutcome{};
         });
     graph.addPass({.name = "tonemap", .reads = {hdr}, .writes = {ldr}},
-                  [this, ldr](PassContext& ctx) {
-                      mLighting->tonemap({float(mOptions.exposureEv),
-                                          render::parseTonemapper(mOptions.tonemapper)});
-                      ctx.write(ldr) = GpuFrameImage{&mLighting->getLdr()};
+                  [this, hdr, ldr](PassContext& ctx) {
+                      mLighting->tonemap(ctx.read(hdr),
+                                         {float(mOptions.exposureEv),
+                                          render::parseTonemapper(mOptions.tonemapper)},
+                                         ctx.write(ldr));
                       return PassOutcome{};
                   });
-    graph.addPass({.name = "frame_readback", .reads = {hdr, ldr}, .writes = {lit}},
-                  [this, lit](PassContext& ctx) {
+    graph.addPass({.name = "frame_readback", .reads = {hdr, direct, ldr}, .writes = {lit}},
+                  [hdr, direct, ldr, lit](PassContext& ctx) {
                       LitFrame& out = ctx.write(lit);
-                      out.hdr = mLighting->readBackHdr();
-                      out.direct = mLighting->readBackDirect();
-                      out.ldr = mLighting->readBackLdr();
+                      out.hdr = render::downloadRgb(ctx.read(hdr));
+                      out.direct = render::downloadRgb(ctx.read(direct));
+                      out.ldr = render::downloadRgb(ctx.read(ldr));
                       return PassOutcome{};
                   });
 }

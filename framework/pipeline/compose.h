@@ -44,11 +44,6 @@ struct LitFrame {
     Image<glm::vec3> ldr;    //!< tonemapped, sRGB-encoded, [0, 1]
 };
 
-//! A GPU image of the frame (owned by the compose passes).
-struct GpuFrameImage {
-    const gpu::Image* image = nullptr;
-};
-
 struct ComposeOptions {
     std::string tonemapper = "aces"; //!< "aces" or "reinhard" (render/lighting_pass.h)
     double exposureEv = 0.0;

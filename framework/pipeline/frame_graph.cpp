@@ -144,7 +144,7 @@ void FrameGraph::addPass(PassDesc desc, std::function<PassOutcome(PassContext&)>
     for (const auto& w : desc.writes) {
         Slot& s = slot(w.name);
         s.type = w.cppType;
-        if (w.type.kind == ResourceKind::GpuImage || w.type.kind == ResourceKind::GpuBuffer)
+        if (w.allocates)
             s.poolKey = w.type.describe() + " " + w.cppType.name();
         s.persistent = std::find(desc.persistent.begin(), desc.persistent.end(), w.name) !=
                        desc.persistent.end();

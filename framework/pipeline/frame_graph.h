@@ -90,6 +90,7 @@ struct ResourceRef {
     ResourceType type;
     std::type_index cppType = typeid(void);
     std::function<std::shared_ptr<void>()> make; //!< default-constructs the data (not for tokens)
+    bool allocates = false; //!< `make` allocates device memory (GPU images, buffers): pooled
 
     ResourceRef(std::string n) : name(std::move(n)) {}
     ResourceRef(const char* n) : name(n) {}
@@ -113,10 +114,13 @@ template <class T> struct Resource {
     operator ResourceRef() const
     {
         auto make = create;
-        return ResourceRef(name, type, typeid(T), [make]() -> std::shared_ptr<void> {
+        ResourceRef ref(name, type, typeid(T), [make]() -> std::shared_ptr<void> {
             return make ? std::static_pointer_cast<void>(make())
                         : std::static_pointer_cast<void>(std::make_shared<T>());
         });
+        ref.allocates = bool(create) && (type.kind == ResourceKind::GpuImage ||
+                                         type.kind == ResourceKind::GpuBuffer);
+        return ref;
     }
 };
 

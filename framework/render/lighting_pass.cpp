@@ -293,6 +293,14 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
                     std::to_string(std::size_t(w) * h) + " pixels, it has " +
                     std::to_string(inputs.coneVisibility->getSize()) + " bytes");
 
+    if (inputs.outHdr != nullptr)
+        requireImage(*inputs.outHdr, gpu::Format::RGBA32Float, w, h, "HDR output");
+    if (inputs.outDirect != nullptr)
+        requireImage(*inputs.outDirect, gpu::Format::RGBA32Float, w, h, "direct output");
+    if ((inputs.outHdr == nullptr) != (inputs.outDirect == nullptr))
+        throw Error("LightingPass::draw: give both outputs (HDR and direct) or neither");
+    const bool ownOutputs = inputs.outHdr == nullptr;
+
     s.resize(w, h);
     s.updateSky(scene.sky);
 
@@ -362,19 +370,22 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
              gpu::Binding::storageImage(3, s.gbuffer[3]), gpu::Binding::storageImage(4, atlas),
              gpu::Binding::storageBuffer(5, s.lights), gpu::Binding::storageBuffer(6, s.sky),
              gpu::Binding::storageImage(7, ao), gpu::Binding::storageBuffer(8, cones),
-             gpu::Binding::storageImage(9, indirect), gpu::Binding::storageImage(10, s.hdr),
-             gpu::Binding::storageImage(11, s.direct)},
+             gpu::Binding::storageImage(9, indirect),
+             gpu::Binding::storageImage(10, ownOutputs ? s.hdr : *inputs.outHdr),
+             gpu::Binding::storageImage(11, ownOutputs ? s.direct : *inputs.outDirect)},
             gpu::PushConstants(constants), groups, kLightingLabel);
-        cmd.dispatch(s.tonemap,
-                     {gpu::Binding::storageImage(0, s.hdr), gpu::Binding::storageImage(1, s.ldr)},
-                     gpu::PushConstants(tonemap), groups, kTonemapLabel);
+        if (ownOutputs)
+            cmd.dispatch(
+                s.tonemap,
+                {gpu::Binding::storageImage(0, s.hdr), gpu::Binding::storageImage(1, s.ldr)},
+                gpu::PushConstants(tonemap), groups, kTonemapLabel);
     });
-    s.drawn = true;
+    s.drawn = s.drawn || ownOutputs;
     s.lastVisibility = visibility;
     s.lastIndirect = inputs.indirectIrradiance != nullptr;
     const auto copyMs = result.sumGpuMs(kCopyLabel);
     const auto lightingMs = result.sumGpuMs(kLightingLabel);
-    const auto tonemapMs = result.sumGpuMs(kTonemapLabel);
+    const auto tonemapMs = ownOutputs ? result.sumGpuMs(kTonemapLabel) : std::optional<double>(0.0);
     s.lastGpuMs = copyMs && lightingMs && tonemapMs
                       ? std::optional<double>(*copyMs + *lightingMs + *tonemapMs)
                       : std::nullopt;
@@ -414,6 +425,33 @@ gpu::RunResult LightingPass::tonemap(const gpu::Image& hdr, const TonemapSetting
     gpu::RunResult result = s.context->run([&](gpu::CommandList& cmd) {
         cmd.dispatch(s.tonemap,
                      {gpu::Binding::storageImage(0, hdr), gpu::Binding::storageImage(1, s.ldr)},
+                     gpu::PushConstants(constants), groups, kTonemapLabel);
+    });
+    s.lastGpuMs = result.sumGpuMs(kTonemapLabel);
+    return result;
+}
+
+gpu::RunResult LightingPass::tonemap(const gpu::Image& hdr, const TonemapSettings& settings,
+                                     const gpu::Image& ldr)
+{
+    State& s = *mState;
+    const gpu::ImageDesc& d = hdr.getDesc();
+    if (!hdr.isValid() || d.dimension != gpu::ImageDimension::Image2D ||
+        d.format != gpu::Format::RGBA32Float)
+        throw Error("LightingPass::tonemap: '" + d.name + "' is not a 2D RGBA32Float image");
+    requireImage(ldr, gpu::Format::RGBA8Unorm, d.width, d.height, "tonemapped output");
+    if (!std::isfinite(settings.exposureEv))
+        throw Error("LightingPass::tonemap: exposure must be finite");
+    TonemapConstants constants;
+    constants.exposureScale = std::exp2(settings.exposureEv);
+    constants.tonemapper = std::uint32_t(settings.tonemapper);
+    constants.width = d.width;
+    constants.height = d.height;
+    const gpu::GroupCount groups{gpu::computeGroupCount(d.width, kGroupSize),
+                                 gpu::computeGroupCount(d.height, kGroupSize), 1};
+    gpu::RunResult result = s.context->run([&](gpu::CommandList& cmd) {
+        cmd.dispatch(s.tonemap,
+                     {gpu::Binding::storageImage(0, hdr), gpu::Binding::storageImage(1, ldr)},
                      gpu::PushConstants(constants), groups, kTonemapLabel);
     });
     s.lastGpuMs = result.sumGpuMs(kTonemapLabel);

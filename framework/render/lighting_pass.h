@@ -116,6 +116,11 @@ struct LightingInputs {
     const gpu::Buffer* coneVisibility = nullptr;
     //! RGBA32Float image of the G-buffer's size: incident indirect irradiance (rgb). Null: none.
     const gpu::Image* indirectIrradiance = nullptr;
+    //! Where to write the frame: RGBA32Float images of the G-buffer's size, e.g. created by the
+    //! frame graph (pipeline/gpu_resources.h). Null: the pass's own images (getHdr(), getDirect()),
+    //! which draw() also tonemaps into getLdr(); with outputs given, call tonemap() yourself.
+    const gpu::Image* outHdr = nullptr;
+    const gpu::Image* outDirect = nullptr;
 };
 
 //! The push constants of lighting.comp.
@@ -162,6 +167,9 @@ public:
     gpu::RunResult tonemap(const TonemapSettings& settings);
     //! Tonemaps any 2D RGBA32Float image into getLdr() (resized to it).
     gpu::RunResult tonemap(const gpu::Image& hdr, const TonemapSettings& settings);
+    //! The same into `ldr`, an RGBA8Unorm image of hdr's size (not the pass's own getLdr()).
+    gpu::RunResult tonemap(const gpu::Image& hdr, const TonemapSettings& settings,
+                           const gpu::Image& ldr);
 
     //! RGBA32Float: emission + direct + sky + indirect (alpha 1). Valid after draw().
     const gpu::Image& getHdr() const;
