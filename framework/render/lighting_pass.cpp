@@ -415,20 +415,7 @@ gpu::RunResult LightingPass::tonemap(const gpu::Image& hdr, const TonemapSetting
         s.ldr =
             createImage2D(*s.context, gpu::Format::RGBA8Unorm, d.width, d.height, "lighting ldr");
     }
-    TonemapConstants constants;
-    constants.exposureScale = std::exp2(settings.exposureEv);
-    constants.tonemapper = std::uint32_t(settings.tonemapper);
-    constants.width = d.width;
-    constants.height = d.height;
-    const gpu::GroupCount groups{gpu::computeGroupCount(d.width, kGroupSize),
-                                 gpu::computeGroupCount(d.height, kGroupSize), 1};
-    gpu::RunResult result = s.context->run([&](gpu::CommandList& cmd) {
-        cmd.dispatch(s.tonemap,
-                     {gpu::Binding::storageImage(0, hdr), gpu::Binding::storageImage(1, s.ldr)},
-                     gpu::PushConstants(constants), groups, kTonemapLabel);
-    });
-    s.lastGpuMs = result.sumGpuMs(kTonemapLabel);
-    return result;
+    return tonemap(hdr, settings, s.ldr);
 }
 
 gpu::RunResult LightingPass::tonemap(const gpu::Image& hdr, const TonemapSettings& settings,

@@ -25,7 +25,7 @@ namespace rtlab::report {
 //! Which columns a family's figures use: declared by the family (plugin::FamilyReport).
 using FamilyColumns = plugin::FamilyReport;
 
-//! The report columns of `family` ("occlusion"; for a run of several families, "a+b", those of
+//! The report columns of `family` (for a run of several families, "a+b", those of
 //! the first that declares any); throws rtlab::Error for a family the registry does not know.
 FamilyColumns getFamilyColumns(const plugin::Registry& registry, const std::string& family);
 
