@@ -55,6 +55,17 @@ private:
     double mRadius;
 };
 
+// Runs the experiment quietly into `directory` and returns its rows.
+std::vector<experiment::Row> runAndLoad(const experiment::Experiment& e,
+                                        const plugin::Registry& registry,
+                                        const std::string& directory)
+{
+    experiment::runExperiment(
+        e, registry,
+        {.outputDirectory = directory, .quiet = true, .queryVulkanForManifest = false});
+    return experiment::loadResults(directory);
+}
+
 } // namespace
 
 TEST(OcclusionDriver, RunsTheFramePipelineAgainstTheGroundTruth)
@@ -134,11 +145,7 @@ TEST(OcclusionDriver, RecordsSkippedPassesAndWhy)
   techniques: {occlusion: {technique: unoccluded}}
 )",
                                                (dir / "passes.yaml").string(), registry);
-    experiment::runExperiment(e, registry,
-                              {.outputDirectory = (dir / "out").string(),
-                               .quiet = true,
-                               .queryVulkanForManifest = false});
-    const auto rows = experiment::loadResults((dir / "out").string());
+    const auto rows = runAndLoad(e, registry, (dir / "out").string());
     ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
     const std::string& first = rows[0].at("passes");
     EXPECT_NE(first.find("character_pose:skipped(the scene has no characters)"), std::string::npos)
@@ -201,10 +208,7 @@ TEST(OcclusionDriver, WithoutCullingEveryPassRunsAndTheImagesAreBitwiseTheSame)
                                         (dir / ("culling_" + culling + ".yaml")).string(),
                                         registry);
         const auto out = dir / ("out_" + culling);
-        experiment::runExperiment(
-            e, registry,
-            {.outputDirectory = out.string(), .quiet = true, .queryVulkanForManifest = false});
-        return experiment::loadResults(out.string());
+        return runAndLoad(e, registry, out.string());
     };
     const auto culled = run("true");
     const auto all = run("false");
@@ -247,11 +251,7 @@ TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
   techniques: {occlusion: {technique: bentcone_ssdo}}
 )",
                                                (dir / "lit.yaml").string(), registry);
-    experiment::runExperiment(e, registry,
-                              {.outputDirectory = (dir / "out").string(),
-                               .quiet = true,
-                               .queryVulkanForManifest = false});
-    const auto rows = experiment::loadResults((dir / "out").string());
+    const auto rows = runAndLoad(e, registry, (dir / "out").string());
     ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
     for (const auto& row : rows) {
         ASSERT_EQ(row.at("status"), "ok") << row.at("error");
@@ -317,10 +317,7 @@ TEST(OcclusionDriver, VulkanTechniquesReadTheGBufferOnTheGpuWithTheSameResult)
 )",
                                         (dir / ("gpu_" + onGpu + ".yaml")).string(), registry);
         const auto out = dir / ("out_" + onGpu);
-        experiment::runExperiment(
-            e, registry,
-            {.outputDirectory = out.string(), .quiet = true, .queryVulkanForManifest = false});
-        return experiment::loadResults(out.string());
+        return runAndLoad(e, registry, out.string());
     };
     const auto gpu = run("true");
     const auto cpu = run("false");
@@ -353,10 +350,7 @@ TEST(OcclusionDriver, ComputesOnlyTheMetricsTheRunAsksForAndTheGroundTruthTheyRe
   techniques: {occlusion: {technique: unoccluded}}
 )",
                                                (dir / "metrics.yaml").string(), registry);
-    experiment::runExperiment(
-        e, registry,
-        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
-    const auto rows = experiment::loadResults(dir.string());
+    const auto rows = runAndLoad(e, registry, dir.string());
     ASSERT_EQ(rows.size(), 1u);
     ASSERT_EQ(rows[0].at("status"), "ok") << rows[0].at("error");
     const std::string& passes = rows[0].at("passes");
@@ -389,10 +383,7 @@ TEST(OcclusionDriver, MeasuresAgainstTheOverriddenQuantityAndSaysSo)
   techniques: {occlusion: {technique: unoccluded}}
 )",
                                                (dir / "override.yaml").string(), registry);
-    experiment::runExperiment(
-        e, registry,
-        {.outputDirectory = dir.string(), .quiet = true, .queryVulkanForManifest = false});
-    const auto rows = experiment::loadResults(dir.string());
+    const auto rows = runAndLoad(e, registry, dir.string());
     ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
     EXPECT_EQ(rows[0].at("reference.quantity"), "ao_uniform");
     EXPECT_DOUBLE_EQ(experiment::getNumber(rows[0], "reference.radius"), 0.25);
