@@ -142,6 +142,8 @@ void LitFrame::endFrame(ResultRow& row)
     const pipeline::ComposeStats& s = mCompose->getStats();
     row.set("frame.lights", std::int64_t(s.lights))
         .set("frame.shadow_maps_rendered", std::int64_t(s.lightsRendered))
+        .set("frame.shadow_faces_rendered", std::int64_t(s.shadowFacesRendered))
+        .set("frame.shadow_skips", s.shadowSkips)
         .set("frame.visibility", s.visibility);
     mRow = nullptr;
 }

@@ -9,9 +9,131 @@
 #include "scene/sky.h"
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cstring>
+#include <limits>
+#include <utility>
+
+#include <glm/common.hpp>
+#include <glm/vec3.hpp>
 
 namespace rtlab::pipeline {
+
+namespace {
+
+constexpr std::array<const char*, render::kCubeFaceCount> kFaceNames = {"+x", "-x", "+y",
+                                                                        "-y", "+z", "-z"};
+// Changed triangles are grouped into the cells of a grid of this many cells per axis over the
+// scene's bounds, one box per cell: far apart changes (two characters, a dig) then do not make
+// one box that every face of every light sees.
+constexpr int kChangeGridSize = 8;
+
+// Triangles are ordered by hash, then by the bits of their box: a strict order even with NaN
+// or -0 coordinates, so that equal triangles (equal positions in the same order) are adjacent.
+std::array<std::uint32_t, 6> getBoxBits(const ShadowTriangle& t)
+{
+    return {std::bit_cast<std::uint32_t>(t.boxMin.x), std::bit_cast<std::uint32_t>(t.boxMin.y),
+            std::bit_cast<std::uint32_t>(t.boxMin.z), std::bit_cast<std::uint32_t>(t.boxMax.x),
+            std::bit_cast<std::uint32_t>(t.boxMax.y), std::bit_cast<std::uint32_t>(t.boxMax.z)};
+}
+
+bool isBefore(const ShadowTriangle& a, const ShadowTriangle& b)
+{
+    if (a.hash != b.hash)
+        return a.hash < b.hash;
+    return getBoxBits(a) < getBoxBits(b);
+}
+
+// The sorted triangles of `g`. The hash is of the position bits in index order: a triangle
+// whose corners are listed in another order rasterises with other roundings, so it counts as
+// changed.
+std::vector<ShadowTriangle> computeShadowTriangles(const scene::RenderScene& g)
+{
+    std::vector<ShadowTriangle> triangles(g.triangleCount());
+    for (std::size_t t = 0; t < triangles.size(); ++t) {
+        ShadowTriangle& out = triangles[t];
+        std::uint64_t h = 0xcbf29ce484222325ull; // FNV-1a over the nine 32-bit words
+        out.boxMin = glm::vec3(std::numeric_limits<float>::max());
+        out.boxMax = glm::vec3(std::numeric_limits<float>::lowest());
+        for (std::size_t k = 0; k < 3; ++k) {
+            const glm::vec3 p = g.positions[g.indices[3 * t + k]];
+            for (int c = 0; c < 3; ++c)
+                h = (h ^ std::bit_cast<std::uint32_t>(p[c])) * 0x100000001b3ull;
+            out.boxMin = glm::min(out.boxMin, p);
+            out.boxMax = glm::max(out.boxMax, p);
+        }
+        // splitmix64's finaliser spreads FNV's weak high bits, which lead the sort.
+        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
+        h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
+        out.hash = h ^ (h >> 31);
+    }
+    std::sort(triangles.begin(), triangles.end(), isBefore);
+    return triangles;
+}
+
+// The bounds of the positions, as render::ShadowPass computes them for its planes.
+std::pair<glm::vec3, glm::vec3> computeBounds(const std::vector<glm::vec3>& positions)
+{
+    if (positions.empty())
+        return {glm::vec3(0.0f), glm::vec3(0.0f)};
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
+    for (const glm::vec3& p : positions) {
+        lo = glm::min(lo, p);
+        hi = glm::max(hi, p);
+    }
+    return {lo, hi};
+}
+
+// The triangles in one list and not the other (as multisets), as boxes: one per cell of the
+// change grid over [boundsMin, boundsMax] that holds the centre of one of them.
+struct ChangedTriangles {
+    std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
+};
+
+ChangedTriangles findChangedTriangles(const std::vector<ShadowTriangle>& before,
+                                      const std::vector<ShadowTriangle>& after, glm::vec3 boundsMin,
+                                      glm::vec3 boundsMax)
+{
+    constexpr int n = kChangeGridSize;
+    const glm::vec3 empty(std::numeric_limits<float>::max());
+    std::vector<std::pair<glm::vec3, glm::vec3>> cells(std::size_t(n * n * n), {empty, -empty});
+    const glm::vec3 extent = glm::max(boundsMax - boundsMin, glm::vec3(1e-30f));
+    ChangedTriangles changed;
+    auto add = [&](const ShadowTriangle& t) {
+        const glm::vec3 u = (0.5f * (t.boxMin + t.boxMax) - boundsMin) / extent * float(n);
+        const glm::ivec3 cell(glm::clamp(glm::floor(u), glm::vec3(0.0f), glm::vec3(float(n - 1))));
+        auto& box = cells[std::size_t((cell.z * n + cell.y) * n + cell.x)];
+        box.first = glm::min(box.first, t.boxMin);
+        box.second = glm::max(box.second, t.boxMax);
+    };
+    auto a = before.begin(), b = after.begin();
+    while (a != before.end() || b != after.end()) {
+        if (b == after.end() || (a != before.end() && isBefore(*a, *b)))
+            add(*a++);
+        else if (a == before.end() || isBefore(*b, *a))
+            add(*b++);
+        else {
+            ++a;
+            ++b;
+        }
+    }
+    for (const auto& box : cells)
+        if (box.first.x <= box.second.x)
+            changed.boxes.push_back(box);
+    return changed;
+}
+
+std::string describeFaces(std::uint8_t mask)
+{
+    std::string s;
+    for (int f = 0; f < render::kCubeFaceCount; ++f)
+        if (mask & (1u << f))
+            s += (s.empty() ? "" : ",") + std::string(kFaceNames[std::size_t(f)]);
+    return s;
+}
+
+} // namespace
 
 Compose::Compose(FrameStart& start, ComposeOptions options)
     : mStart(start), mOptions(std::move(options)), mWidth(start.getOptions().width),
@@ -76,31 +198,82 @@ void Compose::addPasses(FrameGraph& graph)
                  for (std::size_t i = 0; i < g.pointLights.size(); ++i)
                      if (g.pointLights[i].position != mShadowLightPositions[i])
                          return std::string();
+                 const std::string why = "no light and no shadow caster moved since frame " +
+                                         std::to_string(mShadowFrame);
                  mStats.lightsRendered = 0;
-                 return "no light and no shadow caster moved since frame " +
-                        std::to_string(mShadowFrame);
+                 mStats.shadowFacesRendered = 0;
+                 mStats.shadowSkips = "every light: " + why;
+                 return why;
              }},
         [this, geometry, shadowMaps](PassContext& ctx) {
             const scene::RenderScene& g = ctx.read(geometry);
             if (!mShadows)
                 mShadows = std::make_unique<render::ShadowPass>(
                     mStart.getGpu(), render::ShadowPassOptions{.faceSize = mOptions.shadowMapSize});
-            const std::string hash = g.computeContentHash();
-            std::vector<std::size_t> lights;
-            const bool castersMoved =
-                hash != mShadowGeometryHash || g.pointLights.size() != mShadowLightPositions.size();
-            for (std::size_t i = 0; i < g.pointLights.size(); ++i)
-                if (castersMoved || !ctx.mayReuse() ||
-                    g.pointLights[i].position != mShadowLightPositions[i])
-                    lights.push_back(i);
-            mShadows->render(g, lights);
-            mStats.lightsRendered = int(lights.size());
-            mShadowGeometryHash = hash;
+            const std::size_t lightCount = g.pointLights.size();
+            std::vector<ShadowTriangle> triangles = computeShadowTriangles(g);
+            const auto [boundsMin, boundsMax] = computeBounds(g.positions);
+            // Every face of every light is drawn when the kept maps may not be what a full
+            // rendering gives: the near and far planes follow the bounds.
+            const bool drawAll = !ctx.mayReuse() || mShadowFrame < 0 ||
+                                 lightCount != mShadowLightPositions.size() ||
+                                 boundsMin != mShadowBoundsMin || boundsMax != mShadowBoundsMax;
+            const ChangedTriangles changed =
+                drawAll ? ChangedTriangles{}
+                        : findChangedTriangles(mShadowTriangles, triangles, boundsMin, boundsMax);
+            std::vector<std::uint8_t> masks(lightCount, 0);
+            std::vector<std::string> skips;
+            for (std::size_t i = 0; i < lightCount; ++i) {
+                const glm::vec3 p = g.pointLights[i].position;
+                if (drawAll || p != mShadowLightPositions[i]) {
+                    masks[i] = render::kAllCubeFaces;
+                    continue;
+                }
+                for (const auto& [lo, hi] : changed.boxes) {
+                    masks[i] |= render::computeCubeFacesTouching(p, lo, hi);
+                    if (masks[i] == render::kAllCubeFaces)
+                        break;
+                }
+                // The six pyramids cover space, so a light keeps every face only when no
+                // triangle changed (materials, normals or the triangles' order did).
+                if (masks[i] == 0)
+                    skips.push_back(
+                        "light " + std::to_string(i) +
+                        ": no triangle appeared or disappeared, the light did not move");
+                else if (masks[i] != render::kAllCubeFaces)
+                    skips.push_back("light " + std::to_string(i) + " faces " +
+                                    describeFaces(std::uint8_t(render::kAllCubeFaces & ~masks[i])) +
+                                    ": no triangle appeared or disappeared in their view");
+            }
+            std::string joined;
+            for (const std::string& skip : skips)
+                joined += (joined.empty() ? "" : "; ") + skip;
+            mStats.shadowSkips = joined;
+            mStats.lightsRendered = 0;
+            mStats.shadowFacesRendered = 0;
+            const bool nothingToDraw =
+                std::all_of(masks.begin(), masks.end(), [](std::uint8_t m) { return m == 0; });
+            const int lastFrame = mShadowFrame;
+            if (!nothingToDraw)
+                mShadows->renderFaces(g, masks);
+            // Remembered once the maps hold it (a failed rendering keeps the last state).
+            mShadowGeometryHash = g.computeContentHash();
             mShadowLightPositions.clear();
             for (const auto& l : g.pointLights)
                 mShadowLightPositions.push_back(l.position);
+            mShadowTriangles = std::move(triangles);
+            mShadowBoundsMin = boundsMin;
+            mShadowBoundsMax = boundsMax;
             mShadowFrame = ctx.frame();
             ctx.write(shadowMaps) = mShadows.get();
+            if (nothingToDraw)
+                return PassOutcome::skipped("no shadow caster and no light moved since frame " +
+                                            std::to_string(lastFrame));
+            for (std::size_t i = 0; i < lightCount; ++i) {
+                const int faces = std::popcount(mShadows->getLightState(i).lastFaceMask);
+                mStats.lightsRendered += faces > 0 ? 1 : 0;
+                mStats.shadowFacesRendered += faces;
+            }
             return PassOutcome{};
         });
 

@@ -1,9 +1,16 @@
 #pragma once
 // The compose passes of the lit frame, on the GPU, after the families' passes:
 //
-//   shadow_maps     cube shadow maps of the point lights (needs point_lights). Re-rendered only
-//                   for lights that moved, and for all lights when a shadow caster moved (the
-//                   frame's geometry changed: characters, digs); skipped when neither happened.
+//   shadow_maps     cube shadow maps of the point lights (needs point_lights), re-rendered per
+//                   light and cube face: every face of a light that moved, and of every light on
+//                   the first frame, when the number of lights or the scene's bounds (they set the
+//                   maps' planes) changed, or without culling; otherwise only the faces that see
+//                   a triangle that appeared or disappeared since the last frame (walking
+//                   characters, remeshed digs: the symmetric difference of the frames' triangle
+//                   sets, grouped into boxes). The other faces and lights keep their maps, each
+//                   skip recorded with its reason (ComposeStats::shadowSkips); a kept face holds
+//                   what re-rendering it would give, so the frame is bitwise that of a run
+//                   without culling. Skipped when neither geometry nor lights changed.
 //   lighting        point lights with filtered shadows, the 16-lobe SRBF sky attenuated by the
 //                   frame's directional occlusion, emission, and the indirect slot
 //                   (render/lighting_pass.h). The occlusion family fills `occlusion.ambient`
@@ -23,6 +30,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,6 +44,15 @@ class Image;
 }
 
 namespace rtlab::pipeline {
+
+//! A triangle of the geometry the shadow maps were rendered for (compose.cpp): a hash of its
+//! three positions, in order, and its box. Two frames' sorted lists of them give the triangles
+//! that appeared or disappeared in between.
+struct ShadowTriangle {
+    std::uint64_t hash = 0;
+    glm::vec3 boxMin{0.0f};
+    glm::vec3 boxMax{0.0f};
+};
 
 //! The lit frame on the CPU.
 struct LitFrame {
@@ -53,9 +70,11 @@ struct ComposeOptions {
 //! What the compose passes did in the last frame (columns of the row).
 struct ComposeStats {
     int lights = 0;
-    int lightsRendered = 0; //!< shadow maps drawn this frame
-    std::string visibility; //!< "none", "ambient_occlusion", "cones"
-    std::string indirect;   //!< "none (...)" or the producer's slot
+    int lightsRendered = 0;      //!< lights with at least one shadow-map face drawn this frame
+    int shadowFacesRendered = 0; //!< shadow-map cube faces drawn this frame, 0..6 * lights
+    std::string shadowSkips;     //!< the lights and faces whose maps were kept, and why
+    std::string visibility;      //!< "none", "ambient_occlusion", "cones"
+    std::string indirect;        //!< "none (...)" or the producer's slot
 };
 
 class Compose {
@@ -102,6 +121,9 @@ private:
     // What the shadow maps were rendered for.
     std::string mShadowGeometryHash;
     std::vector<glm::vec3> mShadowLightPositions;
+    std::vector<ShadowTriangle> mShadowTriangles; //!< sorted (see compose.cpp)
+    glm::vec3 mShadowBoundsMin{0.0f};
+    glm::vec3 mShadowBoundsMax{0.0f};
     int mShadowFrame = -1;
 };
 

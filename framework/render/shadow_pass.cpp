@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "core/error.h"
 #include "render/gbuffer_geometry.h"
@@ -113,6 +114,49 @@ glm::mat4 computeCubeFaceProjection(int face, float nearPlane, float farPlane)
     return m;
 }
 
+std::uint8_t computeCubeFacesTouching(glm::vec3 light, glm::vec3 boxMin, glm::vec3 boxMax)
+{
+    if (boxMin.x > boxMax.x || boxMin.y > boxMax.y || boxMin.z > boxMax.z)
+        return 0;
+    if (glm::all(glm::lessThanEqual(boxMin, light)) && glm::all(glm::lessThanEqual(light, boxMax)))
+        return kAllCubeFaces;
+    std::array<glm::vec3, 8> corners;
+    for (int corner = 0; corner < 8; ++corner)
+        corners[static_cast<std::size_t>(corner)] =
+            glm::vec3((corner & 1) ? boxMax.x : boxMin.x, (corner & 2) ? boxMax.y : boxMin.y,
+                      (corner & 4) ? boxMax.z : boxMin.z) -
+            light;
+    std::uint8_t mask = 0;
+    for (int face = 0; face < kCubeFaceCount; ++face) {
+        const FaceBasis& f = kFaces[static_cast<std::size_t>(face)];
+        // The pyramid is F.d >= |R.d| and F.d >= |U.d|: four planes through the light (F.d >= 0,
+        // implied by them, is a fifth that rejects boxes behind the face). The box misses it
+        // when all its corners lie outside one of them. The slack (relative to the corner's
+        // distance) keeps a box that grazes a plane in despite float rounding; the GPU's texel
+        // centres lie half a texel inside the face, so the slack loses nothing.
+        const std::array<glm::vec3, 5> normals = {f.forward - f.right, f.forward + f.right,
+                                                  f.forward - f.up, f.forward + f.up, f.forward};
+        bool outside = false;
+        for (const glm::vec3& n : normals) {
+            bool allOut = true;
+            for (const glm::vec3& d : corners) {
+                const float slack = 1e-5f * (std::abs(d.x) + std::abs(d.y) + std::abs(d.z));
+                if (glm::dot(n, d) >= -slack) {
+                    allOut = false;
+                    break;
+                }
+            }
+            if (allOut) {
+                outside = true;
+                break;
+            }
+        }
+        if (!outside)
+            mask = static_cast<std::uint8_t>(mask | (1u << face));
+    }
+    return mask;
+}
+
 struct ShadowPass::State {
     gpu::Context* context = nullptr;
     ShadowPassOptions options;
@@ -205,30 +249,43 @@ ShadowPass& ShadowPass::operator=(ShadowPass&&) noexcept = default;
 
 gpu::RunResult ShadowPass::render(const scene::RenderScene& scene)
 {
-    std::vector<std::size_t> all(scene.pointLights.size());
-    for (std::size_t i = 0; i < all.size(); ++i)
-        all[i] = i;
-    return render(scene, all);
+    const std::vector<std::uint8_t> all(scene.pointLights.size(), kAllCubeFaces);
+    return renderFaces(scene, all);
 }
 
 gpu::RunResult ShadowPass::render(const scene::RenderScene& scene,
                                   std::span<const std::size_t> lightIndices)
 {
-    State& s = *mState;
     const std::size_t lightCount = scene.pointLights.size();
-    for (const std::size_t i : lightIndices)
+    std::vector<std::uint8_t> masks(lightCount, 0);
+    for (const std::size_t i : lightIndices) {
         if (i >= lightCount)
             throw Error("ShadowPass::render: light " + std::to_string(i) + " of " +
                         std::to_string(lightCount));
+        masks[i] = kAllCubeFaces;
+    }
+    return renderFaces(scene, masks);
+}
+
+gpu::RunResult ShadowPass::renderFaces(const scene::RenderScene& scene,
+                                       std::span<const std::uint8_t> faceMasks)
+{
+    State& s = *mState;
+    const std::size_t lightCount = scene.pointLights.size();
+    if (faceMasks.size() != lightCount)
+        throw Error("ShadowPass::renderFaces: " + std::to_string(faceMasks.size()) +
+                    " face masks for " + std::to_string(lightCount) + " lights");
+    for (std::size_t i = 0; i < lightCount; ++i)
+        if ((faceMasks[i] & ~kAllCubeFaces) != 0)
+            throw Error("ShadowPass::renderFaces: face mask " + std::to_string(faceMasks[i]) +
+                        " of light " + std::to_string(i) + " has bits above face 5");
     s.uploadGeometry(scene);
 
-    std::vector<bool> chosen(lightCount, false);
-    for (const std::size_t i : lightIndices)
-        chosen[i] = true;
+    std::vector<std::uint8_t> masks(faceMasks.begin(), faceMasks.end());
     if (lightCount != s.lights.size()) {
         s.createAtlas(lightCount);
         s.lights.assign(lightCount, ShadowLightState{});
-        chosen.assign(lightCount, true);
+        masks.assign(lightCount, kAllCubeFaces);
     }
 
     const float diagonal = glm::length(s.boundsMax - s.boundsMin);
@@ -241,7 +298,10 @@ gpu::RunResult ShadowPass::render(const scene::RenderScene& scene,
     };
     std::vector<FaceDraw> draws;
     for (std::size_t light = 0; light < lightCount; ++light) {
-        if (!chosen[light])
+        ShadowLightState& state = s.lights[light];
+        state.lastFaceMask = 0;
+        std::uint8_t mask = masks[light];
+        if (mask == 0)
             continue;
         const glm::vec3 p = scene.pointLights[light].position;
         float farthest = 0.0f;
@@ -252,19 +312,27 @@ gpu::RunResult ShadowPass::render(const scene::RenderScene& scene,
             farthest = std::max(farthest, glm::length(c - p));
         }
         const float farPlane = std::max(farthest * 1.01f + nearPlane, 4.0f * nearPlane);
+        // The faces kept from the last rendering were drawn with its projection: mixing two
+        // projections in one cube would give a map no full rendering gives.
+        if (!state.rendered || state.position != p || state.nearPlane != nearPlane ||
+            state.farPlane != farPlane)
+            mask = kAllCubeFaces;
         for (int face = 0; face < kCubeFaceCount; ++face) {
+            if ((mask & (1u << face)) == 0)
+                continue;
             FaceDraw d;
             d.slice = static_cast<std::uint32_t>(light * kCubeFaceCount + std::size_t(face));
             d.constants.relativeFaceProjection =
                 computeCubeFaceProjection(face, nearPlane, farPlane);
             d.constants.lightPosition = glm::vec4(p, 1.0f);
             draws.push_back(d);
+            ++state.faceRenderCounts[static_cast<std::size_t>(face)];
         }
-        ShadowLightState& state = s.lights[light];
         state.rendered = true;
         state.position = p;
         state.nearPlane = nearPlane;
         state.farPlane = farPlane;
+        state.lastFaceMask = mask;
         ++state.renderCount;
     }
 

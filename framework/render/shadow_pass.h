@@ -8,7 +8,9 @@
 //   render::ShadowPass shadows(ctx);
 //   shadows.render(scene);                   // every light
 //   std::size_t moved[] = {2};
-//   shadows.render(scene, moved);            // only light 2 (its casters moved)
+//   shadows.render(scene, moved);            // only light 2 (it moved)
+//   std::uint8_t faces[] = {0x01, 0x00, 0x3F};
+//   shadows.renderFaces(scene, faces);       // face +x of light 0, every face of light 2
 //
 // Storage. rtlab's images have a single array layer and no cube views, so the maps live in one
 // 3D R32Float image, the atlas: getFaceSize() x getFaceSize() x 6 * lightCount, slice
@@ -23,9 +25,15 @@
 // closer than that to the light casts no shadow); far plane: beyond the farthest corner of the
 // scene's bounds.
 //
-// Per-light state. The pass remembers, per light, whether its map was rendered and from where,
-// so a caller (a frame graph) can re-render only the lights whose casters or position changed.
-// When the number of lights changes, the atlas is reallocated and every light is rendered.
+// Per-light state. The pass remembers, per light, whether its map was rendered, from where and
+// with which planes, so a caller (a frame graph) can re-render only the lights, and of those only
+// the faces, whose casters or position changed: computeCubeFacesTouching tells which faces see a
+// box of changed triangles. The planes depend only on the scene's bounds and the light's
+// position, so a face that is not re-rendered holds exactly what re-rendering it would give as
+// long as its casters, the bounds and the light stay the same. All faces of a light share one
+// projection: a partial face mask is widened to every face when the light's position or planes
+// differ from its last rendering. When the number of lights changes, the atlas is reallocated
+// and every face of every light is rendered.
 
 #include "gpu/context.h"
 #include "gpu/shader_compiler.h"
@@ -38,6 +46,7 @@
 
 #include "core/image.h"
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -64,13 +73,19 @@ struct ShadowPassOptions {
     gpu::ShaderCompilerOptions compiler; //!< SPIR-V cache etc.; the shader dir is searched too
 };
 
+//! Face mask with every face of a cube (bit f = face f, see computeCubeFace).
+inline constexpr std::uint8_t kAllCubeFaces = 0x3F;
+
 //! What the pass knows about the map of one light.
 struct ShadowLightState {
     bool rendered = false;         //!< its atlas slices hold a rendering
     glm::vec3 position{0.0f};      //!< where the light was when it was last rendered
     float nearPlane = 0.0f;        //!< of that rendering, world units
     float farPlane = 0.0f;         //!< of that rendering, world units
-    std::uint64_t renderCount = 0; //!< renderings so far
+    std::uint64_t renderCount = 0; //!< renderings (of one face or more) so far
+    //! Renderings of each face so far (index = face).
+    std::array<std::uint64_t, kCubeFaceCount> faceRenderCounts{};
+    std::uint8_t lastFaceMask = 0; //!< faces drawn by the last render call, 0: none
 };
 
 //! Major-axis face of direction `d` (!= 0): 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z (ties go to x,
@@ -85,6 +100,13 @@ glm::vec3 computeCubeFaceDirection(int face, glm::vec2 st);
 //! (p - light) -> clip space of `face` for the given planes: x = s, y = t, w = distance along
 //! the face's axis, depth in [0, 1] from near to far.
 glm::mat4 computeCubeFaceProjection(int face, float nearPlane, float farPlane);
+//! Mask (bit f = face f) of the faces of a cube map at `light` whose 90 degree pyramid (the
+//! points whose major axis is the face's: |other coordinates| <= the face's coordinate) meets
+//! the box [boxMin, boxMax]. Conservative: a face may be reported that the box misses (it tests
+//! the pyramid's four planes against the box's corners, with a little slack for rounding), a
+//! face the box meets never is left out. kAllCubeFaces when the light is inside the box, 0 for
+//! an empty box (a min coordinate above the max).
+std::uint8_t computeCubeFacesTouching(glm::vec3 light, glm::vec3 boxMin, glm::vec3 boxMax);
 
 //! Renders cube shadow maps for the point lights of a scene. Move-only; the Context must
 //! outlive it.
@@ -104,16 +126,24 @@ public:
 
     //! Renders the maps of every light of `scene`.
     gpu::RunResult render(const scene::RenderScene& scene);
-    //! Uploads the scene's triangles when they differ from the last call's and renders the maps
-    //! of the lights `lightIndices` (into scene.pointLights; duplicates are drawn once). When
-    //! the number of lights differs from the last call, every light is rendered. Throws
-    //! rtlab::Error for an index out of range, an inconsistent scene, or more lights than a 3D
-    //! image can hold.
+    //! Renders every face of the lights `lightIndices` (into scene.pointLights; duplicates are
+    //! drawn once), as renderFaces with kAllCubeFaces for them and 0 for the others. Throws
+    //! rtlab::Error for an index out of range (and as renderFaces).
     gpu::RunResult render(const scene::RenderScene& scene,
                           std::span<const std::size_t> lightIndices);
+    //! Uploads the scene's triangles when they differ from the last call's and renders, per
+    //! light, the faces of its mask (faceMasks[i] for scene.pointLights[i], bit f = face f;
+    //! lights with mask 0 keep their maps and state). A partial mask is widened to every face
+    //! when the light was not rendered yet, or its position or planes differ from its last
+    //! rendering. When the number of lights differs from the last call, every face of every
+    //! light is rendered. Throws rtlab::Error when faceMasks.size() != scene.pointLights.size(),
+    //! for a mask with bits above kAllCubeFaces, an inconsistent scene, or more lights than a
+    //! 3D image can hold.
+    gpu::RunResult renderFaces(const scene::RenderScene& scene,
+                               std::span<const std::uint8_t> faceMasks);
 
     int getFaceSize() const;
-    //! Lights of the last render() (0 before the first).
+    //! Lights of the last render() or renderFaces() (0 before the first).
     std::size_t getLightCount() const;
     //! The state of light `light` (< getLightCount()).
     const ShadowLightState& getLightState(std::size_t light) const;

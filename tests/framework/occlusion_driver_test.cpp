@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -294,6 +295,69 @@ TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
                   "shadow_maps:skipped(no light and no shadow caster moved since frame 0)"),
               std::string::npos)
         << rows[1].at("passes");
+}
+
+TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesAWalkerChangesAndTheFrameMatchesTheUnculledOne)
+{
+    // The Cornell box with two point lights and a small walking character, three frames. With
+    // culling the shadow pass redraws, after frame 0, only the cube faces that see the walker's
+    // old or new triangles and records the kept ones; without culling it redraws all 12 faces.
+    // The lit HDR frames must not differ by a bit.
+    const auto& registry = plugin::builtinRegistry();
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_walker";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "walker.yaml")
+        << "scene: walker\nbase: cornell_box\nframes: 3\n"
+           "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n"
+           "  - {position: [0.1, 0.3, 0.45], intensity: [0.02, 0.03, 0.04]}\n"
+           "characters:\n  - name: walker\n"
+           "    capsules: [{a: [0, 0.03, 0], b: [0, 0.1, 0], radius: 0.03}]\n"
+           "    path: [{time: 0, position: [0.4, 0, 0.1]}, {time: 0.2, position: [0.45, 0, "
+           "0.2]}]\n";
+    auto run = [&](const std::string& culling) {
+        const auto e =
+            experiment::parseExperiment(R"(base:
+  scene: walker.yaml
+  resolution: [32, 24]
+  frames: 3
+  metrics: [error]
+  frame: {lighting: true, shadow_map_size: 32, culling: )" +
+                                            culling + R"(}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 4}
+  techniques: {occlusion: {technique: gtao}}
+)",
+                                        (dir / ("walker_" + culling + ".yaml")).string(), registry);
+        return runAndLoad(e, registry, (dir / ("out_" + culling)).string());
+    };
+    const auto culled = run("true");
+    const auto all = run("false");
+    ASSERT_EQ(culled.size(), 3u) << (culled.empty() ? "" : culled[0].at("error"));
+    ASSERT_EQ(all.size(), 3u) << (all.empty() ? "" : all[0].at("error"));
+    for (std::size_t i = 0; i < 3; ++i) {
+        ASSERT_EQ(culled[i].at("status"), "ok") << culled[i].at("error");
+        ASSERT_EQ(all[i].at("status"), "ok") << all[i].at("error");
+        EXPECT_EQ(all[i].at("frame.shadow_faces_rendered"), "12") << "frame " << i;
+        EXPECT_EQ(all[i].at("frame.shadow_skips"), "") << "frame " << i;
+        if (i == 0) {
+            EXPECT_EQ(culled[i].at("frame.shadow_faces_rendered"), "12");
+        } else {
+            EXPECT_NE(culled[i].at("passes").find("shadow_maps:run"), std::string::npos)
+                << culled[i].at("passes");
+            const double faces = experiment::getNumber(culled[i], "frame.shadow_faces_rendered");
+            EXPECT_GT(faces, 0.0) << "frame " << i;
+            EXPECT_LT(faces, 12.0) << "frame " << i;
+            EXPECT_NE(culled[i].at("frame.shadow_skips").find("in their view"), std::string::npos)
+                << culled[i].at("frame.shadow_skips");
+        }
+        const Image<glm::vec3> a = experiment::readExrRgb(culled[i].at("image.lit_hdr"));
+        const Image<glm::vec3> b = experiment::readExrRgb(all[i].at("image.lit_hdr"));
+        ASSERT_EQ(a.pixels.size(), b.pixels.size());
+        EXPECT_EQ(
+            std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
+            << "lit frame " << i;
+    }
 }
 
 TEST(OcclusionDriver, VulkanTechniquesReadTheGBufferOnTheGpuWithTheSameResult)
