@@ -55,8 +55,7 @@ void FrameStart::addPasses(FrameGraph& graph)
 {
     const auto sceneRes =
         graph.addExternal<scene::Scene>(kScene, ResourceType::value("scene"), &mScene);
-    const Resource<std::vector<scene::SdfMesh>> sdfMeshes{"sdf_meshes",
-                                                          ResourceType::mesh("sdf meshes")};
+    const auto sdfMeshes = this->sdfMeshes();
     const Resource<std::vector<scene::PosedCapsule>> capsules{
         "capsules", ResourceType::table("posed capsules")};
     const auto geometryRes = geometry();

@@ -104,6 +104,11 @@ public:
 
     // Typed handles of the resources, for the families' passes.
     Resource<scene::Scene> scene() const { return {kScene, ResourceType::value("scene")}; }
+    //! The SDF models as meshes (written only for scenes with SDF models).
+    Resource<std::vector<scene::SdfMesh>> sdfMeshes() const
+    {
+        return {"sdf_meshes", ResourceType::mesh("sdf meshes")};
+    }
     Resource<scene::RenderScene> geometry() const
     {
         return {kGeometry, ResourceType::mesh("render scene")};

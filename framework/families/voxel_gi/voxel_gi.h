@@ -1,55 +1,81 @@
 #pragma once
-// Family `voxel_gi`: a voxel scene structure (cascades, sparse octree, 64-ary adaptive tree) built
-// from the voxelized scene, then cone traced to give indirect diffuse irradiance at G-buffer pixels.
-// Ground truth: the path tracer's indirect-only irradiance with the same lights.
+// Family `voxel_gi`: a voxel scene structure (cascades, sparse octree, 64-ary adaptive tree)
+// built from the voxelized scene, lit by cone tracing in 16 fixed directions, then cone traced
+// from G-buffer pixels to give their indirect diffuse irradiance.
+// Ground truth: the path tracer's indirect-only irradiance (reference.h "indirect") with the
+// same lights and the bounce count the technique declares.
+//
+// A frame calls, each as a pass of the frame graph (families/voxel_gi/voxel_gi_family.cpp):
+//   voxelize(frame)      re-voxelize what changed (nothing, a level, a dug region, a scrolled slab)
+//   injectLight(frame)   update the voxel light buffers (direct, bounces) where they are stale
+//   gather(input, out)   indirect irradiance at every G-buffer pixel
+// Each step says whether it did anything and, when not, why (recorded as a skipped pass).
+//
+// The shared machinery lives beside this header: voxelize.h (triangles -> volumetric G-buffer)
+// and cone_tracing.h (the 16 cones, the march, light injection).
 
 #include "core/image.h"
 #include "plugin/technique.h"
+#include "scene/gbuffer.h"
+#include "scene/render_scene.h"
 
 #include <glm/vec3.hpp>
-#include <glm/vec4.hpp>
 
-#include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
+
+namespace rtlab::gpu {
+class Context;
+}
 
 namespace rtlab::plugin {
 
-//! One voxel of the anisotropic scene voxelization: per axis-aligned face direction (+x,-x,+y,
-//! -y,+z,-z) the albedo and occupancy seen from that side, plus emission and normal.
-struct VoxelSample {
-    glm::ivec3 coord{0};                //!< integer voxel coordinate at the finest level
-    std::array<glm::vec4, 6> faces{};   //!< rgb albedo, a = occupancy in [0, 1]
-    glm::vec3 emission{0.0f};           //!< radiance units
-    glm::vec3 normal{0.0f};             //!< average surface normal, may be zero
+//! What a voxel_gi technique computes, so that the ground truth computes exactly that.
+struct VoxelGiDefinition {
+    int bounces = 2; //!< reflections before the light reaches the pixel (reference "indirect")
 };
 
-//! The voxelized scene shared by all voxel_gi techniques.
-struct VoxelScene {
-    glm::dvec3 origin{0.0};     //!< world position of voxel (0, 0, 0)'s corner
-    double voxelSize = 1.0;     //!< finest voxel edge, world units
-    int resolution = 0;         //!< finest grid is resolution^3
-    std::vector<VoxelSample> voxels;  //!< occupied voxels only
+//! The frame as the structure sees it: the static scene (no characters: the talk does not
+//! voxelize them, their occlusion comes from capsules), the camera, the frame index.
+struct VoxelGiFrame {
+    const scene::RenderScene* geometry = nullptr; //!< triangles, lights, sky
+    std::string geometryKey;                      //!< changes exactly when `geometry` changes
+    glm::dvec3 cameraPosition{0.0};
+    int frameIndex = 0;
+    bool force = false; //!< do the whole step even where nothing changed (culling off)
+    gpu::Context* gpu = nullptr;
+};
+
+//! What a step did: ran, or skipped with the reason.
+struct VoxelGiStep {
+    bool ran = true;
+    std::string skipReason;
+    static VoxelGiStep skipped(std::string why) { return {false, std::move(why)}; }
 };
 
 struct VoxelGiInput {
-    const VoxelScene* scene = nullptr;
-    const Image<glm::vec3>* worldPosition = nullptr;  //!< G-buffer, world units
-    const Image<glm::vec3>* worldNormal = nullptr;    //!< G-buffer, unit length
+    const scene::GBuffer* gbuffer = nullptr; //!< world positions and normals of the pixels
+    glm::dvec3 cameraPosition{0.0};
+    //! The occlusion family's 16 per-direction visibilities (bentcone_ssdo), or null.
+    const std::vector<Image<float>>* coneVisibility = nullptr;
+    int frameIndex = 0;
+    gpu::Context* gpu = nullptr;
 };
 
 //! Sizes the family reports for the data-structure metrics.
 struct VoxelGiMemory {
-    std::size_t topologyBytes = 0;  //!< tree nodes, masks, pointers
-    std::size_t payloadBytes = 0;   //!< colours, occupancy, light
+    std::size_t topologyBytes = 0; //!< tree nodes, masks, pointers, level descriptors
+    std::size_t payloadBytes = 0;  //!< volumetric G-buffer and light buffers
 };
 
 class VoxelGiTechnique : public Technique {
 public:
     static constexpr const char* kFamily = "voxel_gi";
-    //! Builds (or updates) the structure from the voxelized scene.
-    virtual void build(const VoxelScene& scene) = 0;
-    //! Indirect diffuse irradiance at every G-buffer pixel.
+    virtual VoxelGiDefinition definition() const = 0;
+    virtual VoxelGiStep voxelize(const VoxelGiFrame& frame) = 0;
+    virtual VoxelGiStep injectLight(const VoxelGiFrame& frame) = 0;
+    //! Indirect diffuse irradiance at every G-buffer pixel (0 where there is no surface).
     virtual void gather(const VoxelGiInput& input, Image<glm::vec3>& irradiance) = 0;
     virtual VoxelGiMemory memory() const = 0;
 };

@@ -1,0 +1,220 @@
+#pragma once
+// Cone tracing shared by every voxel_gi structure (cascades, octree, 64-ary tree): the 16 fixed
+// cone directions, the front-to-back march, and light injection into the voxels' light buffers.
+// A structure provides a Sampler (below); everything else is the same code for all of them, so
+// the structures differ only in how they store and filter the voxels.
+//
+// The Tomorrow Children (shared/seeds/000_3da000e866ebc485.txt, "Core Lighting Update Logic" to
+// "Need to light pixels"): 16 fixed directions, a spherical design, used for the cones from voxels
+// and from pixels alike; sky light as 16 SRBF lobes on those directions, gathered by cone tracing;
+// emission injected directly; bounce light by tracing the same 16 cones through the direct
+// buffer, and again for the second bounce.
+
+#include "scene/render_scene.h"
+#include "scene/sky.h"
+
+#include <glm/exponential.hpp>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace rtlab::voxelgi {
+
+inline constexpr int kConeCount = scene::kConeDirectionCount;
+
+//! The light buffers of a voxel face, as the structures store them (premultiplied by the face's
+//! occupancy when sampled).
+enum Field : int {
+    kEmission = 0, //!< emitted radiance (injected directly)
+    kDirect = 1,   //!< reflected direct light: albedo/pi * E_0 (sky, point lights, emission)
+    kBounce1 = 2,  //!< reflected first bounce: albedo/pi * E_1
+    kBounce2 = 3,  //!< reflected second bounce: albedo/pi * E_2
+};
+inline constexpr int kFieldCount = 4;
+
+//! The 16 cones: directions (scene/sky.h's design) and a common half-angle.
+struct ConeSet {
+    std::array<glm::dvec3, kConeCount> directions{};
+    double halfAngle = 0.0;    //!< radians
+    double tanHalfAngle = 0.0;
+
+    //! `halfAngleDegrees` in (0, 90). 29 degrees makes the 16 cones' solid angles sum to the
+    //! sphere's (2 pi (1 - cos a) = 4 pi / 16).
+    static ConeSet make(double halfAngleDegrees);
+};
+
+//! Weights w_k (sum over k of w_k = pi) that turn the 16 incoming radiances into irradiance
+//! about normal n: E = sum_k w_k L_k, w_k proportional to max(0, dot(w_k, n)). Exact for a
+//! constant radiance (the furnace) whatever n; zero weights for cones below the surface.
+std::array<double, kConeCount> computeIrradianceWeights(const ConeSet& cones, const glm::dvec3& n);
+
+//! Mean sky radiance over each cone's solid angle (quadrature on the cone), what a cone that
+//! leaves the structure unoccluded sees.
+std::array<glm::vec3, kConeCount> computeSkyPerCone(const scene::Sky& sky, const ConeSet& cones);
+
+//! One filtered sample of a structure at a cone's footprint.
+struct ConeSample {
+    float alpha = 0.0f;                         //!< occupancy seen along the cone's direction
+    std::array<glm::vec3, kFieldCount> light{}; //!< premultiplied by alpha
+    double voxelSize = 1.0;                     //!< size of the voxels sampled (opacity correction)
+};
+
+struct ConeMarchSettings {
+    double tanHalfAngle = 0.55; //!< of the cone
+    double startDistance = 0.0; //!< world units along the cone before the first sample
+    double stepScale = 0.5;     //!< step = stepScale * size of the voxels sampled
+    double maxOpacity = 0.99;   //!< stop when the accumulated occupancy reaches it
+    double maxDistance = 1e30;  //!< world units (point-light shadow cones stop at the light)
+    int maxSteps = 1024;
+};
+
+struct ConeResult {
+    std::array<glm::vec3, kFieldCount> light{}; //!< radiance of each field seen along the cone
+    double transmittance = 1.0;                 //!< 1 - accumulated occupancy
+    bool escaped = false;                       //!< left the structure (sees the sky)
+    int steps = 0;
+};
+
+//! Marches one cone front to back. Sampler: `bool sample(const glm::dvec3& p, double diameter,
+//! int cone, const glm::dvec3& dir, ConeSample& out) const` returns false when p is outside the
+//! structure. Opacity is corrected for the step length, a' = 1 - (1 - a)^(step / voxelSize), and
+//! the radiance composited with the same a' (Engel et al., Real-Time Volume Graphics; the
+//! step-length correction of shared/research/voxelgi.md section 8.1).
+template <class Sampler>
+ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm::dvec3& dir, int cone,
+                     const ConeMarchSettings& s)
+{
+    ConeResult r;
+    double occupied = 0.0;
+    double t = s.startDistance;
+    ConeSample sample;
+    for (int step = 0; step < s.maxSteps; ++step) {
+        if (t >= s.maxDistance)
+            break;
+        const double diameter = 2.0 * t * s.tanHalfAngle;
+        const glm::dvec3 p = origin + t * dir;
+        if (!sampler.sample(p, diameter, cone, dir, sample)) {
+            r.escaped = true;
+            break;
+        }
+        ++r.steps;
+        // Steps follow the voxels actually sampled: the footprint's level, or a coarser one
+        // where the point lies only in coarse levels, or a finer one where the footprint has
+        // outgrown the coarsest level (stepping by the footprint there would jump over walls).
+        const double dt = s.stepScale * sample.voxelSize;
+        const double stepAlpha = std::min(1.0, std::max(0.0, double(sample.alpha)));
+        if (stepAlpha > 0.0) {
+            const double corrected =
+                1.0 - std::pow(1.0 - std::min(stepAlpha, 0.999999), dt / sample.voxelSize);
+            const double weight = (1.0 - occupied) * corrected / stepAlpha;
+            for (int f = 0; f < kFieldCount; ++f)
+                r.light[std::size_t(f)] += float(weight) * sample.light[std::size_t(f)];
+            occupied += (1.0 - occupied) * corrected;
+            if (occupied >= s.maxOpacity)
+                break;
+        }
+        t += dt;
+    }
+    r.transmittance = 1.0 - occupied;
+    return r;
+}
+
+//! The light of the frame that voxels receive directly.
+struct InjectionLights {
+    const std::vector<scene::PointLight>* pointLights = nullptr;
+    std::array<glm::vec3, kConeCount> skyPerCone{}; //!< computeSkyPerCone
+    bool hasSky = false;
+};
+
+//! A surface voxel to light: its centre, mean normal (may be 0) and faces (albedo, occupancy).
+struct InjectionVoxel {
+    glm::dvec3 centre{0.0};
+    glm::vec3 normal{0.0f};
+    double voxelSize = 1.0;
+    const glm::vec4* faces = nullptr; //!< 6 faces
+};
+
+//! Irradiance per face from the 16 cones and the point lights, for each reflected field:
+//! E[kDirect] from emission, sky and point lights (E_0), E[kBounce1] from the direct buffer
+//! (E_1), E[kBounce2] from the first bounce (E_2). The caller turns them into radiance
+//! (albedo / pi * E) for the fields it updates.
+struct FaceIrradiance {
+    std::array<std::array<glm::vec3, 6>, kFieldCount> e{};
+};
+
+struct InjectionSettings {
+    ConeMarchSettings march;     //!< startDistance is set per voxel from startOffset
+    double startOffset = 1.0;    //!< voxels: cone start distance and origin offset along the normal
+    double pointLightTan = 0.05; //!< half-angle tangent of the shadow cones toward point lights
+};
+
+//! The face normal the irradiance of face f is integrated about: the voxel's surface normal when
+//! the surface faces that side, else the face's axis.
+glm::dvec3 getShadingNormal(const InjectionVoxel& voxel, int face);
+
+template <class Sampler>
+FaceIrradiance gatherVoxelIrradiance(const Sampler& sampler, const InjectionVoxel& voxel,
+                                     const ConeSet& cones, const InjectionLights& lights,
+                                     const InjectionSettings& settings)
+{
+    FaceIrradiance out;
+    const glm::dvec3 n(voxel.normal);
+    const glm::dvec3 origin = voxel.centre + n * (0.5 * settings.startOffset * voxel.voxelSize);
+    ConeMarchSettings march = settings.march;
+    march.tanHalfAngle = cones.tanHalfAngle;
+    march.startDistance = settings.startOffset * voxel.voxelSize;
+    // Incoming radiance per cone and field (the sky where the cone escapes).
+    std::array<std::array<glm::vec3, kFieldCount>, kConeCount> incoming{};
+    for (int k = 0; k < kConeCount; ++k) {
+        const ConeResult c = marchCone(sampler, origin, cones.directions[std::size_t(k)], k, march);
+        incoming[std::size_t(k)] = c.light;
+        if (c.escaped && lights.hasSky)
+            incoming[std::size_t(k)][kEmission] +=
+                float(c.transmittance) * lights.skyPerCone[std::size_t(k)];
+    }
+    for (int face = 0; face < 6; ++face) {
+        const glm::dvec3 shading = getShadingNormal(voxel, face);
+        const auto w = computeIrradianceWeights(cones, shading);
+        glm::dvec3 e0(0.0), e1(0.0), e2(0.0);
+        for (int k = 0; k < kConeCount; ++k) {
+            const double wk = w[std::size_t(k)];
+            if (wk == 0.0)
+                continue;
+            e0 += wk * glm::dvec3(incoming[std::size_t(k)][kEmission]);
+            e1 += wk * glm::dvec3(incoming[std::size_t(k)][kDirect]);
+            e2 += wk * glm::dvec3(incoming[std::size_t(k)][kBounce1]);
+        }
+        out.e[kDirect][std::size_t(face)] = glm::vec3(e0);
+        out.e[kBounce1][std::size_t(face)] = glm::vec3(e1);
+        out.e[kBounce2][std::size_t(face)] = glm::vec3(e2);
+    }
+    // Point lights: inverse-square irradiance, shadowed by a thin cone toward the light.
+    if (lights.pointLights != nullptr)
+        for (const scene::PointLight& light : *lights.pointLights) {
+            const glm::dvec3 toLight = glm::dvec3(light.position) - origin;
+            const double d2 = glm::dot(toLight, toLight);
+            if (!(d2 > 0.0))
+                continue;
+            const double d = std::sqrt(d2);
+            const glm::dvec3 l = toLight / d;
+            ConeMarchSettings shadow = march;
+            shadow.tanHalfAngle = settings.pointLightTan;
+            shadow.maxDistance = d;
+            const double visible = marchCone(sampler, origin, l, -1, shadow).transmittance;
+            if (visible <= 0.0)
+                continue;
+            for (int face = 0; face < 6; ++face) {
+                const double c = glm::dot(getShadingNormal(voxel, face), l);
+                if (c > 0.0)
+                    out.e[kDirect][std::size_t(face)] +=
+                        glm::vec3(glm::dvec3(light.intensity) * (c * visible / d2));
+            }
+        }
+    return out;
+}
+
+} // namespace rtlab::voxelgi

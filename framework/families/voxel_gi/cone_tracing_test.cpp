@@ -1,0 +1,118 @@
+// The shared cone machinery: irradiance weights (exact for a constant radiance, zero below the
+// surface), the sky per cone, and the march's step-length-corrected opacity.
+
+#include "families/voxel_gi/cone_tracing.h"
+
+#include "core/error.h"
+
+#include <glm/gtc/constants.hpp>
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace rtlab;
+using namespace rtlab::voxelgi;
+
+namespace {
+
+TEST(ConeTracing, IrradianceWeightsIntegrateAConstantRadianceExactly)
+{
+    const ConeSet cones = ConeSet::make(29.0);
+    const glm::dvec3 normals[] = {{0, 1, 0}, {1, 0, 0}, {0, 0, -1},
+                                  glm::normalize(glm::dvec3(1, 2, 3)),
+                                  glm::normalize(glm::dvec3(-0.3, -1, 0.2))};
+    for (const auto& n : normals) {
+        const auto w = computeIrradianceWeights(cones, n);
+        double sum = 0.0;
+        for (int k = 0; k < kConeCount; ++k) {
+            EXPECT_GE(w[std::size_t(k)], 0.0);
+            // A cone whose axis is below the surface gets no weight.
+            if (glm::dot(cones.directions[std::size_t(k)], n) <= 0.0) {
+                EXPECT_EQ(w[std::size_t(k)], 0.0);
+            }
+            sum += w[std::size_t(k)];
+        }
+        // E = pi L for a constant radiance L (the furnace).
+        EXPECT_NEAR(sum, glm::pi<double>(), 1e-12);
+    }
+    EXPECT_THROW(ConeSet::make(0.0), Error);
+    EXPECT_THROW(ConeSet::make(90.0), Error);
+}
+
+TEST(ConeTracing, SkyPerConeOfAConstantSkyIsThatConstant)
+{
+    scene::Sky sky;
+    sky.kind = scene::Sky::Kind::Constant;
+    sky.constant = {0.5f, 1.0f, 2.0f};
+    const auto perCone = computeSkyPerCone(sky, ConeSet::make(29.0));
+    for (const auto& l : perCone) {
+        EXPECT_NEAR(l.x, 0.5f, 1e-6f);
+        EXPECT_NEAR(l.z, 2.0f, 1e-6f);
+    }
+    // A gradient sky: a cone wholly above the horizon sees more than any cone lower down.
+    sky.kind = scene::Sky::Kind::Gradient;
+    sky.zenith = glm::vec3(1.0f);
+    sky.horizon = glm::vec3(0.2f);
+    sky.ground = glm::vec3(0.0f);
+    const ConeSet cones = ConeSet::make(29.0);
+    const auto g = computeSkyPerCone(sky, cones);
+    for (int k = 0; k < kConeCount; ++k)
+        for (int j = 0; j < kConeCount; ++j)
+            if (cones.directions[std::size_t(k)].y > 0.5 &&
+                cones.directions[std::size_t(k)].y > cones.directions[std::size_t(j)].y + 0.3) {
+                EXPECT_GT(g[std::size_t(k)].x, g[std::size_t(j)].x);
+            }
+}
+
+// A homogeneous medium of occupancy `alpha` per voxel of size 1, radiance 1 in field kDirect,
+// that ends at distance `extent`.
+struct UniformMedium {
+    float alpha = 0.2f;
+    double extent = 8.0;
+    bool sample(const glm::dvec3& p, double, int, const glm::dvec3&, ConeSample& out) const
+    {
+        if (glm::length(p) > extent)
+            return false;
+        out = ConeSample{};
+        out.alpha = alpha;
+        out.light[kDirect] = glm::vec3(alpha); // premultiplied radiance 1
+        out.voxelSize = 1.0;
+        return true;
+    }
+};
+
+TEST(ConeTracing, OpacityIsCorrectedForTheStepLength)
+{
+    // A ray (zero aperture) through 4 voxels of the medium: transmittance (1 - a)^4 whatever the
+    // step, and the radiance gathered is 1 - transmittance (radiance 1 everywhere).
+    const UniformMedium medium{0.2f, 1e9};
+    for (const double stepScale : {0.125, 0.25, 0.5, 1.0}) {
+        ConeMarchSettings s;
+        s.tanHalfAngle = 0.0;
+        s.stepScale = stepScale;
+        s.maxDistance = 4.0;
+        const ConeResult r = marchCone(medium, glm::dvec3(0.0), glm::dvec3(1, 0, 0), 0, s);
+        const double expected = std::pow(1.0 - double(medium.alpha), 4.0);
+        EXPECT_NEAR(r.transmittance, expected, 1e-12) << stepScale;
+        EXPECT_NEAR(r.light[kDirect].x, 1.0 - expected, 1e-6) << stepScale;
+        EXPECT_FALSE(r.escaped);
+    }
+}
+
+TEST(ConeTracing, AConeThatLeavesTheStructureEscapes)
+{
+    const UniformMedium medium{0.0f, 3.0};
+    ConeMarchSettings s;
+    s.tanHalfAngle = 0.5;
+    const ConeResult r = marchCone(medium, glm::dvec3(0.0), glm::dvec3(0, 1, 0), 0, s);
+    EXPECT_TRUE(r.escaped);
+    EXPECT_EQ(r.transmittance, 1.0);
+    // An opaque medium stops the cone at the opacity limit, before the end.
+    const UniformMedium opaque{1.0f, 1e9};
+    const ConeResult o = marchCone(opaque, glm::dvec3(0.0), glm::dvec3(0, 1, 0), 0, s);
+    EXPECT_FALSE(o.escaped);
+    EXPECT_LE(o.transmittance, 1.0 - s.maxOpacity);
+    EXPECT_TRUE(std::isfinite(o.light[kDirect].x));
+}
+
+} // namespace

@@ -1,0 +1,71 @@
+#pragma once
+// Small scenes for the voxel_gi tests: boxes (outward or inward facing), quads, rooms.
+
+#include "scene/render_scene.h"
+
+#include <glm/vec3.hpp>
+
+#include <cstdint>
+
+namespace rtlab::voxelgi::testing {
+
+//! Appends a material and returns its index.
+inline std::uint32_t addMaterial(scene::RenderScene& s, glm::vec3 albedo, glm::vec3 emission = {})
+{
+    s.materials.push_back({"m" + std::to_string(s.materials.size()), albedo, emission});
+    return std::uint32_t(s.materials.size() - 1);
+}
+
+//! Appends the axis-aligned box [lo, hi] as 12 triangles, normals outward (`inward` flips them).
+inline void addBox(scene::RenderScene& s, glm::vec3 lo, glm::vec3 hi, std::uint32_t material,
+                   bool inward = false)
+{
+    const glm::vec3 c[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {lo.x, hi.y, lo.z},
+                            {hi.x, hi.y, lo.z}, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z},
+                            {lo.x, hi.y, hi.z}, {hi.x, hi.y, hi.z}};
+    // Quads (counter-clockwise seen from outside) with their outward normals.
+    const int quads[6][4] = {{1, 3, 7, 5}, {0, 4, 6, 2}, {2, 6, 7, 3},
+                             {0, 1, 5, 4}, {4, 5, 7, 6}, {0, 2, 3, 1}};
+    const glm::vec3 normals[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    for (int q = 0; q < 6; ++q) {
+        const std::uint32_t base = std::uint32_t(s.positions.size());
+        for (int k = 0; k < 4; ++k) {
+            s.positions.push_back(c[quads[q][k]]);
+            s.normals.push_back(inward ? -normals[q] : normals[q]);
+        }
+        const std::uint32_t tri[2][3] = {{0, 1, 2}, {0, 2, 3}};
+        for (const auto& t : tri) {
+            if (inward) {
+                s.indices.insert(s.indices.end(), {base + t[0], base + t[2], base + t[1]});
+            } else {
+                s.indices.insert(s.indices.end(), {base + t[0], base + t[1], base + t[2]});
+            }
+            s.triangleMaterial.push_back(material);
+        }
+    }
+    s.updateBounds();
+}
+
+//! A horizontal quad at height y over [x0, x1] x [z0, z1], normal +y.
+inline void addFloor(scene::RenderScene& s, float y, float x0, float x1, float z0, float z1,
+                     std::uint32_t material)
+{
+    const std::uint32_t base = std::uint32_t(s.positions.size());
+    s.positions.insert(s.positions.end(), {{x0, y, z0}, {x0, y, z1}, {x1, y, z1}, {x1, y, z0}});
+    for (int k = 0; k < 4; ++k)
+        s.normals.push_back({0, 1, 0});
+    s.indices.insert(s.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+    s.triangleMaterial.insert(s.triangleMaterial.end(), {material, material});
+    s.updateBounds();
+}
+
+//! A closed room: the inside of [lo, hi] with walls `thickness` thick (solid: an outer box and
+//! an inner box facing inward).
+inline void addRoom(scene::RenderScene& s, glm::vec3 lo, glm::vec3 hi, float thickness,
+                    std::uint32_t material)
+{
+    addBox(s, lo - thickness, hi + thickness, material, false);
+    addBox(s, lo, hi, material, true);
+}
+
+} // namespace rtlab::voxelgi::testing

@@ -1,0 +1,533 @@
+#include "cascade_volume.h"
+
+#include "core/error.h"
+
+#include <glm/common.hpp>
+#include <glm/gtc/constants.hpp>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <string>
+
+namespace rtlab::voxelgi {
+
+namespace {
+
+// The face a cone travelling along +axis sees is the voxel's -axis face, and the other way.
+int getFaceSeen(int axis, double d)
+{
+    return 2 * axis + (d > 0.0 ? 1 : 0);
+}
+
+std::string formatShift(const glm::ivec3& s)
+{
+    return "(" + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
+}
+
+} // namespace
+
+CascadeVolume::CascadeVolume(CascadeSettings settings)
+    : mSettings(settings), mCones(ConeSet::make(settings.coneHalfAngleDegrees))
+{
+    if (mSettings.levels < 1 || mSettings.levels > 12)
+        throw Error("cascades: levels must be in [1, 12], found " + std::to_string(mSettings.levels));
+    if (mSettings.resolution < 4 || mSettings.resolution % 2 != 0)
+        throw Error("cascades: resolution must be even and at least 4, found " +
+                    std::to_string(mSettings.resolution));
+    if (!(mSettings.voxelSize > 0.0) || !std::isfinite(mSettings.voxelSize))
+        throw Error("cascades: voxel size must be positive and finite");
+    if (mSettings.bounces < 1 || mSettings.bounces > 3)
+        throw Error("cascades: bounces must be in [1, 3], found " + std::to_string(mSettings.bounces));
+    mLevels.resize(std::size_t(mSettings.levels));
+}
+
+VoxelRegion CascadeVolume::computeRegion(int level, const glm::dvec3& camera) const
+{
+    const double v = mSettings.voxelSize * std::ldexp(1.0, level);
+    const double snap = 2.0 * v;
+    VoxelRegion r;
+    r.voxelSize = v;
+    r.resolution = mSettings.resolution;
+    const glm::dvec3 centre = glm::floor(camera / snap + 0.5) * snap;
+    r.origin = centre - 0.5 * double(mSettings.resolution) * v;
+    return r;
+}
+
+std::vector<int> CascadeVolume::getDueLevels(int frame) const
+{
+    std::vector<int> due;
+    const int n = getLevelCount();
+    if (mFirstFrame < 0 || frame <= mFirstFrame || !mSettings.oneLevelPerFrame) {
+        for (int i = n - 1; i >= 0; --i)
+            due.push_back(i);
+        return due;
+    }
+    // Level i every 2^(i+1) frames, one level per frame ("Cascade Update").
+    const unsigned r = unsigned(frame - mFirstFrame);
+    due.push_back(std::min(n - 1, std::countr_zero(r)));
+    return due;
+}
+
+std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
+                                    const std::string& geometryKey, const glm::dvec3& camera,
+                                    int frame, bool force)
+{
+    if (mFirstFrame < 0)
+        mFirstFrame = frame;
+    mCounters.levelsVoxelized = 0;
+    std::string what;
+    for (const int i : getDueLevels(frame)) {
+        Level& level = mLevels[std::size_t(i)];
+        const VoxelRegion region = computeRegion(i, camera);
+        std::string why;
+        glm::ivec3 shift(0);
+        if (!level.voxelized)
+            why = "first voxelization";
+        else if (!(region == level.region)) {
+            shift = glm::ivec3(glm::round((region.origin - level.region.origin) / region.voxelSize));
+            why = "scrolled by " + formatShift(shift) + " voxels";
+        } else if (geometryKey != level.geometryKey)
+            why = "geometry changed";
+        else if (force)
+            why = "culling off";
+        else
+            continue;
+        const Level old = std::move(level);
+        level = Level{};
+        level.region = region;
+        level.centre = region.origin + 0.5 * double(region.resolution) * region.voxelSize;
+        level.grid = voxelizeTriangles(geometry, region,
+                                       {.supersampling = mSettings.supersampling,
+                                        .solid = mSettings.solid});
+        level.geometryKey = geometryKey;
+        level.voxelized = true;
+        level.voxelStamp = ++mStamp;
+        const std::size_t faces = region.getVoxelCount() * kFaceCount;
+        level.alpha.assign(faces, 0.0f);
+        for (auto& field : level.light)
+            field.assign(faces, glm::vec3(0.0f));
+        for (std::size_t f = 0; f < faces; ++f) {
+            level.alpha[f] = level.grid.faces[f].a;
+            level.light[kEmission][f] = level.alpha[f] * level.grid.emission[f];
+        }
+        // Light carried over (the one-pass update builds on it): the same voxels when only the
+        // geometry changed; shifted when the level scrolled, the missing edge taken from the
+        // next coarser level ("Scrolling: missing edge info taken from next cascade up").
+        if (old.voxelized) {
+            const int R = region.resolution;
+            const Level* coarser =
+                i + 1 < getLevelCount() && mLevels[std::size_t(i) + 1].voxelized
+                    ? &mLevels[std::size_t(i) + 1]
+                    : nullptr;
+            tbb::parallel_for(0, R, [&](int z) {
+                for (int y = 0; y < R; ++y)
+                    for (int x = 0; x < R; ++x) {
+                        const glm::ivec3 o = glm::ivec3(x, y, z) + shift;
+                        const std::size_t vox = region.index(x, y, z);
+                        const bool inside = o.x >= 0 && o.y >= 0 && o.z >= 0 && o.x < R &&
+                                            o.y < R && o.z < R;
+                        for (int face = 0; face < kFaceCount; ++face) {
+                            const std::size_t f = vox * kFaceCount + std::size_t(face);
+                            if (level.alpha[f] <= 0.0f)
+                                continue;
+                            for (int field = kDirect; field < kFieldCount; ++field) {
+                                glm::vec3 radiance(0.0f);
+                                if (inside) {
+                                    const std::size_t g =
+                                        old.region.index(o.x, o.y, o.z) * kFaceCount +
+                                        std::size_t(face);
+                                    if (old.alpha[g] > 0.0f)
+                                        radiance = old.light[std::size_t(field)][g] / old.alpha[g];
+                                } else if (coarser) {
+                                    const glm::dvec3 c = region.getVoxelCentre(x, y, z);
+                                    const VoxelRegion& cr = coarser->region;
+                                    const glm::ivec3 ci = glm::clamp(
+                                        glm::ivec3(glm::floor((c - cr.origin) / cr.voxelSize)),
+                                        glm::ivec3(0), glm::ivec3(cr.resolution - 1));
+                                    const std::size_t g =
+                                        cr.index(ci.x, ci.y, ci.z) * kFaceCount + std::size_t(face);
+                                    if (coarser->alpha[g] > 0.0f)
+                                        radiance =
+                                            coarser->light[std::size_t(field)][g] / coarser->alpha[g];
+                                }
+                                level.light[std::size_t(field)][f] = level.alpha[f] * radiance;
+                            }
+                        }
+                    }
+            });
+        }
+        // Solid voxels mirror the light of their nearest surface voxel (breadth-first through
+        // the solid; propagateInward). The talk propagates the surface attributes one layer in;
+        // light is carried through the whole solid so that a cone whose footprint reaches
+        // deeper into a wall sees the wall's surface light, not black.
+        {
+            const int R = region.resolution;
+            std::vector<std::uint32_t> source(region.getVoxelCount(), ~0u);
+            std::vector<std::uint32_t> queue;
+            for (const std::uint32_t v : level.grid.surfaceVoxels) {
+                source[v] = v;
+                queue.push_back(v);
+            }
+            for (std::size_t head = 0; head < queue.size(); ++head) {
+                const std::uint32_t v = queue[head];
+                const int x = int(v % std::uint32_t(R)), y = int((v / std::uint32_t(R)) % std::uint32_t(R)),
+                          z = int(v / (std::uint32_t(R) * std::uint32_t(R)));
+                for (int face = 0; face < kFaceCount; ++face) {
+                    glm::ivec3 c(x, y, z);
+                    c[face / 2] += (face % 2 == 0) ? 1 : -1;
+                    if (c[face / 2] < 0 || c[face / 2] >= R)
+                        continue;
+                    const std::size_t n = region.index(c.x, c.y, c.z);
+                    if (!(level.grid.flags[n] & kVoxelSolid) || source[n] != ~0u)
+                        continue;
+                    source[n] = source[v];
+                    queue.push_back(std::uint32_t(n));
+                    level.inward.emplace_back(std::uint32_t(n), source[v]);
+                }
+            }
+        }
+        propagateInward(level);
+        if (mSettings.precombine)
+            updateCombined(level);
+        ++mCounters.levelsVoxelized;
+        what += (what.empty() ? "" : "; ") + std::string("level ") + std::to_string(i) + ": " + why;
+    }
+    return what;
+}
+
+bool CascadeVolume::isStale(int i) const
+{
+    const Level& level = mLevels[std::size_t(i)];
+    if (!level.voxelized)
+        return false;
+    for (int j = i; j < getLevelCount(); ++j) {
+        const Level& other = mLevels[std::size_t(j)];
+        if (other.voxelStamp > level.litStamp)
+            return true;
+        if (j > i && other.lightStamp > level.litStamp)
+            return true;
+    }
+    // The one-pass update needs one update per bounce to carry light through its own buffers.
+    return mSettings.onePass && level.litCount < mSettings.bounces;
+}
+
+std::string CascadeVolume::injectLight(const scene::RenderScene& geometry,
+                                       const std::string& lightsKey, int frame, bool force)
+{
+    mCounters.levelsLit = 0;
+    mCounters.surfaceVoxelsLit = 0;
+    if (lightsKey != mLightsKey) {
+        mLightsKey = lightsKey;
+        for (Level& level : mLevels) {
+            level.litStamp = 0;
+            level.litCount = 0;
+        }
+    }
+    std::string what;
+    // Coarse levels first: a level's cones read its own and coarser levels.
+    for (const int i : getDueLevels(frame)) {
+        Level& level = mLevels[std::size_t(i)];
+        if (!level.voxelized)
+            continue;
+        const bool stale = isStale(i);
+        if (!stale && !force)
+            continue;
+        bool inputsChanged = level.litStamp == 0;
+        for (int j = i; j < getLevelCount() && !inputsChanged; ++j)
+            inputsChanged = mLevels[std::size_t(j)].voxelStamp > level.litStamp ||
+                            (j > i && mLevels[std::size_t(j)].lightStamp > level.litStamp);
+        lightLevel(i, geometry);
+        level.litCount = inputsChanged ? 1 : level.litCount + 1;
+        level.litStamp = ++mStamp;
+        level.lightStamp = level.litStamp;
+        ++mCounters.levelsLit;
+        mCounters.surfaceVoxelsLit += level.grid.surfaceVoxels.size();
+        what += (what.empty() ? "" : "; ") + std::string("level ") + std::to_string(i) +
+                (stale ? "" : " (culling off)");
+    }
+    return what;
+}
+
+void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry)
+{
+    Level& level = mLevels[std::size_t(i)];
+    struct FieldSampler {
+        const CascadeVolume* volume;
+        bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
+                    ConeSample& out) const
+        {
+            return volume->sampleFields(p, d, cone, dir, out);
+        }
+    } sampler{this};
+    InjectionLights lights;
+    lights.pointLights = &geometry.pointLights;
+    lights.hasSky = geometry.sky.emits();
+    if (lights.hasSky)
+        lights.skyPerCone = computeSkyPerCone(geometry.sky, mCones);
+    InjectionSettings settings;
+    settings.startOffset = mSettings.startOffset;
+    settings.march.stepScale = mSettings.stepScale;
+
+    const auto& surface = level.grid.surfaceVoxels;
+    const int R = level.region.resolution;
+    // The passes of one update: the three-pass schedule traces direct, then the first bounce
+    // from the new direct buffer, then the second; the one-pass schedule traces once and writes
+    // every buffer from the previous ones ("One Pass Strategy").
+    const int passes = mSettings.onePass ? 1 : mSettings.bounces;
+    for (int pass = 0; pass < passes; ++pass) {
+        std::array<std::vector<glm::vec3>, kFieldCount> next = level.light;
+        tbb::parallel_for(std::size_t(0), surface.size(), [&](std::size_t s) {
+            const std::uint32_t vox = surface[s];
+            const int x = int(vox % std::uint32_t(R));
+            const int y = int((vox / std::uint32_t(R)) % std::uint32_t(R));
+            const int z = int(vox / (std::uint32_t(R) * std::uint32_t(R)));
+            InjectionVoxel v;
+            v.centre = level.region.getVoxelCentre(x, y, z);
+            v.normal = level.grid.normal[vox];
+            v.voxelSize = level.region.voxelSize;
+            v.faces = &level.grid.faces[std::size_t(vox) * kFaceCount];
+            const FaceIrradiance e = gatherVoxelIrradiance(sampler, v, mCones, lights, settings);
+            for (int face = 0; face < kFaceCount; ++face) {
+                const std::size_t f = std::size_t(vox) * kFaceCount + std::size_t(face);
+                const glm::vec4& g = level.grid.faces[f];
+                const glm::vec3 reflect = glm::vec3(g) * (g.a / glm::pi<float>());
+                for (int field = kDirect; field < kDirect + mSettings.bounces; ++field) {
+                    const bool written = mSettings.onePass || field == kDirect + pass;
+                    if (written)
+                        next[std::size_t(field)][f] = reflect * e.e[std::size_t(field)][std::size_t(face)];
+                }
+            }
+        });
+        level.light = std::move(next);
+        propagateInward(level);
+    }
+    if (mSettings.precombine)
+        updateCombined(level);
+}
+
+void CascadeVolume::propagateInward(Level& level)
+{
+    for (const auto& [solid, surface] : level.inward) {
+        const std::size_t base = std::size_t(surface) * kFaceCount;
+        // The surface voxel's radiance per face; a face it does not cover takes its mean.
+        std::array<glm::vec3, kFieldCount> mean{};
+        float covered = 0.0f;
+        for (int face = 0; face < kFaceCount; ++face)
+            if (const float a = level.alpha[base + std::size_t(face)]; a > 0.0f) {
+                for (int field = 0; field < kFieldCount; ++field)
+                    mean[std::size_t(field)] += level.light[std::size_t(field)][base + std::size_t(face)] / a;
+                covered += 1.0f;
+            }
+        for (int face = 0; face < kFaceCount; ++face) {
+            const std::size_t g = base + std::size_t(face);
+            const std::size_t f = std::size_t(solid) * kFaceCount + std::size_t(face);
+            const float a = level.alpha[g];
+            for (int field = 0; field < kFieldCount; ++field)
+                level.light[std::size_t(field)][f] =
+                    a > 0.0f ? level.light[std::size_t(field)][g] / a
+                             : (covered > 0.0f ? mean[std::size_t(field)] / covered : glm::vec3(0.0f));
+        }
+    }
+}
+
+void CascadeVolume::updateCombined(Level& level)
+{
+    const std::size_t voxels = level.region.getVoxelCount();
+    level.combined.assign(voxels * kConeCount, glm::vec4(0.0f));
+    const int gathered = mSettings.bounces;
+    tbb::parallel_for(std::size_t(0), voxels, [&](std::size_t vox) {
+        for (int k = 0; k < kConeCount; ++k) {
+            const glm::dvec3& d = mCones.directions[std::size_t(k)];
+            glm::vec4 c(0.0f);
+            for (int axis = 0; axis < 3; ++axis) {
+                const float w = float(d[axis] * d[axis]);
+                const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, d[axis]));
+                glm::vec3 light(0.0f);
+                for (int field = kDirect; field < kDirect + gathered; ++field)
+                    light += level.light[std::size_t(field)][f];
+                c += w * glm::vec4(light, level.alpha[f]);
+            }
+            level.combined[vox * kConeCount + std::size_t(k)] = c;
+        }
+    });
+}
+
+double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter) const
+{
+    const int n = getLevelCount();
+    double containing = -1.0;
+    for (int i = 0; i < n; ++i) {
+        const Level& level = mLevels[std::size_t(i)];
+        if (!level.voxelized)
+            continue;
+        // A sphere inside the level, one voxel in from its faces (trilinear footprint).
+        const double radius = (0.5 * level.region.resolution - 1.0) * level.region.voxelSize;
+        const double r = glm::length(p - level.centre) / radius;
+        if (r <= 1.0) {
+            // From half the radius on, blend toward the next level ("Cascade selection").
+            containing = i + (i + 1 < n ? std::clamp((r - 0.5) / 0.5, 0.0, 1.0) : 0.0);
+            break;
+        }
+    }
+    if (containing < 0.0)
+        return -1.0;
+    const double footprint =
+        diameter > mSettings.voxelSize ? std::log2(diameter / mSettings.voxelSize) : 0.0;
+    return std::min(double(n - 1), std::max(containing, footprint));
+}
+
+void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int cone,
+                                const glm::dvec3& dir, bool gathered, float weight,
+                                ConeSample& out) const
+{
+    const VoxelRegion& r = level.region;
+    const int R = r.resolution;
+    glm::dvec3 c = (p - r.origin) / r.voxelSize - 0.5;
+    glm::ivec3 i0;
+    glm::dvec3 t;
+    for (int a = 0; a < 3; ++a) {
+        c[a] = std::clamp(c[a], 0.0, double(R - 1));
+        i0[a] = std::min(int(std::floor(c[a])), R - 2);
+        t[a] = c[a] - i0[a];
+    }
+    const bool combined = gathered && cone >= 0 && !level.combined.empty();
+    for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = (corner >> 2) & 1;
+        const double w = (dx ? t.x : 1.0 - t.x) * (dy ? t.y : 1.0 - t.y) * (dz ? t.z : 1.0 - t.z);
+        if (w == 0.0)
+            continue;
+        const float fw = float(w) * weight;
+        const std::size_t vox = r.index(i0.x + dx, i0.y + dy, i0.z + dz);
+        if (combined) {
+            const glm::vec4& v = level.combined[vox * kConeCount + std::size_t(cone)];
+            out.alpha += fw * v.a;
+            out.light[kDirect] += fw * glm::vec3(v);
+            continue;
+        }
+        for (int axis = 0; axis < 3; ++axis) {
+            const float aw = fw * float(dir[axis] * dir[axis]);
+            if (aw == 0.0f)
+                continue;
+            const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
+            out.alpha += aw * level.alpha[f];
+            if (gathered) {
+                for (int field = kDirect; field < kDirect + mSettings.bounces; ++field)
+                    out.light[kDirect] += aw * level.light[std::size_t(field)][f];
+            } else {
+                for (int field = 0; field < kFieldCount; ++field)
+                    out.light[std::size_t(field)] += aw * level.light[std::size_t(field)][f];
+            }
+        }
+    }
+}
+
+template <bool Gathered>
+bool CascadeVolume::sampleAt(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
+                             ConeSample& out) const
+{
+    const double l = selectLevel(p, diameter);
+    if (l < 0.0)
+        return false;
+    out = ConeSample{};
+    const int l0 = int(std::floor(l));
+    const float frac = float(l - l0);
+    sampleLevel(mLevels[std::size_t(l0)], p, cone, dir, Gathered, 1.0f - frac, out);
+    if (frac > 0.0f && l0 + 1 < getLevelCount())
+        sampleLevel(mLevels[std::size_t(l0) + 1], p, cone, dir, Gathered, frac, out);
+    out.voxelSize = mSettings.voxelSize * std::exp2(l);
+    return true;
+}
+
+bool CascadeVolume::sampleFields(const glm::dvec3& p, double diameter, int cone,
+                                 const glm::dvec3& dir, ConeSample& out) const
+{
+    return sampleAt<false>(p, diameter, cone, dir, out);
+}
+
+bool CascadeVolume::sampleGathered(const glm::dvec3& p, double diameter, int cone,
+                                   const glm::dvec3& dir, ConeSample& out) const
+{
+    return sampleAt<true>(p, diameter, cone, dir, out);
+}
+
+void CascadeVolume::gather(const scene::GBuffer& gbuffer,
+                           const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out)
+{
+    out = Image<glm::vec3>(gbuffer.width, gbuffer.height, glm::vec3(0.0f));
+    struct GatherSampler {
+        const CascadeVolume* volume;
+        bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
+                    ConeSample& o) const
+        {
+            return volume->sampleGathered(p, d, cone, dir, o);
+        }
+    } sampler{this};
+    const bool useVisibility =
+        coneVisibility != nullptr && coneVisibility->size() == std::size_t(kConeCount);
+    std::vector<std::uint64_t> stepsPerRow(std::size_t(gbuffer.height), 0);
+    std::vector<std::uint64_t> conesPerRow(std::size_t(gbuffer.height), 0);
+    tbb::parallel_for(0, gbuffer.height, [&](int y) {
+        for (int x = 0; x < gbuffer.width; ++x) {
+            if (!gbuffer.hasSurface(x, y))
+                continue;
+            const glm::dvec3 p(gbuffer.position.at(x, y));
+            const glm::dvec3 n(gbuffer.normal.at(x, y));
+            if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
+                continue;
+            const double start = selectLevel(p, 0.0);
+            if (start < 0.0)
+                continue; // outside every level: no indirect light
+            const double v = mSettings.voxelSize * std::exp2(std::floor(start));
+            ConeMarchSettings march;
+            march.tanHalfAngle = mCones.tanHalfAngle;
+            march.stepScale = mSettings.stepScale;
+            march.startDistance = mSettings.startOffset * v;
+            const glm::dvec3 origin = p + n * (0.5 * mSettings.startOffset * v);
+            const auto w = computeIrradianceWeights(mCones, n);
+            glm::vec3 e(0.0f);
+            for (int k = 0; k < kConeCount; ++k) {
+                if (w[std::size_t(k)] == 0.0)
+                    continue;
+                const ConeResult r =
+                    marchCone(sampler, origin, mCones.directions[std::size_t(k)], k, march);
+                stepsPerRow[std::size_t(y)] += std::uint64_t(r.steps);
+                ++conesPerRow[std::size_t(y)];
+                float visible = 1.0f;
+                if (useVisibility)
+                    visible = std::clamp((*coneVisibility)[std::size_t(k)].at(x, y), 0.0f, 1.0f);
+                e += float(w[std::size_t(k)]) * visible * r.light[kDirect];
+            }
+            out.at(x, y) = glm::max(e, glm::vec3(0.0f));
+        }
+    });
+    std::uint64_t steps = 0, cones = 0;
+    for (std::size_t i = 0; i < stepsPerRow.size(); ++i) {
+        steps += stepsPerRow[i];
+        cones += conesPerRow[i];
+    }
+    mCounters.meanStepsPerCone = cones ? double(steps) / double(cones) : 0.0;
+}
+
+std::size_t CascadeVolume::getPayloadBytes() const
+{
+    std::size_t bytes = 0;
+    for (const Level& l : mLevels) {
+        bytes += l.grid.faces.size() * sizeof(glm::vec4) + l.grid.emission.size() * sizeof(glm::vec3) +
+                 l.grid.normal.size() * sizeof(glm::vec3) + l.grid.flags.size();
+        bytes += l.alpha.size() * sizeof(float);
+        for (const auto& f : l.light)
+            bytes += f.size() * sizeof(glm::vec3);
+        bytes += l.combined.size() * sizeof(glm::vec4);
+    }
+    return bytes;
+}
+
+std::size_t CascadeVolume::getTopologyBytes() const
+{
+    // A dense cascade has no topology beyond each level's placement.
+    return mLevels.size() * sizeof(VoxelRegion);
+}
+
+} // namespace rtlab::voxelgi

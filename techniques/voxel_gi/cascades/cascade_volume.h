@@ -1,0 +1,127 @@
+#pragma once
+// The voxel texture cascade of the Tomorrow Children (shared/seeds/000_3da000e866ebc485.txt,
+// "Voxel Texture Cascade", "Data Layout", "Cascade Update", "Cascade selection"): N levels of R^3
+// anisotropic voxels centred on the camera, each doubling the extent of the one inside it.
+// Per level the volumetric G-buffer (voxelize.h) and the light buffers per face (direct, first
+// and second bounce, cone_tracing.h's fields); optionally the pre-combined direction buffers
+// (per voxel and per cone direction the occupancy and the light a pixel gathers, the three faces
+// blended once instead of at every step of every cone: "Pre-Combine Anisotropic Voxels").
+//
+// Level selection at a point p for a footprint d: the coarsest of log2(d / v0) and the level
+// whose region holds p, blended smoothly (the talk's concentric spheres: from half of a level's
+// radius the start level moves toward the next one), with the two nearest levels interpolated.
+
+#include "core/image.h"
+#include "families/voxel_gi/cone_tracing.h"
+#include "scene/gbuffer.h"
+#include "families/voxel_gi/voxelize.h"
+
+#include <glm/vec4.hpp>
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace rtlab::voxelgi {
+
+struct CascadeSettings {
+    int levels = 6;
+    int resolution = 32;   //!< even
+    double voxelSize = 0.0; //!< level 0, world units (> 0)
+    int supersampling = 4;
+    bool solid = true;
+    int bounces = 2;                    //!< 1..3 reflections gathered at the pixel
+    bool onePass = false;               //!< the talk's staggered one-pass update
+    bool oneLevelPerFrame = true;       //!< level i every 2^(i+1) frames
+    double coneHalfAngleDegrees = 29.0;
+    double startOffset = 1.0; //!< voxels
+    double stepScale = 0.5;
+    bool precombine = true;
+};
+
+class CascadeVolume {
+public:
+    struct Level {
+        VoxelRegion region;
+        VoxelGrid grid;
+        std::vector<float> alpha;                                //!< [voxel * 6 + face]
+        std::array<std::vector<glm::vec3>, kFieldCount> light;   //!< [voxel * 6 + face], premultiplied
+        std::vector<glm::vec4> combined; //!< [voxel * 16 + cone]: alpha, premultiplied gathered light
+        std::string geometryKey;         //!< of the voxelized geometry
+        bool voxelized = false;
+        std::uint64_t voxelStamp = 0; //!< when it was last voxelized (CascadeVolume's counter)
+        std::uint64_t lightStamp = 0; //!< when its light buffers last changed
+        std::uint64_t litStamp = 0;   //!< what it was lit against: every stamp up to this one
+        int litCount = 0;             //!< one-pass updates since its inputs last changed
+        glm::dvec3 centre{0.0};
+        //! Solid voxels and the nearest surface voxel, whose light they mirror.
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> inward;
+    };
+
+    explicit CascadeVolume(CascadeSettings settings);
+
+    const CascadeSettings& getSettings() const { return mSettings; }
+    const ConeSet& getCones() const { return mCones; }
+    int getLevelCount() const { return int(mLevels.size()); }
+    const Level& getLevel(int i) const { return mLevels[std::size_t(i)]; }
+
+    //! Region of level `i` for a camera at `camera` (snapped to 2 voxels of the level, so that
+    //! the levels stay nested on voxel boundaries).
+    VoxelRegion computeRegion(int level, const glm::dvec3& camera) const;
+    //! Levels due at `frame` (every level on the first update or with oneLevelPerFrame off).
+    std::vector<int> getDueLevels(int frame) const;
+
+    //! Re-voxelizes the due levels whose region or geometry changed (all when `force`). Returns
+    //! a description of what it did ("" when nothing).
+    std::string voxelize(const scene::RenderScene& geometry, const std::string& geometryKey,
+                         const glm::dvec3& camera, int frame, bool force);
+    //! Updates the light buffers of the due levels that are stale. `lightsKey` changes with the
+    //! lights and sky. Returns what it did ("" when nothing).
+    std::string injectLight(const scene::RenderScene& geometry, const std::string& lightsKey,
+                            int frame, bool force);
+    //! Indirect irradiance at every pixel of `gbuffer` (cones weighted by `coneVisibility` when
+    //! given: 16 images of the pixel's visibility per direction).
+    void gather(const scene::GBuffer& gbuffer, const std::vector<Image<float>>* coneVisibility,
+                Image<glm::vec3>& out);
+
+    //! Sampler of the light fields (injection) and of the gathered light (pixels): see
+    //! cone_tracing.h.
+    bool sampleFields(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
+                      ConeSample& out) const;
+    bool sampleGathered(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
+                        ConeSample& out) const;
+
+    std::size_t getPayloadBytes() const;
+    std::size_t getTopologyBytes() const;
+    //! Counts of the last calls, for the row.
+    struct Counters {
+        int levelsVoxelized = 0;
+        int levelsLit = 0;
+        std::size_t surfaceVoxelsLit = 0;
+        double meanStepsPerCone = 0.0;
+    };
+    const Counters& getCounters() const { return mCounters; }
+
+private:
+    // The level to sample at p for footprint d, continuous; < 0 when p is outside every level.
+    double selectLevel(const glm::dvec3& p, double diameter) const;
+    template <bool Gathered>
+    bool sampleAt(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
+                  ConeSample& out) const;
+    void sampleLevel(const Level& level, const glm::dvec3& p, int cone, const glm::dvec3& dir,
+                     bool gathered, float weight, ConeSample& out) const;
+    void lightLevel(int level, const scene::RenderScene& geometry);
+    void propagateInward(Level& level);
+    void updateCombined(Level& level);
+
+    CascadeSettings mSettings;
+    ConeSet mCones;
+    std::vector<Level> mLevels;
+    bool isStale(int level) const;
+    std::uint64_t mStamp = 0;
+    std::string mLightsKey;
+    int mFirstFrame = -1;
+    Counters mCounters;
+};
+
+} // namespace rtlab::voxelgi
