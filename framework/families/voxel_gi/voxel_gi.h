@@ -56,6 +56,8 @@ struct VoxelGiStep {
 
 struct VoxelGiInput {
     const scene::GBuffer* gbuffer = nullptr; //!< world positions and normals of the pixels
+    //! The frame's full triangle scene (characters included): ray-traced baselines only.
+    const scene::RenderScene* scene = nullptr;
     glm::dvec3 cameraPosition{0.0};
     //! The occlusion family's 16 per-direction visibilities (bentcone_ssdo), or null.
     const std::vector<Image<float>>* coneVisibility = nullptr;

@@ -174,21 +174,23 @@ private:
         // The per-direction visibilities of an occlusion technique listed before this family.
         const auto cones = pipeline::Compose::coneVisibilitySlot(w, h);
         std::vector<pipeline::ResourceRef> gatherOptional;
-        if (graph.declares(cones.name))
+        const bool hasCones = graph.declares(cones.name);
+        if (hasCones)
             gatherOptional.push_back(cones);
         graph.addPass(
             {.name = "voxel_gather",
-             .reads = {voxelLight, gbuffer},
+             .reads = {voxelLight, gbuffer, geometry},
              .optionalReads = gatherOptional,
              .writes = {indirect}},
-            [this, gbuffer, cones, indirect](pipeline::PassContext& ctx) {
+            [this, gbuffer, geometry, cones, hasCones, indirect](pipeline::PassContext& ctx) {
                 const scene::GBuffer& g = ctx.read(gbuffer);
                 plugin::VoxelGiInput input;
                 input.gbuffer = &g;
+                input.scene = &ctx.read(geometry);
                 input.cameraPosition = glm::dvec3(g.camera.position);
                 input.frameIndex = ctx.frame();
                 input.gpu = &mContext.getGpu();
-                const auto* visibility = ctx.tryRead(cones);
+                const auto* visibility = hasCones ? ctx.tryRead(cones) : nullptr;
                 input.coneVisibility =
                     visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
                         ? visibility

@@ -47,10 +47,10 @@
 // | update         | enum  | one_level_per_frame | one_level_per_frame, all_levels     |        |
 // | cone_angle     | float | 29                | [5, 60]                               | degrees (half-angle) |
 // | start_offset   | float | 1                 | [0, 4]                                | voxels |
-// | step_scale     | float | 0.5               | [0.1, 2]                              | of the footprint |
+// | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
 // | precombine     | bool  | true              |                                       |        |
 // | solid          | bool  | true              |                                       |        |
-// voxel_size 0 makes the outermost level span twice the scene's bounding-box diagonal.
+// voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
 // 2 bounces in the voxels plus the pixel's gather (bounces: 3 here).
 //
@@ -66,6 +66,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <optional>
@@ -105,7 +106,7 @@ public:
         schema.addInt("levels", 6, 1, 10, "", "cascade levels, each doubling the extent");
         schema.addInt("resolution", 32, 4, 128, "voxels", "voxels per level and axis (even)");
         schema.addFloat("voxel_size", 0.0, 0.0, 1e6, "world units",
-                        "level-0 voxel size; 0 = the outermost level spans twice the scene diagonal");
+                        "level-0 voxel size; 0 = the outermost level holds the whole scene");
         schema.addInt("supersampling", 4, 1, 16, "rays per voxel side",
                       "voxelization rays per voxel column and axis, per side (coverage)");
         schema.addInt("bounces", 2, 1, 3, "", "reflections gathered at the pixel");
@@ -117,7 +118,7 @@ public:
         schema.addFloat("cone_angle", 29.0, 5.0, 60.0, "degrees", "cone half-angle");
         schema.addFloat("start_offset", 1.0, 0.0, 4.0, "voxels",
                         "cone start distance and origin offset along the normal");
-        schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / footprint diameter");
+        schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
         schema.addBool("precombine", true,
                        "pre-combined direction buffers for the pixel cones (3x fewer lookups)");
         schema.addBool("solid", true, "solid voxelization (fill closed spans)");
@@ -169,10 +170,18 @@ public:
         if (!mVolume) {
             voxelgi::CascadeSettings s = mSettings;
             if (s.voxelSize <= 0.0) {
-                const glm::dvec3 extent = glm::dvec3(frame.geometry->boundsMax - frame.geometry->boundsMin);
-                const double diagonal = glm::length(extent);
-                s.voxelSize = 2.0 * (diagonal > 0.0 ? diagonal : 1.0) /
-                              (double(s.resolution) * std::ldexp(1.0, s.levels - 1));
+                // The outermost level holds every corner of the scene's bounds seen from the
+                // first frame's camera (inside the sphere the level selection uses).
+                const glm::dvec3 lo(frame.geometry->boundsMin), hi(frame.geometry->boundsMax);
+                double farthest = 0.0;
+                for (int c = 0; c < 8; ++c)
+                    farthest = std::max(
+                        farthest, glm::length(glm::dvec3(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y,
+                                                         c & 4 ? hi.z : lo.z) -
+                                              frame.cameraPosition));
+                if (!(farthest > 0.0) || !std::isfinite(farthest))
+                    farthest = 1.0;
+                s.voxelSize = farthest / (0.5 * s.resolution - 2.0) / std::ldexp(1.0, s.levels - 1);
             }
             mVolume.emplace(s);
         }
