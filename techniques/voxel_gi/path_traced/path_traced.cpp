@@ -77,6 +77,12 @@ public:
     {
         if (input.scene == nullptr)
             throw Error("path_traced needs the frame's triangle scene (VoxelGiInput::scene)");
+        if (input.scene->indices.empty()) {
+            // Nothing to reflect light: no indirect light anywhere.
+            irradiance = Image<glm::vec3>(input.gbuffer->width, input.gbuffer->height,
+                                          glm::vec3(0.0f));
+            return;
+        }
         reference::ReferenceSettings s;
         s.quantity = reference::Quantity::Indirect;
         s.bounces = mBounces;
