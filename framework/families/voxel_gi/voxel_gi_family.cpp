@@ -11,10 +11,11 @@
 //                    per-direction visibilities when an occlusion technique listed before it
 //                    gives them)
 //   indirect_slot    into the lit frame's `indirect_irradiance` slot (pipeline/compose.h)
-//   reference        Embree "indirect" with the technique's bounce count, same G-buffer
-//   metric.error     indirect.* RMSE, relMSE, PSNR, mean signed error over surface pixels;
-//   metric.flip      HDR-FLIP of the indirect irradiance
-//   images           technique, reference and signed error as EXR
+//   reference_indirect      Embree "indirect" with the technique's bounce count, same G-buffer
+//   metric.indirect_error   indirect.* RMSE, relMSE, PSNR, mean signed error over surface pixels
+//   metric.indirect_flip    HDR-FLIP of the indirect irradiance
+//   images_indirect         technique, reference and signed error as EXR
+// (names of their own, so that the family runs beside the occlusion family in one frame)
 
 #include "families/voxel_gi/voxel_gi.h"
 
@@ -212,7 +213,7 @@ private:
                           return pipeline::PassOutcome{};
                       });
         graph.addPass(
-            {.name = "reference",
+            {.name = "reference_indirect",
              .reads = {geometry, gbuffer, view},
              .writes = {truth},
              .measurement = true},
@@ -229,9 +230,9 @@ private:
                            : pipeline::PassOutcome{};
             });
         auto metricPass = [&](const std::string& name, std::function<void(pipeline::PassContext&)> f) {
-            graph.addPass({.name = "metric." + name,
+            graph.addPass({.name = "metric.indirect_" + name,
                            .reads = {indirect, truth, view},
-                           .writes = {"metric." + name},
+                           .writes = {"metric.indirect_" + name},
                            .measurement = true},
                           [f](pipeline::PassContext& ctx) {
                               f(ctx);
@@ -261,9 +262,9 @@ private:
                                                   ctx.read(view).surface)
                           .flip);
         });
-        graph.addPass({.name = "images",
+        graph.addPass({.name = "images_indirect",
                        .reads = {indirect, truth, view},
-                       .writes = {"images"},
+                       .writes = {"images_indirect"},
                        .measurement = true},
                       [=, this](pipeline::PassContext& ctx) {
                           const std::string dir =
@@ -279,15 +280,15 @@ private:
                           experiment::writeExr(a, dir + "/indirect.exr");
                           experiment::writeExr(t, dir + "/indirect_reference.exr");
                           experiment::writeExr(error, dir + "/indirect_error.exr");
-                          mRow->set("image.technique", dir + "/indirect.exr")
-                              .set("image.reference", dir + "/indirect_reference.exr")
-                              .set("image.error", dir + "/indirect_error.exr");
+                          mRow->set("image.indirect", dir + "/indirect.exr")
+                              .set("image.indirect_reference", dir + "/indirect_reference.exr")
+                              .set("image.indirect_error", dir + "/indirect_error.exr");
                           return pipeline::PassOutcome{};
                       });
-        setup.outputs.push_back("images");
+        setup.outputs.push_back("images_indirect");
         for (const auto& m : setup.family.metrics)
             if (mRun.wantsMetric(m.name))
-                setup.outputs.push_back("metric." + m.name);
+                setup.outputs.push_back("metric.indirect_" + m.name);
     }
 
     const experiment::RunConfig& mRun;

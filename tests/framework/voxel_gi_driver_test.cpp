@@ -1,0 +1,87 @@
+// The voxel_gi family in the game frame, end to end on lavapipe: bent-cone SSDO and cascades in
+// one run; the cascades fill the lit frame's indirect slot and read SSDO's 16 visibilities; the
+// indirect light is measured against the Embree `indirect` ground truth; the structure's steps
+// are skipped with their reasons when nothing changed; culling off gives the same frame bits.
+
+#include "experiment/analysis.h"
+#include "experiment/image_files.h"
+#include "experiment/runner.h"
+#include "plugin/technique.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+using namespace rtlab;
+
+namespace {
+
+std::vector<experiment::Row> runGameFrame(const std::string& culling, const std::filesystem::path& dir)
+{
+    const auto& registry = plugin::builtinRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: cornell_box
+  resolution: [40, 30]
+  frames: 2
+  camera_path: static
+  metrics: [error]
+  frame: {lighting: true, shadow_map_size: 16, culling: )" + culling + R"(}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 8}
+  techniques:
+    occlusion: {technique: bentcone_ssdo}
+    voxel_gi: {technique: cascades, params: {levels: 3, resolution: 16, supersampling: 2}}
+)",
+                                               (dir / ("gi_" + culling + ".yaml")).string(),
+                                               registry);
+    experiment::runExperiment(e, registry,
+                              {.outputDirectory = (dir / ("out_" + culling)).string(),
+                               .quiet = true,
+                               .queryVulkanForManifest = false});
+    return experiment::loadResults((dir / ("out_" + culling)).string());
+}
+
+TEST(VoxelGiDriver, CascadesFillTheIndirectSlotOfTheLitFrame)
+{
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_voxel_gi_driver";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const auto culled = runGameFrame("true", dir);
+    const auto all = runGameFrame("false", dir);
+    ASSERT_EQ(culled.size(), 2u) << (culled.empty() ? "" : culled[0].at("error"));
+    ASSERT_EQ(all.size(), 2u) << (all.empty() ? "" : all[0].at("error"));
+    for (std::size_t i = 0; i < 2; ++i) {
+        ASSERT_EQ(culled[i].at("status"), "ok") << culled[i].at("error");
+        ASSERT_EQ(all[i].at("status"), "ok") << all[i].at("error");
+        const auto& row = culled[i];
+        EXPECT_EQ(row.at("frame.indirect"), "indirect_irradiance");
+        EXPECT_EQ(row.at("gather.cone_visibility"), "true");
+        EXPECT_EQ(row.at("reference.bounces"), "2");
+        const double rmse = experiment::getNumber(row, "indirect.rmse");
+        EXPECT_TRUE(std::isfinite(rmse) && rmse >= 0.0) << rmse;
+        EXPECT_GT(experiment::getNumber(row, "memory.payload_bytes"), 0.0);
+        const std::string& passes = row.at("passes");
+        EXPECT_NE(passes.find("voxel_gather:run"), std::string::npos) << passes;
+        EXPECT_NE(passes.find("indirect_slot:run"), std::string::npos) << passes;
+        // Frame 1: a still camera and no edit, so the structure has nothing to update.
+        if (i == 0) {
+            EXPECT_NE(passes.find("voxelize:run"), std::string::npos) << passes;
+            EXPECT_NE(passes.find("light_injection:run"), std::string::npos) << passes;
+        } else {
+            EXPECT_NE(passes.find("voxelize:skipped"), std::string::npos) << passes;
+            EXPECT_NE(passes.find("light_injection:skipped"), std::string::npos) << passes;
+            EXPECT_NE(all[i].at("passes").find("voxelize:run"), std::string::npos)
+                << all[i].at("passes");
+        }
+        const Image<glm::vec3> a = experiment::readExrRgb(culled[i].at("image.lit_hdr"));
+        const Image<glm::vec3> b = experiment::readExrRgb(all[i].at("image.lit_hdr"));
+        ASSERT_EQ(a.pixels.size(), b.pixels.size());
+        EXPECT_EQ(
+            std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
+            << "lit frame " << i;
+    }
+}
+
+} // namespace
