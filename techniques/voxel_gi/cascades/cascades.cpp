@@ -31,7 +31,9 @@
 //    level centres; optional pre-combined direction buffers; the per-direction visibilities of
 //    bentcone_ssdo multiply the cones when that occlusion technique runs in the same frame.
 //
-// Not yet: voxelization and cone tracing on Vulkan (this is the CPU path), scrolling that
+// The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; the
+// voxelization and light injection run in C++ (TBB).
+// Not yet: voxelization and light injection on Vulkan, scrolling that
 // voxelizes only the new slab, re-voxelizing only the dug region, quarter-resolution tracing,
 // split near/far cones, character capsules, the extrapolated third bounce, the 3D noise offset.
 //
@@ -50,6 +52,7 @@
 // | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
 // | precombine     | bool  | true              |                                       |        |
 // | solid          | bool  | true              |                                       |        |
+// | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
 // 2 bounces in the voxels plus the pixel's gather (bounces: 3 here).
@@ -58,6 +61,7 @@
 //   techniques:
 //     voxel_gi: {technique: cascades, params: {levels: 6, resolution: 32, schedule: one_pass}}
 
+#include "cascade_gather_gpu.h"
 #include "cascade_volume.h"
 
 #include "core/error.h"
@@ -122,6 +126,9 @@ public:
         schema.addBool("precombine", true,
                        "pre-combined direction buffers for the pixel cones (3x fewer lookups)");
         schema.addBool("solid", true, "solid voxelization (fill closed spans)");
+        schema.addEnum("device", "vulkan", {"vulkan", "cpu"},
+                       "where the pixel gather runs (Vulkan needs precombine; the voxel "
+                       "update runs on the CPU)");
         return schema;
     }
 
@@ -143,6 +150,7 @@ public:
         mSettings.stepScale = p.getFloat("step_scale");
         mSettings.precombine = p.getBool("precombine");
         mSettings.solid = p.getBool("solid");
+        mOnGpu = p.getString("device") == "vulkan";
     }
 
     config::ParamSet effectiveParams() const override
@@ -160,6 +168,7 @@ public:
         p.set("step_scale", mSettings.stepScale);
         p.set("precombine", mSettings.precombine);
         p.set("solid", mSettings.solid);
+        p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
         return p;
     }
 
@@ -205,7 +214,12 @@ public:
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
-        mVolume->gather(*input.gbuffer, input.coneVisibility, irradiance);
+        // The Vulkan gather reads the pre-combined buffers; without them the C++ path runs.
+        mGatheredOnGpu = mOnGpu && mSettings.precombine && input.gpu != nullptr;
+        if (mGatheredOnGpu)
+            mGpu.gather(*input.gpu, *mVolume, *input.gbuffer, input.coneVisibility, irradiance);
+        else
+            mVolume->gather(*input.gbuffer, input.coneVisibility, irradiance);
     }
 
     plugin::VoxelGiMemory memory() const override
@@ -228,13 +242,20 @@ public:
                 {"levels_voxelized", double(c.levelsVoxelized)},
                 {"levels_lit", double(c.levelsLit)},
                 {"surface_voxels", double(surface)},
-                {"steps_per_cone", c.meanStepsPerCone}};
+                {"steps_per_cone", mGatheredOnGpu ? std::nan("") : c.meanStepsPerCone},
+                {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
+                {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs()
+                                                                         : std::nan("")},
+                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
     }
 
 private:
     voxelgi::CascadeSettings mSettings;
     double mVoxelSizeParam = 0.0;
     std::optional<voxelgi::CascadeVolume> mVolume;
+    voxelgi::CascadeGatherGpu mGpu;
+    bool mOnGpu = true;
+    bool mGatheredOnGpu = false;
     std::string mLastVoxelized;
 };
 

@@ -1,0 +1,42 @@
+#pragma once
+// The pixel gather of the cascades on Vulkan (shaders/cascade_gather.comp): the levels'
+// pre-combined direction buffers live in one storage buffer, re-uploaded per level only when the
+// level was re-voxelized or re-lit; positions go up relative to the coarsest level's centre.
+
+#include "cascade_volume.h"
+
+#include "gpu/context.h"
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace rtlab::voxelgi {
+
+class CascadeGatherGpu {
+public:
+    static constexpr const char* kDispatchLabel = "cascades.gather";
+
+    //! Needs a volume with pre-combined buffers (CascadeSettings::precombine).
+    void gather(gpu::Context& context, const CascadeVolume& volume, const scene::GBuffer& gbuffer,
+                const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out);
+    //! GPU time of the last dispatch, when the device has timestamps.
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    //! Bytes uploaded by the last call (levels that changed, pixels).
+    std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
+    //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/cascades/shaders when set, else the source folder.
+    static std::filesystem::path getShaderDir();
+
+private:
+    gpu::Context* mContext = nullptr;
+    gpu::ComputePipeline mPipeline;
+    gpu::Buffer mLevels, mCombined, mPositions, mNormals, mVisibility, mOutput, mCones;
+    std::size_t mCombinedLevelVoxels = 0;
+    int mCombinedLevelCount = 0;
+    std::size_t mPixels = 0;
+    std::vector<std::uint64_t> mUploadedStamps;
+    std::optional<double> mLastGpuMs;
+    std::size_t mLastUploadBytes = 0;
+};
+
+} // namespace rtlab::voxelgi

@@ -1,0 +1,140 @@
+#version 450
+// The pixel gather of the voxel texture cascades on Vulkan: per G-buffer pixel, the 16 fixed cones
+// above the surface marched front to back through the pre-combined direction buffers of the
+// levels, with step-corrected opacity; the same algorithm as CascadeVolume::gather and
+// voxelgi::marchCone (cascade_volume.cpp, framework/families/voxel_gi/cone_tracing.h), in float.
+// Positions are relative to an anchor (the coarsest level's centre), so that coordinates far from
+// the origin keep their precision. The Tomorrow Children, GDC 2015 (seed
+// shared/seeds/000_3da000e866ebc485.txt, "Need to light pixels", "Cascade selection",
+// "Pre-Combine Anisotropic Voxels").
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+struct Level {
+    vec4 origin; // xyz: min corner relative to the anchor, w: voxel size
+    vec4 centre; // xyz: centre relative to the anchor, w: radius of the sphere that selects it (< 0: empty)
+};
+
+layout(std430, binding = 0) readonly buffer LevelBuffer { Level levels[]; };
+// [level][voxel][cone]: rgb = light premultiplied by the occupancy, a = occupancy.
+layout(std430, binding = 1) readonly buffer CombinedBuffer { vec4 combined[]; };
+layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
+layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
+layout(std430, binding = 4) readonly buffer VisibilityBuffer { float visibility[]; }; // [pixel][cone]
+layout(std430, binding = 5) writeonly buffer OutputBuffer { vec4 irradiance[]; };
+layout(std430, binding = 6) readonly buffer ConeBuffer { vec4 cones[16]; };
+
+layout(push_constant) uniform Constants {
+    ivec4 size;  // width, height, levels, resolution
+    vec4 march;  // level-0 voxel size, tan(half-angle), start offset (voxels), step scale
+    ivec4 flags; // x: visibility given, y: max steps
+} pc;
+
+const float kPi = 3.14159265358979;
+
+float selectLevel(vec3 p, float diameter)
+{
+    const int n = pc.size.z;
+    float containing = -1.0;
+    for (int i = 0; i < n; ++i) {
+        const float radius = levels[i].centre.w;
+        if (radius <= 0.0)
+            continue;
+        const float r = length(p - levels[i].centre.xyz) / radius;
+        if (r <= 1.0) {
+            containing = float(i) + (i + 1 < n ? clamp((r - 0.5) / 0.5, 0.0, 1.0) : 0.0);
+            break;
+        }
+    }
+    if (containing < 0.0)
+        return -1.0;
+    const float footprint = diameter > pc.march.x ? log2(diameter / pc.march.x) : 0.0;
+    return min(float(n - 1), max(containing, footprint));
+}
+
+vec4 sampleLevel(int level, vec3 p, int cone)
+{
+    const int R = pc.size.w;
+    vec3 c = (p - levels[level].origin.xyz) / levels[level].origin.w - 0.5;
+    c = clamp(c, vec3(0.0), vec3(float(R - 1)));
+    const ivec3 i0 = min(ivec3(floor(c)), ivec3(R - 2));
+    const vec3 t = c - vec3(i0);
+    const uint base = uint(level) * uint(R) * uint(R) * uint(R);
+    vec4 acc = vec4(0.0);
+    for (int corner = 0; corner < 8; ++corner) {
+        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
+        const float w = w3.x * w3.y * w3.z;
+        if (w == 0.0)
+            continue;
+        const ivec3 v = i0 + d;
+        const uint voxel = base + uint(v.x + R * (v.y + R * v.z));
+        acc += w * combined[voxel * 16u + uint(cone)];
+    }
+    return acc;
+}
+
+void main()
+{
+    const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y)
+        return;
+    const int index = pixel.y * pc.size.x + pixel.x;
+    irradiance[index] = vec4(0.0);
+    const vec4 position = positions[index];
+    const vec3 n = normals[index].xyz;
+    if (position.w == 0.0 || dot(n, n) < 0.5)
+        return;
+    const vec3 p = position.xyz;
+    const float start = selectLevel(p, 0.0);
+    if (start < 0.0)
+        return;
+    const float v = pc.march.x * exp2(floor(start));
+    const vec3 origin = p + n * (0.5 * pc.march.z * v);
+    const float startDistance = pc.march.z * v;
+
+    // Irradiance weights: the clamped cosine, normalised to pi (exact for a constant radiance).
+    float weights[16];
+    float sum = 0.0;
+    for (int k = 0; k < 16; ++k) {
+        weights[k] = max(0.0, dot(cones[k].xyz, n));
+        sum += weights[k];
+    }
+    vec3 e = vec3(0.0);
+    for (int k = 0; k < 16; ++k) {
+        if (weights[k] == 0.0)
+            continue;
+        const vec3 dir = cones[k].xyz;
+        float occupied = 0.0;
+        vec3 light = vec3(0.0);
+        float t = startDistance;
+        for (int step = 0; step < pc.flags.y; ++step) {
+            const float diameter = 2.0 * t * pc.march.y;
+            const vec3 q = origin + t * dir;
+            const float l = selectLevel(q, diameter);
+            if (l < 0.0)
+                break; // left the cascade: no indirect light from beyond
+            const int l0 = int(floor(l));
+            const float frac = l - float(l0);
+            vec4 s = (1.0 - frac) * sampleLevel(l0, q, k);
+            if (frac > 0.0 && l0 + 1 < pc.size.z)
+                s += frac * sampleLevel(l0 + 1, q, k);
+            const float voxelSize = pc.march.x * exp2(l);
+            const float dt = pc.march.w * voxelSize;
+            const float a = clamp(s.a, 0.0, 1.0);
+            if (a > 0.0) {
+                const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
+                light += ((1.0 - occupied) * corrected / a) * s.rgb;
+                occupied += (1.0 - occupied) * corrected;
+                if (occupied >= 0.99)
+                    break;
+            }
+            t += dt;
+        }
+        float visible = 1.0;
+        if (pc.flags.x != 0)
+            visible = clamp(visibility[index * 16 + k], 0.0, 1.0);
+        e += (weights[k] * kPi / sum) * visible * light;
+    }
+    irradiance[index] = vec4(max(e, vec3(0.0)), 1.0);
+}
