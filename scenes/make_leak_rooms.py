@@ -51,7 +51,8 @@ def write(thickness_voxels):
             "  - {position: [0.0, 1.0, 2.5], intensity: [40, 40, 40]}\n"
             "sky: {kind: constant, radiance: [1.0, 1.0, 1.0]}\n"
             "camera: {position: [0.0, 1.2, 0.8], target: [0.0, 0.6, -1.0], fov: 70, near: 0.02, far: 10}\n"
-            % (thickness_voxels, VOXEL, name, name))
+            "parameters: {wall_voxels: %g}\n"
+            % (thickness_voxels, VOXEL, name, name, thickness_voxels))
 
 
 for k in (0.25, 0.5, 1, 2, 4):

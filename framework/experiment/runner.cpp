@@ -206,6 +206,8 @@ std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
             .set("gpu_time_source",
                  std::string(toString(chooseGpuTimeSource(context.getGpu().getDeviceInfo()))));
         base.set("frame.culling", run.culling).set("frame.gbuffer_on_gpu", run.gbufferOnGpu);
+        for (const auto& [name, value] : scene->parameters)
+            base.set("scene." + name, value);
     }
     std::vector<ResultRow> rows;
     for (int frame = 0; frame < frames; ++frame) {

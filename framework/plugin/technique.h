@@ -72,6 +72,18 @@ struct HistogramFigure {
     std::string caption;
 };
 
+//! A figure over every scene of a study: column y against column x (numeric, e.g. a scene
+//! parameter scene.<name>), one line per technique, the mean of the runs with the same x.
+struct AcrossScenesFigure {
+    std::string x;      //!< e.g. "scene.wall_voxels"
+    std::string xLabel;
+    std::string y;      //!< e.g. "indirect.mean_signed_error"
+    std::string yLabel;
+    std::string name;   //!< file name stem
+    std::string title;
+    std::string caption;
+};
+
 //! Which columns a family's figures and tables use (report/report.h).
 struct FamilyReport {
     std::string cost;      //!< e.g. "technique_ms"
@@ -86,6 +98,7 @@ struct FamilyReport {
     std::vector<std::string> tableColumns;
     bool convergence = false; //!< error against cell size with fitted order (grid sweeps)
     std::vector<HistogramFigure> histograms; //!< per-technique histograms
+    std::vector<AcrossScenesFigure> acrossScenes; //!< figures over all scenes of the study
 };
 
 } // namespace rtlab::plugin

@@ -2,11 +2,13 @@
 
 #include "core/error.h"
 #include "core/strings.h"
+#include "plot/charts.h"
 #include "report/report_detail.h"
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <set>
 
 namespace rtlab::report {
@@ -162,6 +164,51 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
         figures.push_back(detail::writeGroupFigures(g, directory, techniques));
         for (const auto& p : figures.back().plots)
             summary.plots.push_back(p + ".png");
+    }
+    // Figures over every scene of the study (a family's acrossScenes), shown with the family's
+    // first group.
+    for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+        const detail::Group& first = groups[gi];
+        bool seen = false;
+        for (std::size_t j = 0; j < gi; ++j)
+            seen = seen || groups[j].family == first.family;
+        if (seen)
+            continue;
+        for (const auto& spec : first.columns.acrossScenes) {
+            std::map<std::string, std::map<double, std::pair<double, int>>> byTechnique;
+            for (const auto& g : groups)
+                if (g.family == first.family)
+                    for (const auto& run : g.runs) {
+                        const double x = run.get(spec.x), y = run.get(spec.y);
+                        if (!std::isfinite(x) || !std::isfinite(y))
+                            continue;
+                        auto& cell = byTechnique[run.technique][x];
+                        cell.first += y;
+                        cell.second += 1;
+                    }
+            plot::LineSpec line;
+            line.title = spec.title;
+            line.xLabel = spec.xLabel;
+            line.yLabel = spec.yLabel;
+            line.colors = plot::ColorTable(techniques);
+            for (const auto& [technique, points] : byTechnique) {
+                if (points.size() < 2)
+                    continue;
+                plot::Series s{technique};
+                for (const auto& [x, sum] : points) {
+                    s.x.push_back(x);
+                    s.y.push_back(sum.first / sum.second);
+                }
+                line.series.push_back(std::move(s));
+            }
+            if (line.series.empty())
+                continue;
+            const std::string path = directory + "/plots/" + detail::makeFileName(spec.name);
+            plot::writeLineChart(line, path);
+            figures[gi].plots.push_back(path);
+            figures[gi].captions.push_back(spec.caption);
+            summary.plots.push_back(path + ".png");
+        }
     }
     std::string manifest;
     try {

@@ -98,6 +98,9 @@ struct Scene {
     //! More paths by name, chosen by an experiment's camera_path (scene/camera_paths.h).
     std::map<std::string, CameraPath> namedCameraPaths;
     int frameCount = 1;    //!< frames in the scene's animation (edits, characters, camera)
+    //! Numbers describing the scene that a study plots against (scene files' `parameters`);
+    //! every row of a run on the scene carries them as columns scene.<name>.
+    std::map<std::string, double> parameters;
     float frameRate = 30.0f;
 
     FeatureSet computeFeatures() const;

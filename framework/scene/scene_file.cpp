@@ -350,7 +350,7 @@ Scene parseSceneFile(const std::string& text, const std::string& label)
     const YAML::Node& root = file.root();
     config::checkKeys(file, root,
                       {"scene", "base", "materials", "meshes", "sdf_models", "point_lights", "sky", "characters",
-                       "camera", "camera_path", "camera_paths", "frames", "frame_rate"},
+                       "camera", "camera_path", "camera_paths", "frames", "frame_rate", "parameters"},
                       {"scene"}, "scene file");
     Parser p{file, std::filesystem::path(label).parent_path(), {}, {}};
     if (root["base"]) {
@@ -393,6 +393,19 @@ Scene parseSceneFile(const std::string& text, const std::string& label)
                 file.fail(kv.first, "camera_paths: '" + name + "' is a built-in camera path (" +
                                         joinList(getBuiltinCameraPathNames()) + "); choose another name");
             p.scene.namedCameraPaths[name] = p.readCameraPath(kv.second, "camera_paths." + name);
+        }
+    }
+    if (root["parameters"]) {
+        const YAML::Node& params = root["parameters"];
+        if (!params.IsMap())
+            file.fail(params, "parameters: expected a mapping from a name to a number, found " +
+                                  config::describeNode(params));
+        for (const auto& kv : params) {
+            const std::string name = kv.first.Scalar();
+            if (name.empty() || name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_") !=
+                                    std::string::npos)
+                file.fail(kv.first, "parameters: '" + name + "' must be snake_case");
+            p.scene.parameters[name] = config::readFloat(file, kv.second, "parameters." + name);
         }
     }
     if (root["frames"])

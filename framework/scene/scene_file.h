@@ -36,6 +36,7 @@
 //       - {time: 1, position: [1, 0.3, 3], target: [0, 0.3, 0]}
 //   frames: 8
 //   frame_rate: 30
+//   parameters: {wall_voxels: 0.25}    # numbers a study plots against (row columns scene.<name>)
 
 #include "scene/scene.h"
 

@@ -72,6 +72,15 @@ TEST(SceneFile, ValidFileBuildsTheScene)
     EXPECT_GT(s.buildRenderScene(0).triangleCount(), 100u);
 }
 
+TEST(SceneFile, ParametersAreNumbersAStudyPlotsAgainst)
+{
+    const Scene s = parseSceneFile(
+        "scene: p\nbase: cornell_box\nparameters: {wall_voxels: 0.25, rooms: 3}\n", "scene.yaml");
+    ASSERT_EQ(s.parameters.size(), 2u);
+    EXPECT_EQ(s.parameters.at("wall_voxels"), 0.25);
+    EXPECT_EQ(s.parameters.at("rooms"), 3.0);
+}
+
 TEST(SceneFile, BaseStartsFromAProceduralScene)
 {
     const Scene s = parseSceneFile("scene: lit_box\nbase: cornell_box\npoint_lights: [{position: [0.27, 0.4, 0.27], "
@@ -96,6 +105,10 @@ TEST(SceneFile, BadInputGivesOneClearErrorWithItsPosition)
         {"scene: x\n", "scene.yaml:1:1:", "the scene is empty"},
         {"scene: x\nsdf_model: []\n", "scene.yaml:2:1:", "did you mean sdf_models?"},
         {"scene: x\nbase: cornel_box\n", "scene.yaml:2:7:", "did you mean cornell_box?"},
+        {"scene: x\nbase: cornell_box\nparameters: [1]\n", "scene.yaml:3:13:",
+         "parameters: expected a mapping"},
+        {"scene: x\nbase: cornell_box\nparameters: {Wall: 1}\n", "scene.yaml:3:14:",
+         "must be snake_case"},
         {"scene: x\nmaterials: [{name: a, albedo: [2, 0, 0]}]\nbase: cornell_box\n", "scene.yaml:2:31:",
          "each channel must be in [0, 0.999]"},
         {"scene: x\nsdf_models: [{name: r, bounds: [[0,0,0],[1,1,1]], edits: [{shape: cube, size: 1}]}]\n",

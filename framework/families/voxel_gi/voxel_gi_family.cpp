@@ -337,7 +337,26 @@ plugin::FamilyInfo describeVoxelGiFamily()
                                    {"indirect.rel_mse", "relative MSE of indirect irradiance"}},
                    .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse",
                                     "indirect.flip", "memory.payload_bytes",
-                                    "counter.surface_voxels", "counter.steps_per_cone"}};
+                                    "counter.surface_voxels", "counter.steps_per_cone"},
+                   .acrossScenes = {
+                       {.x = "scene.wall_voxels",
+                        .xLabel = "wall thickness (level-0 voxels)",
+                        .y = "indirect.mean_signed_error",
+                        .yLabel = "mean indirect irradiance inside (truth 0)",
+                        .name = "voxel_gi_leak",
+                        .title = "leak test: light inside a closed room lit from outside",
+                        .caption = "Leak test (scenes/leak_room_*.yaml): a closed room lit only "
+                                   "from outside; the ground truth inside is 0, so the mean "
+                                   "indirect irradiance there is light that leaked through walls "
+                                   "of the given thickness."},
+                       {.x = "param.resolution",
+                        .xLabel = "voxels per level and axis",
+                        .y = "memory.payload_bytes",
+                        .yLabel = "payload (bytes)",
+                        .name = "voxel_gi_memory",
+                        .title = "memory against resolution",
+                        .caption = "Memory of the structure (payload: volumetric G-buffer, light "
+                                   "and pre-combined buffers) against its resolution, every scene."}}};
     info.runtime = std::make_shared<VoxelGiFamily>();
     return info;
 }
