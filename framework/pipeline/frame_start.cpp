@@ -56,8 +56,7 @@ void FrameStart::addPasses(FrameGraph& graph)
     const auto sceneRes =
         graph.addExternal<scene::Scene>(kScene, ResourceType::value("scene"), &mScene);
     const auto sdfMeshes = this->sdfMeshes();
-    const Resource<std::vector<scene::PosedCapsule>> capsules{
-        "capsules", ResourceType::table("posed capsules")};
+    const auto capsules = this->capsules();
     const auto geometryRes = geometry();
     const Resource<GpuScene> gpuScene{"gpu_scene", ResourceType::value("uploaded scene")};
     const auto gbufferRes = gbuffer();

@@ -104,6 +104,11 @@ public:
 
     // Typed handles of the resources, for the families' passes.
     Resource<scene::Scene> scene() const { return {kScene, ResourceType::value("scene")}; }
+    //! The characters' capsules at this frame (written only for scenes with characters).
+    Resource<std::vector<scene::PosedCapsule>> capsules() const
+    {
+        return {"capsules", ResourceType::table("posed capsules")};
+    }
     //! The SDF models as meshes (written only for scenes with SDF models).
     Resource<std::vector<scene::SdfMesh>> sdfMeshes() const
     {

@@ -1,8 +1,11 @@
 #include "families/voxel_gi/upsample.h"
 
 #include "core/error.h"
+#include "families/voxel_gi/cone_tracing.h"
 
+#include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -76,11 +79,88 @@ std::vector<Image<float>> reduceConeImages(const std::vector<Image<float>>* full
     return out;
 }
 
+namespace {
+
+// The low-resolution samples a full-resolution pixel blends and their weights (summing to 1):
+// the four around it, bilinear times geometric similarity; when all four fail, the most similar
+// of the 3 x 3 around (else the nearest with a surface). Returns how many (0 for no surface).
+int findUpsampleSamples(const ReducedGBuffer& reduced, const scene::GBuffer& full, int x, int y,
+                        int samples[4], float weights[4])
+{
+    if (!full.hasSurface(x, y))
+        return 0;
+    const int f = reduced.factor;
+    const int lw = reduced.gbuffer.width, lh = reduced.gbuffer.height;
+    const glm::vec3 p = full.position.at(x, y), n = full.normal.at(x, y);
+    const float d = std::isfinite(full.depth.at(x, y)) ? full.depth.at(x, y) : 1.0f;
+    // Geometric similarity of low-resolution sample s to the pixel: distance of s from the
+    // pixel's tangent plane against 2 % of the view depth, and the normals' agreement (cos^8).
+    const auto similarity = [&](int s) {
+        const int r = reduced.representative[std::size_t(s)];
+        if (r < 0)
+            return 0.0f;
+        const int rx = r % full.width, ry = r / full.width;
+        const float plane =
+            std::abs(glm::dot(n, full.position.at(rx, ry) - p)) / std::max(0.02f * d, 1e-6f);
+        const float c = std::max(0.0f, glm::dot(n, full.normal.at(rx, ry)));
+        const float c2 = c * c, c4 = c2 * c2;
+        return std::exp(-plane * plane) * c4 * c4;
+    };
+    if (f == 1) {
+        samples[0] = y * lw + x;
+        weights[0] = 1.0f;
+        return 1;
+    }
+    const float u = (x + 0.5f) / float(f) - 0.5f, v = (y + 0.5f) / float(f) - 0.5f;
+    const int i0 = int(std::floor(u)), j0 = int(std::floor(v));
+    const float fu = u - float(i0), fv = v - float(j0);
+    int count = 0;
+    float total = 0.0f;
+    for (int dj = 0; dj <= 1; ++dj)
+        for (int di = 0; di <= 1; ++di) {
+            const int i = std::clamp(i0 + di, 0, lw - 1), j = std::clamp(j0 + dj, 0, lh - 1);
+            const float bilinear = (di ? fu : 1.0f - fu) * (dj ? fv : 1.0f - fv);
+            const int s = j * lw + i;
+            const float w = bilinear * similarity(s);
+            if (w <= 0.0f)
+                continue;
+            samples[count] = s;
+            weights[count] = w;
+            total += w;
+            ++count;
+        }
+    if (total > 1e-6f) {
+        for (int k = 0; k < count; ++k)
+            weights[k] /= total;
+        return count;
+    }
+    const int ci = std::clamp(x / f, 0, lw - 1), cj = std::clamp(y / f, 0, lh - 1);
+    float best = -1.0f;
+    int bestSample = -1;
+    for (int j = std::max(0, cj - 1); j <= std::min(lh - 1, cj + 1); ++j)
+        for (int i = std::max(0, ci - 1); i <= std::min(lw - 1, ci + 1); ++i) {
+            const int s = j * lw + i;
+            if (reduced.representative[std::size_t(s)] < 0)
+                continue;
+            const float w = similarity(s) - 1e-3f * float(std::abs(i - ci) + std::abs(j - cj));
+            if (w > best) {
+                best = w;
+                bestSample = s;
+            }
+        }
+    if (bestSample < 0)
+        return 0;
+    samples[0] = bestSample;
+    weights[0] = 1.0f;
+    return 1;
+}
+
+} // namespace
+
 Image<glm::vec3> upsampleIrradiance(const Image<glm::vec3>& low, const ReducedGBuffer& reduced,
                                     const scene::GBuffer& full)
 {
-    const int f = reduced.factor;
-    if (f == 1)
+    if (reduced.factor == 1)
         return low;
     const int lw = reduced.gbuffer.width, lh = reduced.gbuffer.height;
     if (low.width != lw || low.height != lh)
@@ -88,63 +168,115 @@ Image<glm::vec3> upsampleIrradiance(const Image<glm::vec3>& low, const ReducedGB
                     std::to_string(low.height) + " for a reduced G-buffer of " +
                     std::to_string(lw) + "x" + std::to_string(lh));
     Image<glm::vec3> out(full.width, full.height, glm::vec3(0.0f));
-    // Geometric similarity of low-resolution sample s to the pixel at p with normal n and view
-    // depth d: distance of s from the pixel's tangent plane against 2 % of the depth, and the
-    // normals' agreement (cos^8).
-    const auto similarity = [&](int s, const glm::vec3& p, const glm::vec3& n, float d) {
-        const int r = reduced.representative[std::size_t(s)];
-        if (r < 0)
-            return 0.0f;
-        const int rx = r % full.width, ry = r / full.width;
-        const float plane = std::abs(glm::dot(n, full.position.at(rx, ry) - p)) /
-                            std::max(0.02f * d, 1e-6f);
-        const float c = std::max(0.0f, glm::dot(n, full.normal.at(rx, ry)));
-        const float c2 = c * c, c4 = c2 * c2;
-        return std::exp(-plane * plane) * c4 * c4;
-    };
     for (int y = 0; y < full.height; ++y)
         for (int x = 0; x < full.width; ++x) {
-            if (!full.hasSurface(x, y))
-                continue;
-            const glm::vec3 p = full.position.at(x, y), n = full.normal.at(x, y);
-            const float d = std::isfinite(full.depth.at(x, y)) ? full.depth.at(x, y) : 1.0f;
-            const float u = (x + 0.5f) / float(f) - 0.5f, v = (y + 0.5f) / float(f) - 0.5f;
-            const int i0 = int(std::floor(u)), j0 = int(std::floor(v));
-            const float fu = u - float(i0), fv = v - float(j0);
+            int samples[4];
+            float weights[4];
+            const int n = findUpsampleSamples(reduced, full, x, y, samples, weights);
             glm::vec3 sum(0.0f);
-            float weights = 0.0f;
-            for (int dj = 0; dj <= 1; ++dj)
-                for (int di = 0; di <= 1; ++di) {
-                    const int i = std::clamp(i0 + di, 0, lw - 1), j = std::clamp(j0 + dj, 0, lh - 1);
-                    const float bilinear = (di ? fu : 1.0f - fu) * (dj ? fv : 1.0f - fv);
-                    const int s = j * lw + i;
-                    const float w = bilinear * similarity(s, p, n, d);
-                    sum += w * low.pixels[std::size_t(s)];
-                    weights += w;
-                }
-            if (weights > 1e-6f) {
-                out.at(x, y) = sum / weights;
-                continue;
-            }
-            // No neighbour alike: the most similar of the 3 x 3 around, else the nearest with a
-            // surface.
-            const int ci = std::clamp(x / f, 0, lw - 1), cj = std::clamp(y / f, 0, lh - 1);
-            float best = -1.0f;
-            int bestSample = -1;
-            for (int j = std::max(0, cj - 1); j <= std::min(lh - 1, cj + 1); ++j)
-                for (int i = std::max(0, ci - 1); i <= std::min(lw - 1, ci + 1); ++i) {
-                    const int s = j * lw + i;
-                    if (reduced.representative[std::size_t(s)] < 0)
-                        continue;
-                    const float w = similarity(s, p, n, d) - 1e-3f * float(std::abs(i - ci) + std::abs(j - cj));
-                    if (w > best) {
-                        best = w;
-                        bestSample = s;
-                    }
-                }
-            if (bestSample >= 0)
-                out.at(x, y) = low.pixels[std::size_t(bestSample)];
+            for (int k = 0; k < n; ++k)
+                sum += weights[k] * low.pixels[std::size_t(samples[k])];
+            out.at(x, y) = sum;
         }
+    return out;
+}
+
+double computeCapsuleConeOcclusion(const glm::dvec3& p, const glm::dvec3& dir, double coneHalfAngle,
+                                   const glm::vec3& a, const glm::vec3& b, float radius)
+{
+    const glm::dvec3 A(a), u = glm::dvec3(b) - A;
+    const double uu = glm::dot(u, u);
+    const double r = double(radius);
+    const auto closestOnSegment = [&](const glm::dvec3& q) {
+        return uu > 0.0 ? A + std::clamp(glm::dot(q - A, u) / uu, 0.0, 1.0) * u : A;
+    };
+    // On or inside the capsule: its own character's surface is not occluded by it.
+    if (glm::length(p - closestOnSegment(p)) <= 1.05 * r)
+        return 0.0;
+    // The point of the segment nearest the cone's axis (closest points of a segment and a ray).
+    const glm::dvec3 w0 = A - p;
+    const double ud = glm::dot(u, dir), uw = glm::dot(u, w0), dw = glm::dot(dir, w0);
+    const double denom = uu - ud * ud;
+    double s = denom > 1e-12 * std::max(uu, 1e-300) ? std::clamp((ud * dw - uw) / denom, 0.0, 1.0) : 0.0;
+    const double t = std::max(0.0, glm::dot(A + s * u - p, dir));
+    const glm::dvec3 centre = closestOnSegment(p + t * dir);
+    const glm::dvec3 toCentre = centre - p;
+    const double distance = glm::length(toCentre);
+    if (!(distance > r))
+        return 0.0;
+    const double capAngle = std::asin(std::min(1.0, r / distance));
+    const double between = std::acos(std::clamp(glm::dot(toCentre / distance, dir), -1.0, 1.0));
+    const double outer = coneHalfAngle + capAngle, inner = std::abs(coneHalfAngle - capAngle);
+    if (between >= outer)
+        return 0.0;
+    const double coneSolid = 1.0 - std::cos(coneHalfAngle); // solid angles / 2 pi
+    const double smaller = 1.0 - std::cos(std::min(coneHalfAngle, capAngle));
+    double share = 1.0;
+    if (between > inner) {
+        const double x = std::clamp(1.0 - (between - inner) / (outer - inner), 0.0, 1.0);
+        share = x * x * (3.0 - 2.0 * x);
+    }
+    return std::clamp(smaller * share / coneSolid, 0.0, 1.0);
+}
+
+Image<glm::vec3> combineCones(const ConeCombineInputs& in)
+{
+    const scene::GBuffer& full = *in.full;
+    const ReducedGBuffer& reduced = *in.reduced;
+    const std::size_t lowPixels = std::size_t(reduced.gbuffer.width) * std::size_t(reduced.gbuffer.height);
+    if (in.coneRadiance->size() != lowPixels * kConeCount)
+        throw Error("cone combine: " + std::to_string(in.coneRadiance->size()) +
+                    " cone radiances for " + std::to_string(lowPixels) + " pixels x 16 cones");
+    const bool useVisibility =
+        in.visibility != nullptr && in.visibility->size() == std::size_t(kConeCount);
+    ConeSet cones;
+    cones.directions = scene::getConeDirections();
+    cones.halfAngle = in.coneHalfAngle;
+    cones.tanHalfAngle = std::tan(in.coneHalfAngle);
+    Image<glm::vec3> out(full.width, full.height, glm::vec3(0.0f));
+    tbb::parallel_for(0, full.height, [&](int y) {
+        std::vector<const scene::PosedCapsule*> near;
+        for (int x = 0; x < full.width; ++x) {
+            int samples[4];
+            float weights[4];
+            const int count = findUpsampleSamples(reduced, full, x, y, samples, weights);
+            if (count == 0)
+                continue;
+            const glm::dvec3 p(full.position.at(x, y)), n(full.normal.at(x, y));
+            if (glm::dot(n, n) < 0.5)
+                continue;
+            // Capsules close enough to hide more than 0.25 % of a cone (40 radii).
+            near.clear();
+            if (in.capsules != nullptr)
+                for (const auto& c : *in.capsules) {
+                    const glm::dvec3 A(c.capsule.a), u = glm::dvec3(c.capsule.b) - A;
+                    const double uu = glm::dot(u, u);
+                    const glm::dvec3 q =
+                        uu > 0.0 ? A + std::clamp(glm::dot(p - A, u) / uu, 0.0, 1.0) * u : A;
+                    if (glm::length(p - q) < 40.0 * double(c.capsule.radius))
+                        near.push_back(&c);
+                }
+            const auto w = computeIrradianceWeights(cones, n);
+            glm::dvec3 e(0.0);
+            for (int k = 0; k < kConeCount; ++k) {
+                if (w[std::size_t(k)] == 0.0)
+                    continue;
+                glm::dvec3 radiance(0.0);
+                for (int s = 0; s < count; ++s)
+                    radiance += double(weights[s]) *
+                                glm::dvec3((*in.coneRadiance)[std::size_t(samples[s]) * kConeCount + std::size_t(k)]);
+                double visible = 1.0;
+                if (useVisibility)
+                    visible = std::clamp(double((*in.visibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
+                for (const auto* c : near)
+                    visible *= 1.0 - computeCapsuleConeOcclusion(
+                                         p, cones.directions[std::size_t(k)], in.coneHalfAngle,
+                                         c->capsule.a, c->capsule.b, c->capsule.radius);
+                e += w[std::size_t(k)] * visible * radiance;
+            }
+            out.at(x, y) = glm::max(glm::vec3(e), glm::vec3(0.0f));
+        }
+    });
     return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include "core/image.h"
 #include "scene/gbuffer.h"
+#include "scene/scene.h"
 
 #include <glm/vec3.hpp>
 
@@ -36,5 +37,30 @@ std::vector<Image<float>> reduceConeImages(const std::vector<Image<float>>* full
 //! low-resolution neighbours; pixels without a surface get 0.
 Image<glm::vec3> upsampleIrradiance(const Image<glm::vec3>& low, const ReducedGBuffer& reduced,
                                     const scene::GBuffer& full);
+
+//! The final combine of the talk ("Screen Space Directional Occlusion", "Characters"): the
+//! radiance each of the 16 cones gathered at the representative pixels (`coneRadiance`,
+//! [low-res pixel * 16 + cone]) is upsampled per cone, multiplied per pixel by the occlusion
+//! family's 16 visibilities (when given) and by the characters' capsules' occlusion of each
+//! cone (when given), and integrated with the pixel's own irradiance weights
+//! (cone_tracing.h computeIrradianceWeights). Full resolution in, full resolution out.
+struct ConeCombineInputs {
+    const std::vector<glm::vec3>* coneRadiance = nullptr;
+    const ReducedGBuffer* reduced = nullptr;
+    const scene::GBuffer* full = nullptr;
+    const std::vector<Image<float>>* visibility = nullptr;      //!< 16 full-res images, or null
+    const std::vector<scene::PosedCapsule>* capsules = nullptr; //!< or null
+    double coneHalfAngle = 0.5;                                 //!< radians
+};
+Image<glm::vec3> combineCones(const ConeCombineInputs& in);
+
+//! Share of a cone (axis `dir`, half-angle `coneHalfAngle`) from `p` that a capsule hides: the
+//! capsule is replaced by the sphere on its segment nearest the cone's axis, and the overlap of
+//! the two spherical caps is approximated by the smoothstep of C. Oat, P. Sander, "Ambient
+//! Aperture Lighting", I3D 2007 (as the Last of Us did for its capsule occluders, M. Iwanicki,
+//! "Lighting Technology of The Last of Us", SIGGRAPH 2013, in one direction; the Tomorrow
+//! Children in 16). 0 when p lies on or inside the capsule (its own character's surface).
+double computeCapsuleConeOcclusion(const glm::dvec3& p, const glm::dvec3& dir, double coneHalfAngle,
+                                   const glm::vec3& a, const glm::vec3& b, float radius);
 
 } // namespace rtlab::voxelgi

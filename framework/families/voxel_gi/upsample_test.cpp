@@ -73,3 +73,30 @@ TEST(Upsample, LightDoesNotBleedAcrossADepthDiscontinuity)
 }
 
 } // namespace
+
+namespace {
+
+TEST(CapsuleOcclusion, CoversAConeItFillsAndNothingBehindOrAside)
+{
+    const double cone = 0.5; // radians
+    const glm::dvec3 p(0.0), up(0.0, 1.0, 0.0);
+    // A vertical capsule straight above, wide enough to fill the cone: radius 2 at 3 (the cap's
+    // half-angle asin(2/3) = 0.73 > 0.5).
+    EXPECT_NEAR(computeCapsuleConeOcclusion(p, up, cone, {0, 3, -1}, {0, 3, 1}, 2.0f), 1.0, 1e-12);
+    // Behind the cone (below the point) and far aside: nothing.
+    EXPECT_EQ(computeCapsuleConeOcclusion(p, up, cone, {-1, -3, 0}, {1, -3, 0}, 0.5f), 0.0);
+    EXPECT_EQ(computeCapsuleConeOcclusion(p, up, cone, {10, 0, -1}, {10, 0, 1}, 0.5f), 0.0);
+    // The point on the capsule's own surface: its character is not occluded by itself.
+    EXPECT_EQ(computeCapsuleConeOcclusion(p, up, cone, {0.3, -1, 0}, {0.3, 1, 0}, 0.3f), 0.0);
+    // Farther away hides less, and the share stays in [0, 1].
+    double previous = 1.0;
+    for (const double d : {1.5, 2.0, 3.0, 5.0, 10.0, 40.0}) {
+        const double o = computeCapsuleConeOcclusion(p, up, cone, {-1, d, 0}, {1, d, 0}, 0.4f);
+        EXPECT_GE(o, 0.0);
+        EXPECT_LE(o, previous + 1e-12) << d;
+        previous = o;
+    }
+    EXPECT_LT(previous, 0.01);
+}
+
+} // namespace

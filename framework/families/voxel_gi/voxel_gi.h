@@ -18,6 +18,7 @@
 #include "plugin/technique.h"
 #include "scene/gbuffer.h"
 #include "scene/render_scene.h"
+#include "scene/scene.h"
 
 #include <glm/vec3.hpp>
 
@@ -61,6 +62,8 @@ struct VoxelGiInput {
     glm::dvec3 cameraPosition{0.0};
     //! The occlusion family's 16 per-direction visibilities (bentcone_ssdo), or null.
     const std::vector<Image<float>>* coneVisibility = nullptr;
+    //! The characters' capsules at this frame (not voxelized: they occlude the cones), or null.
+    const std::vector<scene::PosedCapsule>* capsules = nullptr;
     int frameIndex = 0;
     gpu::Context* gpu = nullptr;
 };

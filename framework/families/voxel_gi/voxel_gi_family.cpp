@@ -9,7 +9,7 @@
 //   light_injection  the technique updates its voxel light buffers where they are stale
 //   voxel_gather     indirect irradiance at the G-buffer pixels (with the occlusion family's 16
 //                    per-direction visibilities when an occlusion technique listed before it
-//                    gives them)
+//                    gives them, and the characters' capsules)
 //   indirect_slot    into the lit frame's `indirect_irradiance` slot (pipeline/compose.h)
 //   reference_indirect      Embree "indirect" with the technique's bounce count, same G-buffer
 //   metric.indirect_error   indirect.* RMSE, relMSE, PSNR, mean signed error over surface pixels
@@ -178,12 +178,17 @@ private:
         const bool hasCones = graph.declares(cones.name);
         if (hasCones)
             gatherOptional.push_back(cones);
+        const auto capsules = start.capsules();
+        const bool hasCapsules = graph.declares(capsules.name);
+        if (hasCapsules)
+            gatherOptional.push_back(capsules);
         graph.addPass(
             {.name = "voxel_gather",
              .reads = {voxelLight, gbuffer, geometry},
              .optionalReads = gatherOptional,
              .writes = {indirect}},
-            [this, gbuffer, geometry, cones, hasCones, indirect](pipeline::PassContext& ctx) {
+            [this, gbuffer, geometry, cones, hasCones, capsules, hasCapsules,
+             indirect](pipeline::PassContext& ctx) {
                 const scene::GBuffer& g = ctx.read(gbuffer);
                 plugin::VoxelGiInput input;
                 input.gbuffer = &g;
@@ -191,6 +196,7 @@ private:
                 input.cameraPosition = glm::dvec3(g.camera.position);
                 input.frameIndex = ctx.frame();
                 input.gpu = &mContext.getGpu();
+                input.capsules = hasCapsules ? ctx.tryRead(capsules) : nullptr;
                 const auto* visibility = hasCones ? ctx.tryRead(cones) : nullptr;
                 input.coneVisibility =
                     visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)

@@ -38,10 +38,8 @@ std::filesystem::path CascadeGatherGpu::getShaderDir()
     return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
 }
 
-void CascadeGatherGpu::gather(gpu::Context& context, const CascadeVolume& volume,
-                              const scene::GBuffer& gbuffer,
-                              const std::vector<Image<float>>* coneVisibility,
-                              Image<glm::vec3>& out)
+void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& volume,
+                                   const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
     const CascadeSettings& settings = volume.getSettings();
     if (!settings.precombine)
@@ -56,7 +54,7 @@ void CascadeGatherGpu::gather(gpu::Context& context, const CascadeVolume& volume
         gpu::ComputePipelineDesc desc;
         desc.name = kDispatchLabel;
         desc.spirv = compiler.compileFile(getShaderDir() / "cascade_gather.comp").spirv;
-        for (std::uint32_t b = 0; b < 7; ++b)
+        for (std::uint32_t b = 0; b < 6; ++b)
             desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
         desc.pushConstantSize = sizeof(GatherConstants);
         mPipeline = context.createPipeline(desc);
@@ -109,8 +107,7 @@ void CascadeGatherGpu::gather(gpu::Context& context, const CascadeVolume& volume
     if (mPixels != pixels) {
         mPositions = makeBuffer(context, pixels * sizeof(glm::vec4), "cascades.positions");
         mNormals = makeBuffer(context, pixels * sizeof(glm::vec4), "cascades.normals");
-        mOutput = makeBuffer(context, pixels * sizeof(glm::vec4), "cascades.irradiance");
-        mVisibility = makeBuffer(context, pixels * kConeCount * sizeof(float), "cascades.visibility");
+        mOutput = makeBuffer(context, pixels * kConeCount * sizeof(glm::vec4), "cascades.cones");
         mPixels = pixels;
     }
     std::vector<glm::vec4> positions(pixels), normals(pixels);
@@ -126,38 +123,27 @@ void CascadeGatherGpu::gather(gpu::Context& context, const CascadeVolume& volume
     mPositions.uploadSpan<glm::vec4>(positions);
     mNormals.uploadSpan<glm::vec4>(normals);
     mLastUploadBytes += 2 * pixels * sizeof(glm::vec4);
-    const bool useVisibility =
-        coneVisibility != nullptr && coneVisibility->size() == std::size_t(kConeCount);
-    if (useVisibility) {
-        std::vector<float> packed(pixels * kConeCount);
-        for (std::size_t i = 0; i < pixels; ++i)
-            for (int k = 0; k < kConeCount; ++k)
-                packed[i * kConeCount + std::size_t(k)] = (*coneVisibility)[std::size_t(k)].pixels[i];
-        mVisibility.uploadSpan<float>(packed);
-        mLastUploadBytes += packed.size() * sizeof(float);
-    }
 
     GatherConstants constants;
     constants.size = {w, h, n, R};
     constants.march = {float(settings.voxelSize), float(volume.getCones().tanHalfAngle),
                        float(settings.startOffset), float(settings.stepScale)};
-    constants.flags = {useVisibility ? 1 : 0, 1024, 0, 0};
+    constants.flags = {0, 1024, 0, 0};
     const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
         cmd.dispatch(mPipeline,
                      {gpu::Binding::storageBuffer(0, mLevels), gpu::Binding::storageBuffer(1, mCombined),
                       gpu::Binding::storageBuffer(2, mPositions), gpu::Binding::storageBuffer(3, mNormals),
-                      gpu::Binding::storageBuffer(4, mVisibility), gpu::Binding::storageBuffer(5, mOutput),
-                      gpu::Binding::storageBuffer(6, mCones)},
+                      gpu::Binding::storageBuffer(4, mOutput), gpu::Binding::storageBuffer(5, mCones)},
                      gpu::PushConstants(constants),
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), 8),
                                      gpu::computeGroupCount(std::uint64_t(h), 8), 1},
                      kDispatchLabel);
     });
     mLastGpuMs = result.sumGpuMs(kDispatchLabel);
-    const std::vector<glm::vec4> e = mOutput.downloadVector<glm::vec4>(pixels);
-    out = Image<glm::vec3>(w, h);
-    for (std::size_t i = 0; i < pixels; ++i)
-        out.pixels[i] = glm::vec3(e[i]);
+    const std::vector<glm::vec4> e = mOutput.downloadVector<glm::vec4>(pixels * kConeCount);
+    out.resize(pixels * kConeCount);
+    for (std::size_t i = 0; i < out.size(); ++i)
+        out[i] = glm::vec3(e[i]);
 }
 
 } // namespace rtlab::voxelgi

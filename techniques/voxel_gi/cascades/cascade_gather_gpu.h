@@ -17,9 +17,10 @@ class CascadeGatherGpu {
 public:
     static constexpr const char* kDispatchLabel = "cascades.gather";
 
-    //! Needs a volume with pre-combined buffers (CascadeSettings::precombine).
-    void gather(gpu::Context& context, const CascadeVolume& volume, const scene::GBuffer& gbuffer,
-                const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out);
+    //! CascadeVolume::gatherCones on the GPU: the radiance of each of the 16 cones at every
+    //! pixel, [pixel * 16 + cone]. Needs pre-combined buffers (CascadeSettings::precombine).
+    void gatherCones(gpu::Context& context, const CascadeVolume& volume,
+                     const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
     //! GPU time of the last dispatch, when the device has timestamps.
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     //! Bytes uploaded by the last call (levels that changed, pixels).
@@ -30,7 +31,7 @@ public:
 private:
     gpu::Context* mContext = nullptr;
     gpu::ComputePipeline mPipeline;
-    gpu::Buffer mLevels, mCombined, mPositions, mNormals, mVisibility, mOutput, mCones;
+    gpu::Buffer mLevels, mCombined, mPositions, mNormals, mOutput, mCones;
     std::size_t mCombinedLevelVoxels = 0;
     int mCombinedLevelCount = 0;
     std::size_t mPixels = 0;

@@ -1,6 +1,7 @@
 #include "cascade_volume.h"
 
 #include "core/error.h"
+#include "families/voxel_gi/upsample.h"
 
 #include <glm/common.hpp>
 #include <glm/gtc/constants.hpp>
@@ -455,7 +456,22 @@ bool CascadeVolume::sampleGathered(const glm::dvec3& p, double diameter, int con
 void CascadeVolume::gather(const scene::GBuffer& gbuffer,
                            const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out)
 {
-    out = Image<glm::vec3>(gbuffer.width, gbuffer.height, glm::vec3(0.0f));
+    std::vector<glm::vec3> cones;
+    gatherCones(gbuffer, cones);
+    const ReducedGBuffer same = reduceGBuffer(gbuffer, 1);
+    ConeCombineInputs in;
+    in.coneRadiance = &cones;
+    in.reduced = &same;
+    in.full = &gbuffer;
+    in.visibility = coneVisibility;
+    in.coneHalfAngle = mCones.halfAngle;
+    out = combineCones(in);
+}
+
+void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+{
+    out.assign(std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount,
+               glm::vec3(0.0f));
     struct GatherSampler {
         const CascadeVolume* volume;
         bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
@@ -464,8 +480,6 @@ void CascadeVolume::gather(const scene::GBuffer& gbuffer,
             return volume->sampleGathered(p, d, cone, dir, o);
         }
     } sampler{this};
-    const bool useVisibility =
-        coneVisibility != nullptr && coneVisibility->size() == std::size_t(kConeCount);
     std::vector<std::uint64_t> stepsPerRow(std::size_t(gbuffer.height), 0);
     std::vector<std::uint64_t> conesPerRow(std::size_t(gbuffer.height), 0);
     tbb::parallel_for(0, gbuffer.height, [&](int y) {
@@ -486,7 +500,8 @@ void CascadeVolume::gather(const scene::GBuffer& gbuffer,
             march.startDistance = mSettings.startOffset * v;
             const glm::dvec3 origin = p + n * (0.5 * mSettings.startOffset * v);
             const auto w = computeIrradianceWeights(mCones, n);
-            glm::vec3 e(0.0f);
+            const std::size_t base =
+                (std::size_t(y) * std::size_t(gbuffer.width) + std::size_t(x)) * kConeCount;
             for (int k = 0; k < kConeCount; ++k) {
                 if (w[std::size_t(k)] == 0.0)
                     continue;
@@ -494,12 +509,8 @@ void CascadeVolume::gather(const scene::GBuffer& gbuffer,
                     marchCone(sampler, origin, mCones.directions[std::size_t(k)], k, march);
                 stepsPerRow[std::size_t(y)] += std::uint64_t(r.steps);
                 ++conesPerRow[std::size_t(y)];
-                float visible = 1.0f;
-                if (useVisibility)
-                    visible = std::clamp((*coneVisibility)[std::size_t(k)].at(x, y), 0.0f, 1.0f);
-                e += float(w[std::size_t(k)]) * visible * r.light[kDirect];
+                out[base + std::size_t(k)] = glm::max(r.light[kDirect], glm::vec3(0.0f));
             }
-            out.at(x, y) = glm::max(e, glm::vec3(0.0f));
         }
     });
     std::uint64_t steps = 0, cones = 0;

@@ -79,8 +79,12 @@ public:
     //! lights and sky. Returns what it did ("" when nothing).
     std::string injectLight(const scene::RenderScene& geometry, const std::string& lightsKey,
                             int frame, bool force);
-    //! Indirect irradiance at every pixel of `gbuffer` (cones weighted by `coneVisibility` when
-    //! given: 16 images of the pixel's visibility per direction).
+    //! The radiance each of the 16 cones gathers at every pixel of `gbuffer`, [pixel * 16 +
+    //! cone]; 0 for cones below the surface and for pixels without a surface or outside the
+    //! cascade.
+    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! Indirect irradiance at every pixel of `gbuffer`: gatherCones combined per pixel
+    //! (upsample.h combineCones), cones weighted by `coneVisibility` when given.
     void gather(const scene::GBuffer& gbuffer, const std::vector<Image<float>>* coneVisibility,
                 Image<glm::vec3>& out);
 

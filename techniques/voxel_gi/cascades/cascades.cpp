@@ -225,18 +225,24 @@ public:
     {
         // The Vulkan gather reads the pre-combined buffers; without them the C++ path runs.
         // Reduced resolution ("Trace at a lower resolution"): one pixel per trace_step^2 block,
-        // each with its own pixel's cone visibilities, upsampled by depth and normal.
+        // the cones' radiance upsampled by depth and normal.
         mGatheredOnGpu = mOnGpu && mSettings.precombine && input.gpu != nullptr;
         const voxelgi::ReducedGBuffer reduced = voxelgi::reduceGBuffer(*input.gbuffer, mTraceStep);
-        const std::vector<Image<float>> cones =
-            voxelgi::reduceConeImages(input.coneVisibility, reduced);
-        const std::vector<Image<float>>* visibility = input.coneVisibility ? &cones : nullptr;
-        Image<glm::vec3> low;
+        std::vector<glm::vec3> cones;
         if (mGatheredOnGpu)
-            mGpu.gather(*input.gpu, *mVolume, reduced.gbuffer, visibility, low);
+            mGpu.gatherCones(*input.gpu, *mVolume, reduced.gbuffer, cones);
         else
-            mVolume->gather(reduced.gbuffer, visibility, low);
-        irradiance = voxelgi::upsampleIrradiance(low, reduced, *input.gbuffer);
+            mVolume->gatherCones(reduced.gbuffer, cones);
+        // The final combine at full resolution: each cone upsampled, times the pixel's own
+        // visibilities (bent-cone SSDO) and the characters' capsules.
+        voxelgi::ConeCombineInputs combine;
+        combine.coneRadiance = &cones;
+        combine.reduced = &reduced;
+        combine.full = input.gbuffer;
+        combine.visibility = input.coneVisibility;
+        combine.capsules = input.capsules;
+        combine.coneHalfAngle = mVolume->getCones().halfAngle;
+        irradiance = voxelgi::combineCones(combine);
     }
 
     plugin::VoxelGiMemory memory() const override

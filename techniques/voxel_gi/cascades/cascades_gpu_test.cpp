@@ -8,6 +8,7 @@
 #include "cascade_gather_gpu.h"
 #include "cascade_volume.h"
 
+#include "families/voxel_gi/upsample.h"
 #include "families/voxel_gi/voxel_gi_test_scenes.h"
 #include "gpu/context.h"
 #include "reference/reference.h"
@@ -51,11 +52,29 @@ void compare(const glm::vec3& offset, const CascadeSettings& settings)
     CascadeVolume volume(settings);
     volume.voxelize(s, "k", glm::dvec3(camera.position), 0, false);
     volume.injectLight(s, "l", 0, false);
-    Image<glm::vec3> cpu, gpu;
-    volume.gather(g, nullptr, cpu);
+    std::vector<glm::vec3> cpuCones, gpuCones;
+    volume.gatherCones(g, cpuCones);
     gpu::Context context;
     CascadeGatherGpu gather;
-    gather.gather(context, volume, g, nullptr, gpu);
+    gather.gatherCones(context, volume, g, gpuCones);
+    // Compared as irradiance (the cones combined per pixel) and cone by cone below.
+    const ReducedGBuffer same = reduceGBuffer(g, 1);
+    const auto combine = [&](const std::vector<glm::vec3>& cones) {
+        ConeCombineInputs in;
+        in.coneRadiance = &cones;
+        in.reduced = &same;
+        in.full = &g;
+        in.coneHalfAngle = volume.getCones().halfAngle;
+        return combineCones(in);
+    };
+    const Image<glm::vec3> cpu = combine(cpuCones), gpu = combine(gpuCones);
+    int conesOff = 0;
+    for (std::size_t i = 0; i < cpuCones.size(); ++i) {
+        const double a = cpuCones[i].x + cpuCones[i].y + cpuCones[i].z;
+        const double b = gpuCones[i].x + gpuCones[i].y + gpuCones[i].z;
+        conesOff += std::abs(a - b) > 1e-3 * std::max(a, 1e-3) ? 1 : 0;
+    }
+    EXPECT_LE(conesOff, int(cpuCones.size() / 100)) << "cones differing by more than 1e-3";
     ASSERT_EQ(cpu.pixels.size(), gpu.pixels.size());
     double sum = 0.0;
     int lit = 0, within = 0;
@@ -76,7 +95,7 @@ void compare(const glm::vec3& offset, const CascadeSettings& settings)
     EXPECT_LT(sum / lit, 1e-5);
     EXPECT_GE(within, int(0.99 * lit));
     // A second call uploads no level (nothing changed), only the pixels.
-    gather.gather(context, volume, g, nullptr, gpu);
+    gather.gatherCones(context, volume, g, gpuCones);
     EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
 }
 

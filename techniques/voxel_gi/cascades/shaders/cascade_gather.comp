@@ -20,17 +20,14 @@ layout(std430, binding = 0) readonly buffer LevelBuffer { Level levels[]; };
 layout(std430, binding = 1) readonly buffer CombinedBuffer { vec4 combined[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
-layout(std430, binding = 4) readonly buffer VisibilityBuffer { float visibility[]; }; // [pixel][cone]
-layout(std430, binding = 5) writeonly buffer OutputBuffer { vec4 irradiance[]; };
-layout(std430, binding = 6) readonly buffer ConeBuffer { vec4 cones[16]; };
+layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
+layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
 
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, levels, resolution
     vec4 march;  // level-0 voxel size, tan(half-angle), start offset (voxels), step scale
-    ivec4 flags; // x: visibility given, y: max steps
+    ivec4 flags; // y: max steps
 } pc;
-
-const float kPi = 3.14159265358979;
 
 float selectLevel(vec3 p, float diameter)
 {
@@ -80,7 +77,8 @@ void main()
     if (pixel.x >= pc.size.x || pixel.y >= pc.size.y)
         return;
     const int index = pixel.y * pc.size.x + pixel.x;
-    irradiance[index] = vec4(0.0);
+    for (int k = 0; k < 16; ++k)
+        coneRadiance[index * 16 + k] = vec4(0.0);
     const vec4 position = positions[index];
     const vec3 n = normals[index].xyz;
     if (position.w == 0.0 || dot(n, n) < 0.5)
@@ -93,16 +91,11 @@ void main()
     const vec3 origin = p + n * (0.5 * pc.march.z * v);
     const float startDistance = pc.march.z * v;
 
-    // Irradiance weights: the clamped cosine, normalised to pi (exact for a constant radiance).
-    float weights[16];
-    float sum = 0.0;
+    // The radiance of each cone above the surface; the pixel's irradiance weights, the
+    // occlusion family's visibilities and the capsules are applied in the combine step
+    // (families/voxel_gi/upsample.h), at full resolution.
     for (int k = 0; k < 16; ++k) {
-        weights[k] = max(0.0, dot(cones[k].xyz, n));
-        sum += weights[k];
-    }
-    vec3 e = vec3(0.0);
-    for (int k = 0; k < 16; ++k) {
-        if (weights[k] == 0.0)
+        if (dot(cones[k].xyz, n) <= 0.0)
             continue;
         const vec3 dir = cones[k].xyz;
         float occupied = 0.0;
@@ -131,10 +124,6 @@ void main()
             }
             t += dt;
         }
-        float visible = 1.0;
-        if (pc.flags.x != 0)
-            visible = clamp(visibility[index * 16 + k], 0.0, 1.0);
-        e += (weights[k] * kPi / sum) * visible * light;
+        coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
     }
-    irradiance[index] = vec4(max(e, vec3(0.0)), 1.0);
 }
