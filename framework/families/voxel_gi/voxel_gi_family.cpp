@@ -14,6 +14,8 @@
 //   reference_indirect      Embree "indirect" with the technique's bounce count, same G-buffer
 //   metric.indirect_error   indirect.* RMSE, relMSE, PSNR, mean signed error over surface pixels
 //   metric.indirect_flip    HDR-FLIP of the indirect irradiance
+//   metric.indirect_flicker the frame-to-frame change of the error along the camera path
+//                           (remember_indirect keeps the previous frame for it)
 //   images_indirect         technique, reference and signed error as EXR
 // (names of their own, so that the family runs beside the occlusion family in one frame)
 
@@ -25,6 +27,7 @@
 #include "experiment/image_files.h"
 #include "experiment/runner.h"
 #include "metrics/image_metrics.h"
+#include "metrics/temporal_metrics.h"
 #include "pipeline/compose.h"
 #include "pipeline/frame_graph.h"
 #include "pipeline/frame_start.h"
@@ -34,6 +37,21 @@
 
 namespace rtlab::families {
 namespace {
+
+Image<float> computeLuminance(const Image<glm::vec3>& rgb)
+{
+    Image<float> out(rgb.width, rgb.height, 0.0f);
+    for (std::size_t i = 0; i < rgb.pixels.size(); ++i)
+        out.pixels[i] = 0.2126f * rgb.pixels[i].x + 0.7152f * rgb.pixels[i].y +
+                        0.0722f * rgb.pixels[i].z;
+    return out;
+}
+
+// The previous frame's indirect light, for the flicker metric.
+struct PreviousIndirect {
+    Image<float> technique, reference, depth;
+    glm::mat4 projection{1.0f}, view{1.0f};
+};
 
 class VoxelGiRun final : public experiment::FamilyRun {
 public:
@@ -62,14 +80,23 @@ public:
             .set("reference.bounces", std::int64_t(mSettings.bounces));
     }
 
-    void beginFrame(int, experiment::ResultRow& row) override { mRow = &row; }
+    void beginFrame(int frame, experiment::ResultRow& row) override
+    {
+        mRow = &row;
+        mGraph->setExternalAvailable("previous_indirect", mHavePrevious,
+                                     frame == 0 ? "first frame of the run"
+                                                : "the previous frame has no ground truth");
+    }
 
     void endFrame(int, const std::vector<pipeline::PassRecord>& records,
                   experiment::ResultRow& row) override
     {
         // The technique's time: its three steps, CPU wall time (the GPU paths will add theirs).
         double total = 0.0;
+        mHavePrevious = false;
         for (const auto& r : records) {
+            if (r.name == "remember_indirect")
+                mHavePrevious = r.ran;
             const bool mine = r.name == "voxelize" || r.name == "light_injection" ||
                               r.name == "voxel_gather";
             if (!mine)
@@ -106,6 +133,7 @@ private:
         pipeline::FrameGraph& graph = setup.graph;
         pipeline::FrameStart& start = *setup.frameStart;
         mScene = &start.getScene();
+        mGraph = &graph;
         const int w = mRun.width, h = mRun.height;
         const auto sceneRes = start.scene();
         const auto sdfMeshes = start.sdfMeshes();
@@ -268,6 +296,49 @@ private:
                                                   ctx.read(view).surface)
                           .flip);
         });
+        // Flicker along the camera path: the frame-to-frame change of the indirect light's
+        // error at reprojected points (metrics/temporal_metrics.h), on luminance.
+        const auto previous = graph.addExternal<PreviousIndirect>(
+            "previous_indirect", pipeline::ResourceType::cpuImage("previous indirect", w, h),
+            &mPrevious);
+        graph.addPass({.name = "metric.indirect_flicker",
+                       .reads = {indirect, truth, view, gbuffer, previous},
+                       .writes = {"metric.indirect_flicker"},
+                       .measurement = true},
+                      [=, this](pipeline::PassContext& ctx) {
+                          const PreviousIndirect& before = ctx.read(previous);
+                          const scene::GBuffer& g = ctx.read(gbuffer);
+                          const Image<float> now = computeLuminance(ctx.read(indirect));
+                          const Image<float> truthNow = computeLuminance(ctx.read(truth).irradiance);
+                          const metrics::TemporalFrame then{.technique = &before.technique,
+                                                            .reference = &before.reference,
+                                                            .linearDepth = &before.depth,
+                                                            .projection = before.projection,
+                                                            .view = before.view};
+                          const metrics::TemporalFrame current{.technique = &now,
+                                                               .reference = &truthNow,
+                                                               .linearDepth = &g.depth,
+                                                               .projection = g.projection,
+                                                               .view = g.view,
+                                                               .mask = &ctx.read(view).surface};
+                          const auto change = metrics::computeTemporalChange(then, current);
+                          mRow->set("indirect_flicker.rms", change.flickerRms)
+                              .set("indirect_flicker.technique_change_rms", change.techniqueChangeRms)
+                              .set("indirect_flicker.reference_change_rms", change.referenceChangeRms)
+                              .set("indirect_flicker.used_share", change.usedShare);
+                          return pipeline::PassOutcome{};
+                      });
+        graph.addPass({.name = "remember_indirect",
+                       .reads = {indirect, truth, gbuffer},
+                       .writes = {"indirect_frame_memory"},
+                       .measurement = true},
+                      [=, this](pipeline::PassContext& ctx) {
+                          const scene::GBuffer& g = ctx.read(gbuffer);
+                          mPrevious = PreviousIndirect{computeLuminance(ctx.read(indirect)),
+                                                       computeLuminance(ctx.read(truth).irradiance),
+                                                       g.depth, g.projection, g.view};
+                          return pipeline::PassOutcome{};
+                      });
         graph.addPass({.name = "images_indirect",
                        .reads = {indirect, truth, view},
                        .writes = {"images_indirect"},
@@ -293,8 +364,11 @@ private:
                       });
         setup.outputs.push_back("images_indirect");
         for (const auto& m : setup.family.metrics)
-            if (mRun.wantsMetric(m.name))
+            if (mRun.wantsMetric(m.name)) {
                 setup.outputs.push_back("metric.indirect_" + m.name);
+                if (m.name == "flicker")
+                    setup.outputs.push_back("indirect_frame_memory");
+            }
     }
 
     const experiment::RunConfig& mRun;
@@ -310,6 +384,9 @@ private:
     std::uint64_t mGeometryEditKey = 0;
     int mGeometryFrame = -1;
     experiment::ResultRow* mRow = nullptr;
+    pipeline::FrameGraph* mGraph = nullptr;
+    PreviousIndirect mPrevious;
+    bool mHavePrevious = false;
 };
 
 class VoxelGiFamily final : public experiment::Family {
@@ -330,7 +407,9 @@ plugin::FamilyInfo describeVoxelGiFamily()
         .groundTruth = "Embree path tracer, indirect only, same lights and bounce count",
         .metrics = {{"error", "RMSE, relative MSE, PSNR, mean signed error of the indirect "
                               "irradiance over surface pixels (indirect.*)"},
-                    {"flip", "HDR-FLIP of the indirect irradiance (indirect.flip)"}},
+                    {"flip", "HDR-FLIP of the indirect irradiance (indirect.flip)"},
+                    {"flicker", "frame-to-frame change of the indirect light's error along the "
+                                "camera path, at reprojected points (indirect_flicker.*)"}},
     };
     info.domain = plugin::FamilyDomain::Screen;
     info.report = {.cost = "technique_ms",
@@ -340,7 +419,9 @@ plugin::FamilyInfo describeVoxelGiFamily()
                    .passes = {"voxelize_ms", "light_injection_ms", "voxel_gather_ms"},
                    .passTimeLabel = "time (ms, CPU)",
                    .extraErrors = {{"indirect.flip", "HDR-FLIP of indirect irradiance"},
-                                   {"indirect.rel_mse", "relative MSE of indirect irradiance"}},
+                                   {"indirect.rel_mse", "relative MSE of indirect irradiance"},
+                                   {"indirect_flicker.rms",
+                                    "flicker: RMS frame-to-frame change of the indirect error"}},
                    .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse",
                                     "indirect.flip", "memory.payload_bytes",
                                     "counter.surface_voxels", "counter.steps_per_cone"},
