@@ -83,6 +83,16 @@ public:
     //! Indirect diffuse irradiance at every G-buffer pixel (0 where there is no surface).
     virtual void gather(const VoxelGiInput& input, Image<glm::vec3>& irradiance) = 0;
     virtual VoxelGiMemory memory() const = 0;
+    //! For the split of the error: the technique's own voxels and light buffers gathered along
+    //! `raysPerPixel` rays per pixel (zero aperture, no 16-direction quadrature, the finest voxels
+    //! available) instead of its cones, at the same points. Technique vs this is the cone error;
+    //! this vs the ground truth is the error of the voxel representation (geometry and light
+    //! buffers). False when the technique has no such path.
+    virtual bool traceVoxelRays(const VoxelGiInput& input, int raysPerPixel,
+                                Image<glm::vec3>& irradiance)
+    {
+        return false;
+    }
 };
 
 } // namespace rtlab::plugin

@@ -14,6 +14,8 @@
 //   reference_indirect      Embree "indirect" with the technique's bounce count, same G-buffer
 //   metric.indirect_error   indirect.* RMSE, relMSE, PSNR, mean signed error over surface pixels
 //   metric.indirect_flip    HDR-FLIP of the indirect irradiance
+//   voxel_rays, metric.indirect_split  the error split: the technique's voxels gathered along
+//                           rays (traceVoxelRays) against its cones and against the truth
 //   metric.indirect_flicker the frame-to-frame change of the error along the camera path
 //                           (remember_indirect keeps the previous frame for it)
 //   images_indirect         technique, reference and signed error as EXR
@@ -33,6 +35,7 @@
 #include "pipeline/frame_start.h"
 #include "reference/reference.h"
 
+#include <cmath>
 #include <filesystem>
 
 namespace rtlab::families {
@@ -52,6 +55,9 @@ struct PreviousIndirect {
     Image<float> technique, reference, depth;
     glm::mat4 projection{1.0f}, view{1.0f};
 };
+
+// Rays per pixel of the split's voxel-ray gather (a 16 x 16 stratified grid).
+constexpr int kSplitRays = 256;
 
 class VoxelGiRun final : public experiment::FamilyRun {
 public:
@@ -296,6 +302,53 @@ private:
                                                   ctx.read(view).surface)
                           .flip);
         });
+        // The split of the error: the technique's voxels gathered along rays instead of cones.
+        const pipeline::Resource<Image<glm::vec3>> voxelRays{
+            "voxel_rays", pipeline::ResourceType::cpuImage("vec3", w, h)};
+        graph.addPass({.name = "voxel_rays",
+                       .reads = {voxelLight, gbuffer},
+                       .writes = {voxelRays},
+                       .measurement = true},
+                      [this, gbuffer, voxelRays](pipeline::PassContext& ctx) {
+                          plugin::VoxelGiInput input;
+                          input.gbuffer = &ctx.read(gbuffer);
+                          input.frameIndex = ctx.frame();
+                          Image<glm::vec3>& out = ctx.write(voxelRays);
+                          if (!mTechnique->traceVoxelRays(input, kSplitRays, out)) {
+                              out = Image<glm::vec3>();
+                              return pipeline::PassOutcome::skipped(
+                                  "technique '" + mTechniqueName + "' traces no voxel rays");
+                          }
+                          return pipeline::PassOutcome{};
+                      });
+        graph.addPass({.name = "metric.indirect_split",
+                       .reads = {indirect, voxelRays, truth, view},
+                       .writes = {"metric.indirect_split"},
+                       .measurement = true},
+                      [=, this](pipeline::PassContext& ctx) {
+                          const Image<glm::vec3>& rays = ctx.read(voxelRays);
+                          const auto& technique = ctx.read(indirect);
+                          const auto& surface = ctx.read(view).surface;
+                          metrics::ImageErrorOptions o;
+                          o.range = metrics::DynamicRange::Hdr;
+                          o.withSsim = false;
+                          o.withFlip = false;
+                          const bool have = rays.width == technique.width &&
+                                            rays.height == technique.height;
+                          const auto cone = have ? metrics::computeImageErrors(technique, rays, o, surface)
+                                                 : metrics::ImageErrors{};
+                          const auto voxels =
+                              have ? metrics::computeImageErrors(rays, ctx.read(truth).irradiance, o, surface)
+                                   : metrics::ImageErrors{};
+                          const double nan = std::nan("");
+                          mRow->set("split.cone_rmse", have ? cone.rmse : nan)
+                              .set("split.cone_mean_signed_error", have ? cone.meanSignedError : nan)
+                              .set("split.voxel_rmse", have ? voxels.rmse : nan)
+                              .set("split.voxel_mean_signed_error",
+                                   have ? voxels.meanSignedError : nan)
+                              .set("split.rays_per_pixel", std::int64_t(kSplitRays));
+                          return pipeline::PassOutcome{};
+                      });
         // Flicker along the camera path: the frame-to-frame change of the indirect light's
         // error at reprojected points (metrics/temporal_metrics.h), on luminance.
         const auto previous = graph.addExternal<PreviousIndirect>(
@@ -409,7 +462,11 @@ plugin::FamilyInfo describeVoxelGiFamily()
                               "irradiance over surface pixels (indirect.*)"},
                     {"flip", "HDR-FLIP of the indirect irradiance (indirect.flip)"},
                     {"flicker", "frame-to-frame change of the indirect light's error along the "
-                                "camera path, at reprojected points (indirect_flicker.*)"}},
+                                "camera path, at reprojected points (indirect_flicker.*)"},
+                    {"split", "the error split: technique against its own voxels gathered "
+                              "along 256 rays per pixel (split.cone_*: the cone approximation) "
+                              "and those against the ground truth (split.voxel_*: voxel geometry "
+                              "and light buffers)"}},
     };
     info.domain = plugin::FamilyDomain::Screen;
     info.report = {.cost = "technique_ms",
@@ -423,7 +480,8 @@ plugin::FamilyInfo describeVoxelGiFamily()
                                    {"indirect_flicker.rms",
                                     "flicker: RMS frame-to-frame change of the indirect error"}},
                    .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse",
-                                    "indirect.flip", "memory.payload_bytes",
+                                    "indirect.flip", "split.cone_rmse", "split.voxel_rmse",
+                                    "split.voxel_mean_signed_error", "memory.payload_bytes",
                                     "counter.surface_voxels", "counter.steps_per_cone"},
                    .acrossScenes = {
                        {.x = "scene.wall_voxels",

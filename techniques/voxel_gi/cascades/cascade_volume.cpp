@@ -521,6 +521,53 @@ void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::
     mCounters.meanStepsPerCone = cones ? double(steps) / double(cones) : 0.0;
 }
 
+void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
+{
+    out = Image<glm::vec3>(gbuffer.width, gbuffer.height, glm::vec3(0.0f));
+    struct GatherSampler {
+        const CascadeVolume* volume;
+        bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& o) const
+        {
+            return volume->sampleGathered(p, d, -1, dir, o); // -1: blend the faces along dir
+        }
+    } sampler{this};
+    const int side = std::max(1, int(std::lround(std::sqrt(double(rays)))));
+    tbb::parallel_for(0, gbuffer.height, [&](int y) {
+        for (int x = 0; x < gbuffer.width; ++x) {
+            if (!gbuffer.hasSurface(x, y))
+                continue;
+            const glm::dvec3 p(gbuffer.position.at(x, y));
+            const glm::dvec3 n(gbuffer.normal.at(x, y));
+            if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
+                continue;
+            const double start = selectLevel(p, 0.0);
+            if (start < 0.0)
+                continue;
+            const double v = mSettings.voxelSize * std::exp2(std::floor(start));
+            ConeMarchSettings march;
+            march.tanHalfAngle = 0.0;
+            march.stepScale = mSettings.stepScale;
+            march.startDistance = mSettings.startOffset * v;
+            const glm::dvec3 origin = p + n * (0.5 * mSettings.startOffset * v);
+            const glm::dvec3 helper = std::abs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+            const glm::dvec3 t = glm::normalize(glm::cross(helper, n)), b = glm::cross(n, t);
+            // A stratified side x side grid on the disk (Malley), turned by the pixel's hash.
+            const double turn = double((std::uint32_t(x) * 73856093u) ^ (std::uint32_t(y) * 19349663u)) /
+                                4294967296.0;
+            glm::dvec3 sum(0.0);
+            for (int i = 0; i < side; ++i)
+                for (int j = 0; j < side; ++j) {
+                    const double u1 = (i + 0.5) / side, u2 = (j + 0.5) / side + turn;
+                    const double r = std::sqrt(u1), phi = 2.0 * glm::pi<double>() * u2;
+                    const glm::dvec3 d = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b +
+                                                        std::sqrt(std::max(0.0, 1.0 - u1)) * n);
+                    sum += glm::dvec3(marchCone(sampler, origin, d, -1, march).light[kDirect]);
+                }
+            out.at(x, y) = glm::vec3(glm::max(glm::pi<double>() * sum / double(side * side), glm::dvec3(0.0)));
+        }
+    });
+}
+
 std::size_t CascadeVolume::getPayloadBytes() const
 {
     std::size_t bytes = 0;

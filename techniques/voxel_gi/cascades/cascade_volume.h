@@ -83,6 +83,10 @@ public:
     //! cone]; 0 for cones below the surface and for pixels without a surface or outside the
     //! cascade.
     void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! The same light gathered along `rays` cosine-distributed rays per pixel (zero aperture:
+    //! every sample at the finest level holding it), E = pi * mean radiance; the directions are
+    //! a stratified grid turned per pixel, so the result is deterministic.
+    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
     //! Indirect irradiance at every pixel of `gbuffer`: gatherCones combined per pixel
     //! (upsample.h combineCones), cones weighted by `coneVisibility` when given.
     void gather(const scene::GBuffer& gbuffer, const std::vector<Image<float>>* coneVisibility,

@@ -245,6 +245,17 @@ public:
         irradiance = voxelgi::combineCones(combine);
     }
 
+    bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
+                        Image<glm::vec3>& irradiance) override
+    {
+        // At the same representative pixels as the cones, upsampled the same way.
+        const voxelgi::ReducedGBuffer reduced = voxelgi::reduceGBuffer(*input.gbuffer, mTraceStep);
+        Image<glm::vec3> low;
+        mVolume->gatherRays(reduced.gbuffer, raysPerPixel, low);
+        irradiance = voxelgi::upsampleIrradiance(low, reduced, *input.gbuffer);
+        return true;
+    }
+
     plugin::VoxelGiMemory memory() const override
     {
         if (!mVolume)

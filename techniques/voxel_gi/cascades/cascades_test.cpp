@@ -97,6 +97,23 @@ TEST(Cascades, FurnaceMatchesItsClosedForm)
     }
 }
 
+TEST(Cascades, VoxelRaysSeeTheFurnaceToo)
+{
+    // The split's reference path (rays through the same voxels and light) in the furnace: the
+    // same closed form and tolerance as the cones.
+    scene::RenderScene s;
+    const auto m = addMaterial(s, glm::vec3(0.5f), glm::vec3(1.0f));
+    addRoom(s, glm::vec3(-0.3f), glm::vec3(0.3f), 0.3f, m);
+    CascadeVolume volume(furnaceSettings());
+    volume.voxelize(s, "furnace", glm::dvec3(0.0), 0, false);
+    volume.injectLight(s, "lights", 0, false);
+    Image<glm::vec3> e;
+    volume.gatherRays(makeFloorGBuffer(4, 4, -0.3, -0.2, 0.2, -0.2, 0.2), 64, e);
+    const double expected = glm::pi<double>() * 0.75;
+    for (const auto& p : e.pixels)
+        EXPECT_NEAR(p.x, expected, 0.035 * expected);
+}
+
 TEST(Cascades, OnePassConvergesToThreePasses)
 {
     CascadeSettings three = furnaceSettings();
