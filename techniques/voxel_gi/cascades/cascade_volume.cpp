@@ -453,6 +453,26 @@ bool CascadeVolume::sampleGathered(const glm::dvec3& p, double diameter, int con
     return sampleAt<true>(p, diameter, cone, dir, out);
 }
 
+bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
+                                 glm::dvec3& n, ConeMarchSettings& march) const
+{
+    if (!gbuffer.hasSurface(x, y))
+        return false;
+    const glm::dvec3 p(gbuffer.position.at(x, y));
+    n = glm::dvec3(gbuffer.normal.at(x, y));
+    if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
+        return false;
+    const double start = selectLevel(p, 0.0);
+    if (start < 0.0)
+        return false;
+    // Start a voxel of the pixel's start level out, along the normal and along the cone.
+    const double v = mSettings.voxelSize * std::exp2(std::floor(start));
+    march.stepScale = mSettings.stepScale;
+    march.startDistance = mSettings.startOffset * v;
+    origin = p + n * (0.5 * mSettings.startOffset * v);
+    return true;
+}
+
 void CascadeVolume::gather(const scene::GBuffer& gbuffer,
                            const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out)
 {
@@ -484,21 +504,11 @@ void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::
     std::vector<std::uint64_t> conesPerRow(std::size_t(gbuffer.height), 0);
     tbb::parallel_for(0, gbuffer.height, [&](int y) {
         for (int x = 0; x < gbuffer.width; ++x) {
-            if (!gbuffer.hasSurface(x, y))
-                continue;
-            const glm::dvec3 p(gbuffer.position.at(x, y));
-            const glm::dvec3 n(gbuffer.normal.at(x, y));
-            if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
-                continue;
-            const double start = selectLevel(p, 0.0);
-            if (start < 0.0)
-                continue; // outside every level: no indirect light
-            const double v = mSettings.voxelSize * std::exp2(std::floor(start));
+            glm::dvec3 origin, n;
             ConeMarchSettings march;
+            if (!preparePixel(gbuffer, x, y, origin, n, march))
+                continue; // no surface, or outside every level: no indirect light
             march.tanHalfAngle = mCones.tanHalfAngle;
-            march.stepScale = mSettings.stepScale;
-            march.startDistance = mSettings.startOffset * v;
-            const glm::dvec3 origin = p + n * (0.5 * mSettings.startOffset * v);
             const auto w = computeIrradianceWeights(mCones, n);
             const std::size_t base =
                 (std::size_t(y) * std::size_t(gbuffer.width) + std::size_t(x)) * kConeCount;
@@ -534,21 +544,11 @@ void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<gl
     const int side = std::max(1, int(std::lround(std::sqrt(double(rays)))));
     tbb::parallel_for(0, gbuffer.height, [&](int y) {
         for (int x = 0; x < gbuffer.width; ++x) {
-            if (!gbuffer.hasSurface(x, y))
-                continue;
-            const glm::dvec3 p(gbuffer.position.at(x, y));
-            const glm::dvec3 n(gbuffer.normal.at(x, y));
-            if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
-                continue;
-            const double start = selectLevel(p, 0.0);
-            if (start < 0.0)
-                continue;
-            const double v = mSettings.voxelSize * std::exp2(std::floor(start));
+            glm::dvec3 origin, n;
             ConeMarchSettings march;
-            march.tanHalfAngle = 0.0;
-            march.stepScale = mSettings.stepScale;
-            march.startDistance = mSettings.startOffset * v;
-            const glm::dvec3 origin = p + n * (0.5 * mSettings.startOffset * v);
+            if (!preparePixel(gbuffer, x, y, origin, n, march))
+                continue;
+            march.tanHalfAngle = 0.0; // rays
             const glm::dvec3 helper = std::abs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
             const glm::dvec3 t = glm::normalize(glm::cross(helper, n)), b = glm::cross(n, t);
             // A stratified side x side grid on the disk (Malley), turned by the pixel's hash.

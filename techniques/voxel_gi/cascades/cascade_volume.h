@@ -111,6 +111,10 @@ public:
     const Counters& getCounters() const { return mCounters; }
 
 private:
+    // Where a pixel's cones start (origin, normal, start distance and step); false when it has no
+    // surface or lies outside every level.
+    bool preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
+                      glm::dvec3& n, ConeMarchSettings& march) const;
     // The level to sample at p for footprint d, continuous; < 0 when p is outside every level.
     double selectLevel(const glm::dvec3& p, double diameter) const;
     template <bool Gathered>
