@@ -27,6 +27,57 @@ std::string formatShift(const glm::ivec3& s)
     return "(" + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
 }
 
+// The voxels of `old` that lie in `region` (old shifted by `shift` voxels), the rest empty.
+VoxelGrid scrollVoxels(const VoxelGrid& old, const VoxelRegion& region, const glm::ivec3& shift)
+{
+    VoxelGrid grid;
+    grid.region = region;
+    const std::size_t voxels = region.getVoxelCount();
+    grid.faces.assign(voxels * kFaceCount, glm::vec4(0.0f));
+    grid.emission.assign(voxels * kFaceCount, glm::vec3(0.0f));
+    grid.normal.assign(voxels, glm::vec3(0.0f));
+    grid.flags.assign(voxels, 0);
+    const int R = region.resolution;
+    for (int z = 0; z < R; ++z)
+        for (int y = 0; y < R; ++y)
+            for (int x = 0; x < R; ++x) {
+                const glm::ivec3 o = glm::ivec3(x, y, z) + shift;
+                if (o.x < 0 || o.y < 0 || o.z < 0 || o.x >= R || o.y >= R || o.z >= R)
+                    continue;
+                const std::size_t to = region.index(x, y, z), from = old.region.index(o.x, o.y, o.z);
+                for (int f = 0; f < kFaceCount; ++f) {
+                    grid.faces[to * kFaceCount + std::size_t(f)] = old.faces[from * kFaceCount + std::size_t(f)];
+                    grid.emission[to * kFaceCount + std::size_t(f)] =
+                        old.emission[from * kFaceCount + std::size_t(f)];
+                }
+                grid.normal[to] = old.normal[from];
+                grid.flags[to] = old.flags[from];
+            }
+    return grid;
+}
+
+// Copies the voxels of `part` in [begin, end) into `grid` (same region).
+void pasteVoxels(const VoxelGrid& part, const glm::ivec3& begin, const glm::ivec3& endIn,
+                 VoxelGrid& grid)
+{
+    const int R = grid.region.resolution;
+    glm::ivec3 end = endIn;
+    for (int a = 0; a < 3; ++a)
+        end[a] = end[a] < 0 ? R : end[a];
+    for (int z = begin.z; z < end.z; ++z)
+        for (int y = begin.y; y < end.y; ++y)
+            for (int x = begin.x; x < end.x; ++x) {
+                const std::size_t v = grid.region.index(x, y, z);
+                for (int f = 0; f < kFaceCount; ++f) {
+                    grid.faces[v * kFaceCount + std::size_t(f)] = part.faces[v * kFaceCount + std::size_t(f)];
+                    grid.emission[v * kFaceCount + std::size_t(f)] =
+                        part.emission[v * kFaceCount + std::size_t(f)];
+                }
+                grid.normal[v] = part.normal[v];
+                grid.flags[v] = part.flags[v];
+            }
+}
+
 } // namespace
 
 CascadeVolume::CascadeVolume(CascadeSettings settings)
@@ -99,9 +150,33 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         level = Level{};
         level.region = region;
         level.centre = region.origin + 0.5 * double(region.resolution) * region.voxelSize;
-        level.grid = voxelizeTriangles(geometry, region,
-                                       {.supersampling = mSettings.supersampling,
-                                        .solid = mSettings.solid});
+        const int R = region.resolution;
+        const bool onlyScrolled = old.voxelized && geometryKey == old.geometryKey && !force &&
+                                  shift != glm::ivec3(0) && glm::all(glm::lessThan(glm::abs(shift), glm::ivec3(R)));
+        if (onlyScrolled) {
+            // Keep the voxels the old region shares with the new one and voxelize only the new
+            // slabs ("Voxelize if Cascade level has moved": the geometry at the edges).
+            level.grid = scrollVoxels(old.grid, region, shift);
+            std::size_t slabVoxels = 0;
+            for (int a = 0; a < 3; ++a) {
+                if (shift[a] == 0)
+                    continue;
+                VoxelizeOptions options{.supersampling = mSettings.supersampling,
+                                        .solid = mSettings.solid};
+                options.boxBegin[a] = shift[a] > 0 ? R - shift[a] : 0;
+                options.boxEnd[a] = shift[a] > 0 ? R : -shift[a];
+                const VoxelGrid slab = voxelizeTriangles(geometry, region, options);
+                pasteVoxels(slab, options.boxBegin, options.boxEnd, level.grid);
+                slabVoxels += std::size_t(std::abs(shift[a])) * std::size_t(R) * std::size_t(R);
+            }
+            finalizeVoxelGrid(level.grid);
+            why += ", voxelized the new slabs (" + std::to_string(slabVoxels) + " of " +
+                   std::to_string(region.getVoxelCount()) + " voxels)";
+        } else {
+            level.grid = voxelizeTriangles(geometry, region,
+                                           {.supersampling = mSettings.supersampling,
+                                            .solid = mSettings.solid});
+        }
         level.geometryKey = geometryKey;
         level.voxelized = true;
         level.voxelStamp = ++mStamp;
@@ -117,7 +192,6 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         // geometry changed; shifted when the level scrolled, the missing edge taken from the
         // next coarser level ("Scrolling: missing edge info taken from next cascade up").
         if (old.voxelized) {
-            const int R = region.resolution;
             const Level* coarser =
                 i + 1 < getLevelCount() && mLevels[std::size_t(i) + 1].voxelized
                     ? &mLevels[std::size_t(i) + 1]
@@ -164,7 +238,6 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         // light is carried through the whole solid so that a cone whose footprint reaches
         // deeper into a wall sees the wall's surface light, not black.
         {
-            const int R = region.resolution;
             std::vector<std::uint32_t> source(region.getVoxelCount(), ~0u);
             std::vector<std::uint32_t> queue;
             for (const std::uint32_t v : level.grid.surfaceVoxels) {

@@ -189,11 +189,39 @@ TEST(Cascades, SkipsWhatDidNotChangeAndUpdatesOneLevelPerFrame)
     EXPECT_EQ(volume.injectLight(s, "l", 1, false), "");
     // The camera moves by two level-1 voxels: level 1, due at frame 2, scrolls.
     EXPECT_EQ(volume.voxelize(s, "a", glm::dvec3(0.25, 0.0, 0.0), 2, false),
-              "level 1: scrolled by (2, 0, 0) voxels");
-    // Culling off redoes the due level.
+              "level 1: scrolled by (2, 0, 0) voxels, voxelized the new slabs (512 of 4096 voxels)");
+    // Culling off redoes the due level whole.
     EXPECT_EQ(volume.voxelize(s, "a", glm::dvec3(0.25, 0.0, 0.0), 3, true),
               "level 0: scrolled by (4, 0, 0) voxels");
     EXPECT_EQ(volume.voxelize(s, "a", glm::dvec3(0.25, 0.0, 0.0), 5, true), "level 0: culling off");
+}
+
+TEST(Cascades, AScrollVoxelizesOnlyTheNewSlabsAndEqualsAFullVoxelization)
+{
+    // A box room and a furniture box; the camera moves by 3 level-0 voxels in x and 1 in z.
+    scene::RenderScene s;
+    const auto m = addMaterial(s, {0.6f, 0.5f, 0.4f}, {0.1f, 0.0f, 0.0f});
+    addRoom(s, glm::vec3(-0.4f), glm::vec3(0.4f), 0.1f, m);
+    addBox(s, glm::vec3(-0.13f, -0.4f, -0.2f), glm::vec3(0.07f, -0.17f, 0.05f), m);
+    CascadeSettings settings = furnaceSettings();
+    settings.resolution = 16;
+    settings.voxelSize = 1.0 / 16.0;
+    CascadeVolume scrolled(settings), fresh(settings);
+    const glm::dvec3 a(0.0), b(3.0 / 16.0 + 0.01, 0.0, -1.0 / 16.0);
+    scrolled.voxelize(s, "k", a, 0, false);
+    const std::string what = scrolled.voxelize(s, "k", b, 1, false);
+    EXPECT_NE(what.find("voxelized the new slabs"), std::string::npos) << what;
+    fresh.voxelize(s, "k", b, 0, false);
+    for (int level = 0; level < 2; ++level) {
+        const VoxelGrid& x = scrolled.getLevel(level).grid;
+        const VoxelGrid& y = fresh.getLevel(level).grid;
+        ASSERT_TRUE(x.region == y.region);
+        EXPECT_EQ(x.flags, y.flags) << level;
+        EXPECT_EQ(x.surfaceVoxels, y.surfaceVoxels) << level;
+        EXPECT_EQ(x.faces, y.faces) << level;
+        EXPECT_EQ(x.emission, y.emission) << level;
+        EXPECT_EQ(x.normal, y.normal) << level;
+    }
 }
 
 TEST(Cascades, DeterministicForAnyThreadCount)
