@@ -1,6 +1,7 @@
 #include "cascade_volume.h"
 
 #include "core/error.h"
+#include "core/hash.h"
 #include "families/voxel_gi/upsample.h"
 
 #include <glm/common.hpp>
@@ -122,12 +123,61 @@ std::vector<int> CascadeVolume::getDueLevels(int frame) const
     return due;
 }
 
+void CascadeVolume::trackGeometryChange(const scene::RenderScene& geometry,
+                                        const std::string& geometryKey)
+{
+    if (geometryKey == mTrianglesKey)
+        return;
+    std::vector<TriangleKey> keys(geometry.triangleCount());
+    for (std::size_t t = 0; t < keys.size(); ++t) {
+        Hasher h;
+        glm::vec3 lo(1e30f), hi(-1e30f);
+        for (int k = 0; k < 3; ++k) {
+            const glm::vec3 p = geometry.positions[geometry.indices[3 * t + std::size_t(k)]];
+            h.addValue(p);
+            lo = glm::min(lo, p);
+            hi = glm::max(hi, p);
+        }
+        h.addValue(geometry.triangleMaterial[t]);
+        const std::string digest = h.hexDigest();
+        keys[t] = {std::stoull(digest.substr(0, 16), nullptr, 16), lo, hi};
+    }
+    std::sort(keys.begin(), keys.end());
+    if (!mTrianglesKey.empty()) {
+        // The symmetric difference of the two sorted triangle sets: what a dig (or any edit)
+        // added or removed. Triangles kept unchanged by the re-mesh do not count.
+        glm::dvec3 lo(1e300), hi(-1e300);
+        std::size_t i = 0, j = 0;
+        const auto add = [&](const TriangleKey& k) {
+            lo = glm::min(lo, glm::dvec3(k.lo));
+            hi = glm::max(hi, glm::dvec3(k.hi));
+        };
+        while (i < mTriangles.size() || j < keys.size()) {
+            if (j == keys.size() || (i < mTriangles.size() && mTriangles[i].hash < keys[j].hash))
+                add(mTriangles[i++]);
+            else if (i == mTriangles.size() || keys[j].hash < mTriangles[i].hash)
+                add(keys[j++]);
+            else {
+                ++i;
+                ++j;
+            }
+        }
+        for (Level& level : mLevels) {
+            level.changedMin = glm::min(level.changedMin, lo);
+            level.changedMax = glm::max(level.changedMax, hi);
+        }
+    }
+    mTriangles = std::move(keys);
+    mTrianglesKey = geometryKey;
+}
+
 std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                                     const std::string& geometryKey, const glm::dvec3& camera,
                                     int frame, bool force)
 {
     if (mFirstFrame < 0)
         mFirstFrame = frame;
+    trackGeometryChange(geometry, geometryKey);
     mCounters.levelsVoxelized = 0;
     std::string what;
     for (const int i : getDueLevels(frame)) {
@@ -153,7 +203,39 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         const int R = region.resolution;
         const bool onlyScrolled = old.voxelized && geometryKey == old.geometryKey && !force &&
                                   shift != glm::ivec3(0) && glm::all(glm::lessThan(glm::abs(shift), glm::ivec3(R)));
-        if (onlyScrolled) {
+        // Only the geometry changed: the box of voxels the changed triangles touch, one voxel
+        // wider (a voxel's solid fill and coverage depend on the rays through its column).
+        glm::ivec3 dugBegin(0), dugEnd(0);
+        const bool onlyEdited = old.voxelized && !force && shift == glm::ivec3(0) &&
+                                geometryKey != old.geometryKey &&
+                                old.changedMin.x <= old.changedMax.x;
+        if (onlyEdited) {
+            dugBegin = glm::clamp(
+                glm::ivec3(glm::floor((old.changedMin - region.origin) / region.voxelSize)) - 1,
+                glm::ivec3(0), glm::ivec3(R));
+            dugEnd = glm::clamp(
+                glm::ivec3(glm::floor((old.changedMax - region.origin) / region.voxelSize)) + 2,
+                dugBegin, glm::ivec3(R));
+        }
+        if (onlyEdited) {
+            // "Voxelize ... any geometry that has just appeared or been changed" (the dug region).
+            level.grid = scrollVoxels(old.grid, region, glm::ivec3(0));
+            const glm::ivec3 extent = dugEnd - dugBegin;
+            const std::size_t boxVoxels =
+                std::size_t(extent.x) * std::size_t(extent.y) * std::size_t(extent.z);
+            if (boxVoxels > 0) {
+                VoxelizeOptions options{.supersampling = mSettings.supersampling,
+                                        .solid = mSettings.solid};
+                options.boxBegin = dugBegin;
+                options.boxEnd = dugEnd;
+                pasteVoxels(voxelizeTriangles(geometry, region, options), dugBegin, dugEnd,
+                            level.grid);
+                finalizeVoxelGrid(level.grid);
+            }
+            why += boxVoxels > 0 ? ": re-voxelized the changed region (" + std::to_string(boxVoxels) +
+                                       " of " + std::to_string(region.getVoxelCount()) + " voxels)"
+                                 : ": the change lies outside the level, nothing re-voxelized";
+        } else if (onlyScrolled) {
             // Keep the voxels the old region shares with the new one and voxelize only the new
             // slabs ("Voxelize if Cascade level has moved": the geometry at the edges).
             level.grid = scrollVoxels(old.grid, region, shift);

@@ -54,6 +54,9 @@ public:
         std::uint64_t litStamp = 0;   //!< what it was lit against: every stamp up to this one
         int litCount = 0;             //!< one-pass updates since its inputs last changed
         glm::dvec3 centre{0.0};
+        //! Bounds of the triangles that appeared or disappeared since it was voxelized (min > max
+        //! when none): what a re-voxelization of only the changed region must cover.
+        glm::dvec3 changedMin{1e300}, changedMax{-1e300};
         //! Solid voxels and the nearest surface voxel, whose light they mirror.
         std::vector<std::pair<std::uint32_t, std::uint32_t>> inward;
     };
@@ -130,6 +133,16 @@ private:
     ConeSet mCones;
     std::vector<Level> mLevels;
     bool isStale(int level) const;
+    // Records the triangles that appeared or disappeared since the last geometry (their bounds,
+    // into every level's changed box).
+    void trackGeometryChange(const scene::RenderScene& geometry, const std::string& geometryKey);
+    struct TriangleKey {
+        std::uint64_t hash = 0;
+        glm::vec3 lo{0.0f}, hi{0.0f};
+        bool operator<(const TriangleKey& o) const { return hash < o.hash; }
+    };
+    std::vector<TriangleKey> mTriangles; //!< of the last geometry seen, sorted by hash
+    std::string mTrianglesKey;
     std::uint64_t mStamp = 0;
     std::string mLightsKey;
     int mFirstFrame = -1;

@@ -18,7 +18,8 @@
 //    with supersampled coverage and solid fill; only the level due this frame is updated (level
 //    i every 2^(i+1) frames) unless `update: all_levels`; a level is re-voxelized only when its
 //    region scrolled (then only the new slabs are voxelized; the rest is shifted) or the geometry
-//    changed, its light carried over (a scrolled level takes the missing edge from the next
+//    changed (then only the voxels around the triangles that appeared or disappeared: the dug
+//    region), its light carried over (a scrolled level takes the missing edge from the next
 //    coarser level).
 // 2. Light injection per surface voxel: 16 cones gather emission, the sky (as 16 SRBF lobes on
 //    the cone directions, by the cones that leave the cascade) and, through the direct buffer,
@@ -36,8 +37,8 @@
 //
 // The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; the
 // voxelization and light injection run in C++ (TBB).
-// Not yet: voxelization and light injection on Vulkan, re-voxelizing only the dug region, split
-// near/far cones, the extrapolated third bounce, the 3D noise offset.
+// Not yet: voxelization and light injection on Vulkan, split near/far cones, the extrapolated
+// third bounce, the 3D noise offset.
 //
 // Parameters
 // | name           | type  | default           | range / choices                       | unit   |

@@ -224,6 +224,37 @@ TEST(Cascades, AScrollVoxelizesOnlyTheNewSlabsAndEqualsAFullVoxelization)
     }
 }
 
+TEST(Cascades, AnEditReVoxelizesOnlyTheChangedRegionAndEqualsAFullVoxelization)
+{
+    // The room with a box, then the box moved (a dig removes triangles and adds others).
+    const auto make = [](float x) {
+        scene::RenderScene s;
+        const auto m = addMaterial(s, {0.6f, 0.5f, 0.4f});
+        addRoom(s, glm::vec3(-0.4f), glm::vec3(0.4f), 0.1f, m);
+        addBox(s, glm::vec3(x, -0.4f, -0.2f), glm::vec3(x + 0.13f, -0.27f, -0.05f), m);
+        return s;
+    };
+    const scene::RenderScene before = make(-0.2f), after = make(-0.14f);
+    CascadeSettings settings = furnaceSettings();
+    settings.resolution = 16;
+    settings.voxelSize = 1.0 / 16.0;
+    CascadeVolume edited(settings), fresh(settings);
+    edited.voxelize(before, before.computeContentHash(), glm::dvec3(0.0), 0, false);
+    const std::string what =
+        edited.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 1, false);
+    EXPECT_NE(what.find("re-voxelized the changed region"), std::string::npos) << what;
+    fresh.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 0, false);
+    for (int level = 0; level < 2; ++level) {
+        const VoxelGrid& x = edited.getLevel(level).grid;
+        const VoxelGrid& y = fresh.getLevel(level).grid;
+        EXPECT_EQ(x.flags, y.flags) << level;
+        EXPECT_EQ(x.surfaceVoxels, y.surfaceVoxels) << level;
+        EXPECT_EQ(x.faces, y.faces) << level;
+        EXPECT_EQ(x.emission, y.emission) << level;
+        EXPECT_EQ(x.normal, y.normal) << level;
+    }
+}
+
 TEST(Cascades, DeterministicForAnyThreadCount)
 {
     Image<glm::vec3> one, two;
