@@ -70,6 +70,8 @@ TEST(VoxelGiDriver, CascadesFillTheIndirectSlotOfTheLitFrame)
         // Frame 1: a still camera and no edit, so the structure has nothing to update.
         if (i == 0) {
             EXPECT_NE(passes.find("voxelize:run"), std::string::npos) << passes;
+            EXPECT_NE(row.at("voxelize.did").find("level 2: first voxelization"), std::string::npos)
+                << row.at("voxelize.did");
             EXPECT_NE(passes.find("light_injection:run"), std::string::npos) << passes;
         } else {
             EXPECT_NE(passes.find("voxelize:skipped"), std::string::npos) << passes;

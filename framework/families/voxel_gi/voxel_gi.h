@@ -48,11 +48,13 @@ struct VoxelGiFrame {
     gpu::Context* gpu = nullptr;
 };
 
-//! What a step did: ran, or skipped with the reason.
+//! What a step did: ran (and what it did, for the row), or skipped with the reason.
 struct VoxelGiStep {
     bool ran = true;
     std::string skipReason;
-    static VoxelGiStep skipped(std::string why) { return {false, std::move(why)}; }
+    std::string did; //!< e.g. "level 1: scrolled by (2, 0, 0) voxels, voxelized the new slabs"
+    static VoxelGiStep skipped(std::string why) { return {false, std::move(why), {}}; }
+    static VoxelGiStep done(std::string what) { return {true, {}, std::move(what)}; }
 };
 
 struct VoxelGiInput {

@@ -191,6 +191,7 @@ private:
                           const scene::RenderScene& g = ctx.read(staticGeometry);
                           const plugin::VoxelGiStep step = mTechnique->voxelize(makeFrame(ctx, g));
                           ctx.write(voxels) = ctx.frame();
+                          mRow->set("voxelize.did", step.did);
                           return step.ran ? pipeline::PassOutcome{}
                                           : pipeline::PassOutcome::skipped(step.skipReason);
                       });
@@ -203,6 +204,7 @@ private:
                           const plugin::VoxelGiStep step =
                               mTechnique->injectLight(makeFrame(ctx, g));
                           ctx.write(voxelLight) = ctx.frame();
+                          mRow->set("light_injection.did", step.did);
                           return step.ran ? pipeline::PassOutcome{}
                                           : pipeline::PassOutcome::skipped(step.skipReason);
                       });

@@ -91,6 +91,10 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
 
     const int R = region.resolution;
     const int S = options.supersampling;
+    glm::ivec3 boxBegin = glm::clamp(options.boxBegin, glm::ivec3(0), glm::ivec3(R));
+    glm::ivec3 boxEnd = options.boxEnd;
+    for (int a = 0; a < 3; ++a)
+        boxEnd[a] = std::clamp(boxEnd[a] < 0 ? R : boxEnd[a], boxBegin[a], R);
     const int N = R * S;
     const double h = region.voxelSize / S;
     const std::size_t voxelCount = region.getVoxelCount();
@@ -146,13 +150,15 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
             }
             if (maxU < lo[u] || minU > hi[u] || maxV < lo[v] || minV > hi[v])
                 continue;
-            const int j0 = std::max(0, int(std::floor((minV - lo[v]) / region.voxelSize)));
-            const int j1 = std::min(R - 1, int(std::floor((maxV - lo[v]) / region.voxelSize)));
+            const int j0 =
+                std::max(boxBegin[v], int(std::floor((minV - lo[v]) / region.voxelSize)));
+            const int j1 =
+                std::min(boxEnd[v] - 1, int(std::floor((maxV - lo[v]) / region.voxelSize)));
             for (int j = j0; j <= j1; ++j)
                 buckets[std::size_t(j)].push_back(std::uint32_t(t));
         }
 
-        tbb::parallel_for(0, R, [&](int row) {
+        tbb::parallel_for(boxBegin[v], boxEnd[v], [&](int row) {
             // The S rays-rows of voxel row `row`, N rays each.
             std::vector<std::vector<Fragment>> rays(std::size_t(N) * std::size_t(S));
             std::size_t fragments = 0;
@@ -173,8 +179,8 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                 const glm::dvec2 A = q[order[0]], B = q[order[1]], C = q[order[2]];
                 const double minU = std::min({A.x, B.x, C.x}), maxU = std::max({A.x, B.x, C.x});
                 const double minV = std::min({A.y, B.y, C.y}), maxV = std::max({A.y, B.y, C.y});
-                const int i0 = std::max(0, int(std::ceil(minU / h - 0.5)));
-                const int i1 = std::min(N - 1, int(std::floor(maxU / h - 0.5)));
+                const int i0 = std::max(boxBegin[u] * S, int(std::ceil(minU / h - 0.5)));
+                const int i1 = std::min(boxEnd[u] * S - 1, int(std::floor(maxU / h - 0.5)));
                 const int jr0 = std::max(row * S, int(std::ceil(minV / h - 0.5)));
                 const int jr1 = std::min(row * S + S - 1, int(std::floor(maxV / h - 0.5)));
                 const bool entering = tri.normal[a] < 0.0; // a ray along +a meets its front
@@ -222,7 +228,7 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                         while (g + 1 < frags.size() &&
                                std::floor((frags[g + 1].depth - lo[a]) / region.voxelSize) == k)
                             ++g;
-                        if (k >= 0.0 && k < R) {
+                        if (k >= boxBegin[a] && k < boxEnd[a]) {
                             coord[a] = int(k);
                             const std::size_t vox = region.index(coord.x, coord.y, coord.z);
                             ++acc.surfaceRays[vox * 3 + std::size_t(a)];
@@ -261,15 +267,15 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                                 continue;
                             const double s0 = (spanStart - lo[a]) / region.voxelSize;
                             const double s1 = (fr.depth - lo[a]) / region.voxelSize;
-                            for (int k = std::max(0, int(std::floor(s0)));
-                                 k <= std::min(R - 1, int(std::floor(s1))); ++k) {
+                            for (int k = std::max(boxBegin[a], int(std::floor(s0)));
+                                 k <= std::min(boxEnd[a] - 1, int(std::floor(s1))); ++k) {
                                 if (!covered[std::size_t(k)])
                                     touched.push_back(k);
                                 covered[std::size_t(k)] |= 2;
                             }
                             if (middle)
-                                for (int k = std::max(0, int(std::ceil(s0 - 0.5)));
-                                     k <= std::min(R - 1, int(std::floor(s1 - 0.5))); ++k) {
+                                for (int k = std::max(boxBegin[a], int(std::ceil(s0 - 0.5)));
+                                     k <= std::min(boxEnd[a] - 1, int(std::floor(s1 - 0.5))); ++k) {
                                     coord[a] = k;
                                     ++acc.votes[region.index(coord.x, coord.y, coord.z)];
                                 }
@@ -325,7 +331,6 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
         }
         if (surface) {
             grid.flags[vox] = kVoxelSurface;
-            grid.surfaceVoxels.push_back(std::uint32_t(vox));
             const double len = glm::length(acc.normal[vox]);
             if (len > 1e-9)
                 grid.normal[vox] = glm::vec3(acc.normal[vox] / len);
@@ -333,6 +338,22 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
             grid.flags[vox] = kVoxelSolid;
         }
     }
+    local.solidVoxels = finalizeVoxelGrid(grid);
+    local.surfaceVoxels = grid.surfaceVoxels.size();
+    if (stats)
+        *stats = local;
+    return grid;
+}
+
+std::size_t finalizeVoxelGrid(VoxelGrid& grid)
+{
+    const VoxelRegion& region = grid.region;
+    const int R = region.resolution;
+    grid.surfaceVoxels.clear();
+    for (std::size_t vox = 0; vox < grid.flags.size(); ++vox)
+        if (grid.flags[vox] & kVoxelSurface)
+            grid.surfaceVoxels.push_back(std::uint32_t(vox));
+    std::size_t solidVoxels = 0;
     // Solid voxels: opaque on every face, the neighbouring surface's attributes one layer in.
     for (int z = 0; z < R; ++z)
         for (int y = 0; y < R; ++y)
@@ -340,7 +361,7 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                 const std::size_t vox = region.index(x, y, z);
                 if (!(grid.flags[vox] & kVoxelSolid))
                     continue;
-                ++local.solidVoxels;
+                ++solidVoxels;
                 glm::vec3 mean(0.0f);
                 int meanCount = 0;
                 glm::vec3 sideAlbedo[kFaceCount];
@@ -367,10 +388,7 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                     grid.faces[vox * kFaceCount + std::size_t(face)] =
                         glm::vec4(hasSide[face] ? sideAlbedo[face] : mean, 1.0f);
             }
-    local.surfaceVoxels = grid.surfaceVoxels.size();
-    if (stats)
-        *stats = local;
-    return grid;
+    return solidVoxels;
 }
 
 } // namespace rtlab::voxelgi

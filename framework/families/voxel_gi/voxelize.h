@@ -82,6 +82,11 @@ struct VoxelGrid {
 struct VoxelizeOptions {
     int supersampling = 4; //!< rays per voxel column and axis, per side (1..16)
     bool solid = true;     //!< fill closed spans and propagate attributes inward
+    //! Only the voxels in [boxBegin, boxEnd) (voxel indices; boxEnd -1 = the resolution) are
+    //! voxelized, the others stay empty: a scrolled slab or a dug region. A voxel's values depend
+    //! only on the rays through its column, so they equal those of a whole-region voxelization.
+    glm::ivec3 boxBegin{0};
+    glm::ivec3 boxEnd{-1};
 };
 
 struct VoxelizeStats {
@@ -91,9 +96,15 @@ struct VoxelizeStats {
     std::size_t solidVoxels = 0;
 };
 
-//! Voxelizes every triangle of `scene` that meets `region`. Throws rtlab::Error for a region
-//! with resolution < 1 or a non-positive or non-finite voxel size, or a bad option.
+//! Voxelizes every triangle of `scene` that meets `region` (its box). Throws rtlab::Error for a
+//! region with resolution < 1 or a non-positive or non-finite voxel size, or a bad option.
 VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& region,
                             const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
+
+//! The steps that look across voxels, after the grid's voxels were set (voxelizeTriangles does
+//! this; call it again after pasting parts of grids together): solid voxels' faces opaque with
+//! the neighbouring surface's albedo (one layer inward), and the list of surface voxels.
+//! Returns the number of solid voxels.
+std::size_t finalizeVoxelGrid(VoxelGrid& grid);
 
 } // namespace rtlab::voxelgi

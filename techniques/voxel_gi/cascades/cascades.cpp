@@ -208,8 +208,7 @@ public:
                                                    frame.cameraPosition, frame.frameIndex, frame.force);
         if (what.empty())
             return plugin::VoxelGiStep::skipped("no due level moved and the geometry is unchanged");
-        mLastVoxelized = what;
-        return {};
+        return plugin::VoxelGiStep::done(what);
     }
 
     plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
@@ -219,7 +218,7 @@ public:
         if (what.empty())
             return plugin::VoxelGiStep::skipped(
                 "the due level's voxels, lights and coarser levels are unchanged since it was lit");
-        return {};
+        return plugin::VoxelGiStep::done("lit " + what);
     }
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
@@ -292,7 +291,6 @@ private:
     bool mOnGpu = true;
     bool mGatheredOnGpu = false;
     int mTraceStep = 4;
-    std::string mLastVoxelized;
 };
 
 } // namespace
