@@ -31,9 +31,10 @@
 // 3. Per pixel, 16 cones (those above the surface) through the light the pixel gathers,
 //    front to back with step-corrected opacity, the start level blended by distance to the
 //    level centres, at one pixel per trace_step^2 block (the talk's quarter resolution)
-//    upsampled by depth and normal (families/voxel_gi/upsample.h); optional pre-combined
-//    direction buffers; the per-direction visibilities of
-//    bentcone_ssdo multiply the cones when that occlusion technique runs in the same frame.
+//    with optional pre-combined direction buffers. At full resolution each cone's radiance is
+//    upsampled by depth and normal and multiplied by the pixel's per-direction visibilities of
+//    bentcone_ssdo (when that occlusion technique runs in the same frame) and by the characters'
+//    capsules tested against the cone ("Characters": not voxelized; families/voxel_gi/upsample.h).
 //
 // The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; the
 // voxelization and light injection run in C++ (TBB).
