@@ -391,4 +391,57 @@ std::size_t finalizeVoxelGrid(VoxelGrid& grid)
     return solidVoxels;
 }
 
+// The voxels of `old` that lie in `region` (old shifted by `shift` voxels), the rest empty.
+VoxelGrid shiftVoxelGrid(const VoxelGrid& old, const VoxelRegion& region, const glm::ivec3& shift)
+{
+    VoxelGrid grid;
+    grid.region = region;
+    const std::size_t voxels = region.getVoxelCount();
+    grid.faces.assign(voxels * kFaceCount, glm::vec4(0.0f));
+    grid.emission.assign(voxels * kFaceCount, glm::vec3(0.0f));
+    grid.normal.assign(voxels, glm::vec3(0.0f));
+    grid.flags.assign(voxels, 0);
+    const int R = region.resolution;
+    for (int z = 0; z < R; ++z)
+        for (int y = 0; y < R; ++y)
+            for (int x = 0; x < R; ++x) {
+                const glm::ivec3 o = glm::ivec3(x, y, z) + shift;
+                if (o.x < 0 || o.y < 0 || o.z < 0 || o.x >= R || o.y >= R || o.z >= R)
+                    continue;
+                const std::size_t to = region.index(x, y, z), from = old.region.index(o.x, o.y, o.z);
+                for (int f = 0; f < kFaceCount; ++f) {
+                    grid.faces[to * kFaceCount + std::size_t(f)] = old.faces[from * kFaceCount + std::size_t(f)];
+                    grid.emission[to * kFaceCount + std::size_t(f)] =
+                        old.emission[from * kFaceCount + std::size_t(f)];
+                }
+                grid.normal[to] = old.normal[from];
+                grid.flags[to] = old.flags[from];
+            }
+    return grid;
+}
+
+// (voxelize.h)
+// Copies the voxels of `part` in [begin, end) into `grid` (same region).
+void pasteVoxelBox(const VoxelGrid& part, const glm::ivec3& begin, const glm::ivec3& endIn,
+                 VoxelGrid& grid)
+{
+    const int R = grid.region.resolution;
+    glm::ivec3 end = endIn;
+    for (int a = 0; a < 3; ++a)
+        end[a] = end[a] < 0 ? R : end[a];
+    for (int z = begin.z; z < end.z; ++z)
+        for (int y = begin.y; y < end.y; ++y)
+            for (int x = begin.x; x < end.x; ++x) {
+                const std::size_t v = grid.region.index(x, y, z);
+                for (int f = 0; f < kFaceCount; ++f) {
+                    grid.faces[v * kFaceCount + std::size_t(f)] = part.faces[v * kFaceCount + std::size_t(f)];
+                    grid.emission[v * kFaceCount + std::size_t(f)] =
+                        part.emission[v * kFaceCount + std::size_t(f)];
+                }
+                grid.normal[v] = part.normal[v];
+                grid.flags[v] = part.flags[v];
+            }
+}
+
+
 } // namespace rtlab::voxelgi

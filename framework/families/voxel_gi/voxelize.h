@@ -107,4 +107,11 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
 //! Returns the number of solid voxels.
 std::size_t finalizeVoxelGrid(VoxelGrid& grid);
 
+//! The voxels of `old` that lie in `region` (the same lattice, `shift` voxels further: region's
+//! voxel v is old's voxel v + shift), the rest empty; call finalizeVoxelGrid after filling it.
+VoxelGrid shiftVoxelGrid(const VoxelGrid& old, const VoxelRegion& region, const glm::ivec3& shift);
+//! Copies the voxels of `part` in [begin, end) (end -1 = the resolution) into `grid` (same region).
+void pasteVoxelBox(const VoxelGrid& part, const glm::ivec3& begin, const glm::ivec3& end,
+                   VoxelGrid& grid);
+
 } // namespace rtlab::voxelgi

@@ -28,57 +28,6 @@ std::string formatShift(const glm::ivec3& s)
     return "(" + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
 }
 
-// The voxels of `old` that lie in `region` (old shifted by `shift` voxels), the rest empty.
-VoxelGrid scrollVoxels(const VoxelGrid& old, const VoxelRegion& region, const glm::ivec3& shift)
-{
-    VoxelGrid grid;
-    grid.region = region;
-    const std::size_t voxels = region.getVoxelCount();
-    grid.faces.assign(voxels * kFaceCount, glm::vec4(0.0f));
-    grid.emission.assign(voxels * kFaceCount, glm::vec3(0.0f));
-    grid.normal.assign(voxels, glm::vec3(0.0f));
-    grid.flags.assign(voxels, 0);
-    const int R = region.resolution;
-    for (int z = 0; z < R; ++z)
-        for (int y = 0; y < R; ++y)
-            for (int x = 0; x < R; ++x) {
-                const glm::ivec3 o = glm::ivec3(x, y, z) + shift;
-                if (o.x < 0 || o.y < 0 || o.z < 0 || o.x >= R || o.y >= R || o.z >= R)
-                    continue;
-                const std::size_t to = region.index(x, y, z), from = old.region.index(o.x, o.y, o.z);
-                for (int f = 0; f < kFaceCount; ++f) {
-                    grid.faces[to * kFaceCount + std::size_t(f)] = old.faces[from * kFaceCount + std::size_t(f)];
-                    grid.emission[to * kFaceCount + std::size_t(f)] =
-                        old.emission[from * kFaceCount + std::size_t(f)];
-                }
-                grid.normal[to] = old.normal[from];
-                grid.flags[to] = old.flags[from];
-            }
-    return grid;
-}
-
-// Copies the voxels of `part` in [begin, end) into `grid` (same region).
-void pasteVoxels(const VoxelGrid& part, const glm::ivec3& begin, const glm::ivec3& endIn,
-                 VoxelGrid& grid)
-{
-    const int R = grid.region.resolution;
-    glm::ivec3 end = endIn;
-    for (int a = 0; a < 3; ++a)
-        end[a] = end[a] < 0 ? R : end[a];
-    for (int z = begin.z; z < end.z; ++z)
-        for (int y = begin.y; y < end.y; ++y)
-            for (int x = begin.x; x < end.x; ++x) {
-                const std::size_t v = grid.region.index(x, y, z);
-                for (int f = 0; f < kFaceCount; ++f) {
-                    grid.faces[v * kFaceCount + std::size_t(f)] = part.faces[v * kFaceCount + std::size_t(f)];
-                    grid.emission[v * kFaceCount + std::size_t(f)] =
-                        part.emission[v * kFaceCount + std::size_t(f)];
-                }
-                grid.normal[v] = part.normal[v];
-                grid.flags[v] = part.flags[v];
-            }
-}
-
 } // namespace
 
 CascadeVolume::CascadeVolume(CascadeSettings settings)
@@ -219,7 +168,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         }
         if (onlyEdited) {
             // "Voxelize ... any geometry that has just appeared or been changed" (the dug region).
-            level.grid = scrollVoxels(old.grid, region, glm::ivec3(0));
+            level.grid = shiftVoxelGrid(old.grid, region, glm::ivec3(0));
             const glm::ivec3 extent = dugEnd - dugBegin;
             const std::size_t boxVoxels =
                 std::size_t(extent.x) * std::size_t(extent.y) * std::size_t(extent.z);
@@ -228,7 +177,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                                         .solid = mSettings.solid};
                 options.boxBegin = dugBegin;
                 options.boxEnd = dugEnd;
-                pasteVoxels(voxelizeTriangles(geometry, region, options), dugBegin, dugEnd,
+                pasteVoxelBox(voxelizeTriangles(geometry, region, options), dugBegin, dugEnd,
                             level.grid);
                 finalizeVoxelGrid(level.grid);
             }
@@ -238,7 +187,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         } else if (onlyScrolled) {
             // Keep the voxels the old region shares with the new one and voxelize only the new
             // slabs ("Voxelize if Cascade level has moved": the geometry at the edges).
-            level.grid = scrollVoxels(old.grid, region, shift);
+            level.grid = shiftVoxelGrid(old.grid, region, shift);
             std::size_t slabVoxels = 0;
             for (int a = 0; a < 3; ++a) {
                 if (shift[a] == 0)
@@ -248,7 +197,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 options.boxBegin[a] = shift[a] > 0 ? R - shift[a] : 0;
                 options.boxEnd[a] = shift[a] > 0 ? R : -shift[a];
                 const VoxelGrid slab = voxelizeTriangles(geometry, region, options);
-                pasteVoxels(slab, options.boxBegin, options.boxEnd, level.grid);
+                pasteVoxelBox(slab, options.boxBegin, options.boxEnd, level.grid);
                 slabVoxels += std::size_t(std::abs(shift[a])) * std::size_t(R) * std::size_t(R);
             }
             finalizeVoxelGrid(level.grid);
@@ -409,14 +358,7 @@ std::string CascadeVolume::injectLight(const scene::RenderScene& geometry,
 void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry)
 {
     Level& level = mLevels[std::size_t(i)];
-    struct FieldSampler {
-        const CascadeVolume* volume;
-        bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
-                    ConeSample& out) const
-        {
-            return volume->sampleFields(p, d, cone, dir, out);
-        }
-    } sampler{this};
+    const FieldSampler sampler{this};
     InjectionLights lights;
     lights.pointLights = &geometry.pointLights;
     lights.hasSky = geometry.sky.emits();
@@ -606,121 +548,6 @@ bool CascadeVolume::sampleGathered(const glm::dvec3& p, double diameter, int con
                                    const glm::dvec3& dir, ConeSample& out) const
 {
     return sampleAt<true>(p, diameter, cone, dir, out);
-}
-
-bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
-                                 glm::dvec3& n, ConeMarchSettings& march) const
-{
-    if (!gbuffer.hasSurface(x, y))
-        return false;
-    const glm::dvec3 p(gbuffer.position.at(x, y));
-    n = glm::dvec3(gbuffer.normal.at(x, y));
-    if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
-        return false;
-    const double start = selectLevel(p, 0.0);
-    if (start < 0.0)
-        return false;
-    // Start a voxel of the pixel's start level out, along the normal and along the cone.
-    const double v = mSettings.voxelSize * std::exp2(std::floor(start));
-    march.stepScale = mSettings.stepScale;
-    march.startDistance = mSettings.startOffset * v;
-    origin = p + n * (0.5 * mSettings.startOffset * v);
-    return true;
-}
-
-void CascadeVolume::gather(const scene::GBuffer& gbuffer,
-                           const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out)
-{
-    std::vector<glm::vec3> cones;
-    gatherCones(gbuffer, cones);
-    const ReducedGBuffer same = reduceGBuffer(gbuffer, 1);
-    ConeCombineInputs in;
-    in.coneRadiance = &cones;
-    in.reduced = &same;
-    in.full = &gbuffer;
-    in.visibility = coneVisibility;
-    in.coneHalfAngle = mCones.halfAngle;
-    out = combineCones(in);
-}
-
-void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
-{
-    out.assign(std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount,
-               glm::vec3(0.0f));
-    struct GatherSampler {
-        const CascadeVolume* volume;
-        bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
-                    ConeSample& o) const
-        {
-            return volume->sampleGathered(p, d, cone, dir, o);
-        }
-    } sampler{this};
-    std::vector<std::uint64_t> stepsPerRow(std::size_t(gbuffer.height), 0);
-    std::vector<std::uint64_t> conesPerRow(std::size_t(gbuffer.height), 0);
-    tbb::parallel_for(0, gbuffer.height, [&](int y) {
-        for (int x = 0; x < gbuffer.width; ++x) {
-            glm::dvec3 origin, n;
-            ConeMarchSettings march;
-            if (!preparePixel(gbuffer, x, y, origin, n, march))
-                continue; // no surface, or outside every level: no indirect light
-            march.tanHalfAngle = mCones.tanHalfAngle;
-            const auto w = computeIrradianceWeights(mCones, n);
-            const std::size_t base =
-                (std::size_t(y) * std::size_t(gbuffer.width) + std::size_t(x)) * kConeCount;
-            for (int k = 0; k < kConeCount; ++k) {
-                if (w[std::size_t(k)] == 0.0)
-                    continue;
-                const ConeResult r =
-                    marchCone(sampler, origin, mCones.directions[std::size_t(k)], k, march);
-                stepsPerRow[std::size_t(y)] += std::uint64_t(r.steps);
-                ++conesPerRow[std::size_t(y)];
-                out[base + std::size_t(k)] = glm::max(r.light[kDirect], glm::vec3(0.0f));
-            }
-        }
-    });
-    std::uint64_t steps = 0, cones = 0;
-    for (std::size_t i = 0; i < stepsPerRow.size(); ++i) {
-        steps += stepsPerRow[i];
-        cones += conesPerRow[i];
-    }
-    mCounters.meanStepsPerCone = cones ? double(steps) / double(cones) : 0.0;
-}
-
-void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
-{
-    out = Image<glm::vec3>(gbuffer.width, gbuffer.height, glm::vec3(0.0f));
-    struct GatherSampler {
-        const CascadeVolume* volume;
-        bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& o) const
-        {
-            return volume->sampleGathered(p, d, -1, dir, o); // -1: blend the faces along dir
-        }
-    } sampler{this};
-    const int side = std::max(1, int(std::lround(std::sqrt(double(rays)))));
-    tbb::parallel_for(0, gbuffer.height, [&](int y) {
-        for (int x = 0; x < gbuffer.width; ++x) {
-            glm::dvec3 origin, n;
-            ConeMarchSettings march;
-            if (!preparePixel(gbuffer, x, y, origin, n, march))
-                continue;
-            march.tanHalfAngle = 0.0; // rays
-            const glm::dvec3 helper = std::abs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-            const glm::dvec3 t = glm::normalize(glm::cross(helper, n)), b = glm::cross(n, t);
-            // A stratified side x side grid on the disk (Malley), turned by the pixel's hash.
-            const double turn = double((std::uint32_t(x) * 73856093u) ^ (std::uint32_t(y) * 19349663u)) /
-                                4294967296.0;
-            glm::dvec3 sum(0.0);
-            for (int i = 0; i < side; ++i)
-                for (int j = 0; j < side; ++j) {
-                    const double u1 = (i + 0.5) / side, u2 = (j + 0.5) / side + turn;
-                    const double r = std::sqrt(u1), phi = 2.0 * glm::pi<double>() * u2;
-                    const glm::dvec3 d = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b +
-                                                        std::sqrt(std::max(0.0, 1.0 - u1)) * n);
-                    sum += glm::dvec3(marchCone(sampler, origin, d, -1, march).light[kDirect]);
-                }
-            out.at(x, y) = glm::vec3(glm::max(glm::pi<double>() * sum / double(side * side), glm::dvec3(0.0)));
-        }
-    });
 }
 
 std::size_t CascadeVolume::getPayloadBytes() const

@@ -102,6 +102,26 @@ public:
     bool sampleGathered(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
                         ConeSample& out) const;
 
+    //! marchCone's samplers over this volume: the light fields (injection) and the gathered
+    //! light (pixels; `perCone` false blends the faces along each direction, for rays).
+    struct FieldSampler {
+        const CascadeVolume* volume;
+        bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
+                    ConeSample& out) const
+        {
+            return volume->sampleFields(p, d, cone, dir, out);
+        }
+    };
+    struct GatheredSampler {
+        const CascadeVolume* volume;
+        bool perCone = true;
+        bool sample(const glm::dvec3& p, double d, int cone, const glm::dvec3& dir,
+                    ConeSample& out) const
+        {
+            return volume->sampleGathered(p, d, perCone ? cone : -1, dir, out);
+        }
+    };
+
     std::size_t getPayloadBytes() const;
     std::size_t getTopologyBytes() const;
     //! Counts of the last calls, for the row.

@@ -71,6 +71,22 @@ Image<glm::vec3> runFurnace(const CascadeSettings& settings, glm::dvec3 offset, 
     return e;
 }
 
+// Every level of `a` holds bitwise the voxels of `b`.
+void expectSameVoxels(const CascadeVolume& a, const CascadeVolume& b)
+{
+    ASSERT_EQ(a.getLevelCount(), b.getLevelCount());
+    for (int level = 0; level < a.getLevelCount(); ++level) {
+        const VoxelGrid& x = a.getLevel(level).grid;
+        const VoxelGrid& y = b.getLevel(level).grid;
+        ASSERT_TRUE(x.region == y.region) << level;
+        EXPECT_EQ(x.flags, y.flags) << level;
+        EXPECT_EQ(x.surfaceVoxels, y.surfaceVoxels) << level;
+        EXPECT_EQ(x.faces, y.faces) << level;
+        EXPECT_EQ(x.emission, y.emission) << level;
+        EXPECT_EQ(x.normal, y.normal) << level;
+    }
+}
+
 TEST(Cascades, RegistersWithItsParameters)
 {
     plugin::Registry registry;
@@ -212,16 +228,7 @@ TEST(Cascades, AScrollVoxelizesOnlyTheNewSlabsAndEqualsAFullVoxelization)
     const std::string what = scrolled.voxelize(s, "k", b, 1, false);
     EXPECT_NE(what.find("voxelized the new slabs"), std::string::npos) << what;
     fresh.voxelize(s, "k", b, 0, false);
-    for (int level = 0; level < 2; ++level) {
-        const VoxelGrid& x = scrolled.getLevel(level).grid;
-        const VoxelGrid& y = fresh.getLevel(level).grid;
-        ASSERT_TRUE(x.region == y.region);
-        EXPECT_EQ(x.flags, y.flags) << level;
-        EXPECT_EQ(x.surfaceVoxels, y.surfaceVoxels) << level;
-        EXPECT_EQ(x.faces, y.faces) << level;
-        EXPECT_EQ(x.emission, y.emission) << level;
-        EXPECT_EQ(x.normal, y.normal) << level;
-    }
+    expectSameVoxels(scrolled, fresh);
 }
 
 TEST(Cascades, AnEditReVoxelizesOnlyTheChangedRegionAndEqualsAFullVoxelization)
@@ -244,15 +251,7 @@ TEST(Cascades, AnEditReVoxelizesOnlyTheChangedRegionAndEqualsAFullVoxelization)
         edited.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 1, false);
     EXPECT_NE(what.find("re-voxelized the changed region"), std::string::npos) << what;
     fresh.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 0, false);
-    for (int level = 0; level < 2; ++level) {
-        const VoxelGrid& x = edited.getLevel(level).grid;
-        const VoxelGrid& y = fresh.getLevel(level).grid;
-        EXPECT_EQ(x.flags, y.flags) << level;
-        EXPECT_EQ(x.surfaceVoxels, y.surfaceVoxels) << level;
-        EXPECT_EQ(x.faces, y.faces) << level;
-        EXPECT_EQ(x.emission, y.emission) << level;
-        EXPECT_EQ(x.normal, y.normal) << level;
-    }
+    expectSameVoxels(edited, fresh);
 }
 
 TEST(Cascades, DeterministicForAnyThreadCount)
