@@ -1,6 +1,7 @@
 #include "families/voxel_gi/cone_tracing.h"
 
 #include "core/error.h"
+#include "core/hash.h"
 
 #include <glm/gtc/constants.hpp>
 #include <glm/trigonometric.hpp>
@@ -8,6 +9,22 @@
 #include <string>
 
 namespace rtlab::voxelgi {
+
+std::string computeLightsKey(const scene::RenderScene& g)
+{
+    Hasher h;
+    h.addValue(g.pointLights.size());
+    for (const auto& l : g.pointLights)
+        h.addValue(l.position).addValue(l.intensity);
+    h.addValue(int(g.sky.kind))
+        .addValue(g.sky.constant)
+        .addValue(g.sky.zenith)
+        .addValue(g.sky.horizon)
+        .addValue(g.sky.ground)
+        .addValue(g.sky.lobes)
+        .addValue(g.sky.sharpness);
+    return h.hexDigest();
+}
 
 ConeSet ConeSet::make(double halfAngleDegrees)
 {

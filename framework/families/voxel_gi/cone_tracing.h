@@ -20,6 +20,7 @@
 
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
 
 namespace rtlab::voxelgi {
@@ -122,6 +123,10 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
     r.transmittance = 1.0 - occupied;
     return r;
 }
+
+//! Changes exactly when the point lights or the sky change (what light injection depends on
+//! besides the voxels).
+std::string computeLightsKey(const scene::RenderScene& scene);
 
 //! The light of the frame that voxels receive directly.
 struct InjectionLights {

@@ -114,4 +114,15 @@ VoxelGrid shiftVoxelGrid(const VoxelGrid& old, const VoxelRegion& region, const 
 void pasteVoxelBox(const VoxelGrid& part, const glm::ivec3& begin, const glm::ivec3& end,
                    VoxelGrid& grid);
 
+//! The cells of a lattice (min corner `origin`, cube cells of `cellSize`, `cells` per axis) that
+//! a triangle of `scene` meets, for sparse structures that are built from the voxels geometry
+//! passes through (the "voxel fragments" of Crassin et al. 2011; the solid children of Quantum
+//! Break's tree). Closed cells: a triangle touching a cell's face meets it. Exact separating-axis
+//! test per cell (Akenine-Moeller 2001, "Fast 3D Triangle-Box Overlap Testing"), visiting only
+//! the cells around the triangle's plane. Sorted by (z, y, x), unique; degenerate and non-finite
+//! triangles meet nothing. Throws rtlab::Error for a non-positive cell size or cell count.
+std::vector<glm::ivec3> listCellsMeetingTriangles(const scene::RenderScene& scene,
+                                                  const glm::dvec3& origin, double cellSize,
+                                                  const glm::ivec3& cells);
+
 } // namespace rtlab::voxelgi

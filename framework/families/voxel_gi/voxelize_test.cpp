@@ -7,10 +7,14 @@
 
 #include "core/error.h"
 
+#include <glm/common.hpp>
+#include <glm/vector_relational.hpp>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <set>
+#include <tuple>
 
 using namespace rtlab;
 using namespace rtlab::voxelgi;
@@ -175,6 +179,109 @@ TEST(Voxelize, EmptyAndDegenerateInputGiveEmptyGridsOrClearErrors)
     EXPECT_THROW(voxelizeTriangles(empty, {glm::dvec3(0.0), 0.0, 4}, {}), Error);
     EXPECT_THROW(voxelizeTriangles(empty, {glm::dvec3(0.0), 1.0, 0}, {}), Error);
     EXPECT_THROW(voxelizeTriangles(empty, unitRegion(4), {.supersampling = 0}), Error);
+}
+
+// listCellsMeetingTriangles: exact cases, then completeness against points sampled on random
+// triangles (every cell holding a point of a triangle must be listed) and a bound on the extra
+// cells (a listed cell lies within one cell of a sampled point).
+scene::RenderScene oneTriangle(glm::vec3 a, glm::vec3 b, glm::vec3 c)
+{
+    scene::RenderScene s;
+    s.positions = {a, b, c};
+    s.indices = {0, 1, 2};
+    s.triangleMaterial = {addMaterial(s, glm::vec3(0.5f))};
+    return s;
+}
+
+TEST(SurfaceCells, AxisAlignedTrianglesMeetExactlyTheirLayer)
+{
+    // In the middle of layer z = 2 of a 4^3 lattice of unit cells: the 3 x 3 cells under it...
+    const auto mid = listCellsMeetingTriangles(
+        oneTriangle({0.5f, 0.5f, 2.5f}, {2.5f, 0.5f, 2.5f}, {0.5f, 2.5f, 2.5f}), glm::dvec3(0.0), 1.0,
+        glm::ivec3(4));
+    // ...that the triangle x + y <= 3 touches: (x, y) with x + y <= 3, x, y in 0..2.
+    EXPECT_EQ(mid.size(), 8u); // all but (2, 2); (1, 2) and (2, 1) touch it at a corner
+    for (const auto& c : mid) {
+        EXPECT_EQ(c.z, 2);
+        EXPECT_LE(c.x + c.y, 3);
+    }
+    // On the boundary between layers 1 and 2: both layers (closed cells).
+    const auto onFace = listCellsMeetingTriangles(
+        oneTriangle({0.5f, 0.5f, 2.0f}, {0.9f, 0.5f, 2.0f}, {0.5f, 0.9f, 2.0f}), glm::dvec3(0.0), 1.0,
+        glm::ivec3(4));
+    ASSERT_EQ(onFace.size(), 2u);
+    EXPECT_EQ(onFace[0], glm::ivec3(0, 0, 1));
+    EXPECT_EQ(onFace[1], glm::ivec3(0, 0, 2));
+    // Outside the lattice: nothing; degenerate and NaN: nothing.
+    EXPECT_TRUE(listCellsMeetingTriangles(oneTriangle({5, 5, 5}, {6, 5, 5}, {5, 6, 5}), glm::dvec3(0.0),
+                                          1.0, glm::ivec3(4))
+                    .empty());
+    EXPECT_TRUE(listCellsMeetingTriangles(oneTriangle({1, 1, 1}, {2, 2, 2}, {3, 3, 3}), glm::dvec3(0.0),
+                                          1.0, glm::ivec3(4))
+                    .empty());
+    EXPECT_TRUE(listCellsMeetingTriangles(oneTriangle({1, NAN, 1}, {2, 1, 1}, {1, 2, 1}), glm::dvec3(0.0),
+                                          1.0, glm::ivec3(4))
+                    .empty());
+    EXPECT_THROW(listCellsMeetingTriangles(scene::RenderScene{}, glm::dvec3(0.0), 0.0, glm::ivec3(4)),
+                 Error);
+}
+
+TEST(SurfaceCells, RandomTrianglesListEveryCellTheyPassThrough)
+{
+    std::uint32_t state = 12345u;
+    auto next = [&] {
+        state = state * 1664525u + 1013904223u;
+        return float(state >> 8) / float(1u << 24);
+    };
+    for (const glm::dvec3 origin : {glm::dvec3(0.0), glm::dvec3(1e5, -2e5, 3e5)}) {
+        scene::RenderScene s;
+        const auto m = addMaterial(s, glm::vec3(0.5f));
+        for (int t = 0; t < 40; ++t) {
+            for (int k = 0; k < 3; ++k)
+                s.positions.push_back(glm::vec3(origin) +
+                                      glm::vec3(0.2f + 7.6f * next(), 0.2f + 7.6f * next(), 0.2f + 7.6f * next()));
+            s.indices.insert(s.indices.end(), {std::uint32_t(3 * t), std::uint32_t(3 * t + 1),
+                                               std::uint32_t(3 * t + 2)});
+            s.triangleMaterial.push_back(m);
+        }
+        const double cell = 0.5;
+        const auto cells = listCellsMeetingTriangles(s, origin, cell, glm::ivec3(16));
+        std::set<std::tuple<int, int, int>> listed;
+        for (const auto& c : cells)
+            listed.insert({c.x, c.y, c.z});
+        EXPECT_EQ(listed.size(), cells.size()) << "unique";
+        // Completeness: points on each triangle, away from cell faces by more than float error.
+        std::set<std::tuple<int, int, int>> touched;
+        int missing = 0;
+        for (std::size_t t = 0; t < s.indices.size() / 3; ++t) {
+            const glm::dvec3 a = glm::dvec3(s.positions[3 * t]) - origin,
+                             b = glm::dvec3(s.positions[3 * t + 1]) - origin,
+                             c = glm::dvec3(s.positions[3 * t + 2]) - origin;
+            for (int i = 0; i <= 60; ++i)
+                for (int j = 0; i + j <= 60; ++j) {
+                    const glm::dvec3 p = (a + (b - a) * (i / 60.0) + (c - a) * (j / 60.0)) / cell;
+                    const glm::dvec3 f = p - glm::floor(p);
+                    if (glm::any(glm::lessThan(glm::min(f, 1.0 - f), glm::dvec3(1e-3))))
+                        continue;
+                    const glm::ivec3 q(glm::floor(p));
+                    touched.insert({q.x, q.y, q.z});
+                    missing += listed.count({q.x, q.y, q.z}) ? 0 : 1;
+                }
+        }
+        EXPECT_EQ(missing, 0);
+        // Soundness, loosely: a listed cell that no sampled point fell into must neighbour one
+        // that did (the sampling spacing is below a cell).
+        int far = 0;
+        for (const auto& c : cells) {
+            bool near = false;
+            for (int dz = -1; dz <= 1 && !near; ++dz)
+                for (int dy = -1; dy <= 1 && !near; ++dy)
+                    for (int dx = -1; dx <= 1 && !near; ++dx)
+                        near = touched.count({c.x + dx, c.y + dy, c.z + dz}) != 0;
+            far += near ? 0 : 1;
+        }
+        EXPECT_EQ(far, 0);
+    }
 }
 
 } // namespace

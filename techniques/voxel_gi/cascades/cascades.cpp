@@ -85,22 +85,6 @@ namespace {
 
 using namespace rtlab;
 
-std::string computeLightsKey(const scene::RenderScene& g)
-{
-    Hasher h;
-    h.addValue(g.pointLights.size());
-    for (const auto& l : g.pointLights)
-        h.addValue(l.position).addValue(l.intensity);
-    h.addValue(int(g.sky.kind))
-        .addValue(g.sky.constant)
-        .addValue(g.sky.zenith)
-        .addValue(g.sky.horizon)
-        .addValue(g.sky.ground)
-        .addValue(g.sky.lobes)
-        .addValue(g.sky.sharpness);
-    return h.hexDigest();
-}
-
 class Cascades final : public plugin::VoxelGiTechnique {
 public:
     static plugin::TechniqueInfo describe()
@@ -214,7 +198,7 @@ public:
 
     plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
     {
-        const std::string what = mVolume->injectLight(*frame.geometry, computeLightsKey(*frame.geometry),
+        const std::string what = mVolume->injectLight(*frame.geometry, voxelgi::computeLightsKey(*frame.geometry),
                                                       frame.frameIndex, frame.force);
         if (what.empty())
             return plugin::VoxelGiStep::skipped(

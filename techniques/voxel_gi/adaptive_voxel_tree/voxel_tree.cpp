@@ -1,0 +1,326 @@
+#include "voxel_tree.h"
+
+#include "core/error.h"
+
+#include <glm/geometric.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <limits>
+#include <string>
+
+namespace rtlab::voxelgi {
+
+namespace {
+
+std::string toString(const glm::ivec3& c)
+{
+    return "(" + std::to_string(c.x) + ", " + std::to_string(c.y) + ", " + std::to_string(c.z) + ")";
+}
+
+bool inside(const glm::ivec3& c, const glm::ivec3& cells)
+{
+    return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < cells.x && c.y < cells.y && c.z < cells.z;
+}
+
+// Sort key of a cell of `level`: root cell index, then one 6-bit child digit per level below the
+// root. Sorting by it gives the breadth-first order of each level in which children are packed.
+std::uint64_t makeKey(const VoxelTreeLayout& layout, int level, const glm::ivec3& c)
+{
+    const glm::ivec3 root = c >> (2 * level);
+    std::uint64_t key = std::uint64_t(root.x) +
+                        std::uint64_t(layout.rootCells.x) *
+                            (std::uint64_t(root.y) + std::uint64_t(layout.rootCells.y) * std::uint64_t(root.z));
+    for (int l = 1; l <= level; ++l)
+        key = (key << 6) | std::uint64_t(getChildBit(c >> (2 * (level - l))));
+    return key;
+}
+
+glm::ivec3 decodeKey(const VoxelTreeLayout& layout, int level, std::uint64_t key)
+{
+    glm::ivec3 below(0);
+    for (int l = 0; l < level; ++l) {
+        const int bit = int(key & 63u);
+        below += glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4) << (2 * l);
+        key >>= 6;
+    }
+    const auto rx = std::uint64_t(layout.rootCells.x), ry = std::uint64_t(layout.rootCells.y);
+    const glm::ivec3 root(int(key % rx), int((key / rx) % ry), int(key / (rx * ry)));
+    return (root << (2 * level)) + below;
+}
+
+void sortUnique(std::vector<std::uint64_t>& keys)
+{
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+}
+
+} // namespace
+
+AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::vector<glm::ivec3> leaves,
+                                           bool dilate)
+{
+    if (layout.depth < 1 || layout.depth > 8)
+        throw Error("adaptive voxel tree: depth " + std::to_string(layout.depth) +
+                    " is outside [1, 8]");
+    if (layout.rootCells.x < 1 || layout.rootCells.y < 1 || layout.rootCells.z < 1)
+        throw Error("adaptive voxel tree: root cells " + toString(layout.rootCells) +
+                    " must be at least 1 per axis");
+    const double rootCount =
+        double(layout.rootCells.x) * double(layout.rootCells.y) * double(layout.rootCells.z);
+    // Keys hold the root index and 6 bits per level; leaf coordinates must fit an int.
+    if (rootCount * std::ldexp(1.0, 6 * layout.depth) >= std::ldexp(1.0, 63) ||
+        double(std::max({layout.rootCells.x, layout.rootCells.y, layout.rootCells.z})) *
+                std::ldexp(1.0, 2 * layout.depth) >= 2147483647.0)
+        throw Error("adaptive voxel tree: " + toString(layout.rootCells) + " root cells of depth " +
+                    std::to_string(layout.depth) + " address more cells than 63-bit keys hold");
+
+    AdaptiveVoxelTree tree;
+    tree.mLayout = layout;
+    tree.mDilated = dilate;
+    const int depth = layout.depth;
+    std::vector<std::vector<std::uint64_t>> keys(std::size_t(depth) + 1);
+
+    const glm::ivec3 leafCells = layout.getCells(depth);
+    keys[std::size_t(depth)].reserve(leaves.size());
+    for (const glm::ivec3& c : leaves) {
+        if (!inside(c, leafCells))
+            throw Error("adaptive voxel tree: leaf " + toString(c) + " is outside the grid of " +
+                        toString(leafCells) + " leaf cells");
+        keys[std::size_t(depth)].push_back(makeKey(layout, depth, c));
+    }
+    leaves.clear();
+    leaves.shrink_to_fit();
+    sortUnique(keys[std::size_t(depth)]);
+
+    // Upper levels: the parents of the level below, dilated by one cell (a 3x3x3 block) when
+    // asked, except at level 0, which is dense.
+    for (int level = depth - 1; level >= 1; --level) {
+        auto& out = keys[std::size_t(level)];
+        const auto& below = keys[std::size_t(level) + 1];
+        std::vector<std::uint64_t> parents;
+        parents.reserve(below.size() / 8 + 1);
+        for (std::uint64_t k : below)
+            if (parents.empty() || parents.back() != (k >> 6))
+                parents.push_back(k >> 6); // below is sorted, so equal parents are adjacent
+        if (!dilate) {
+            out = std::move(parents);
+            continue;
+        }
+        const glm::ivec3 cells = layout.getCells(level);
+        out.reserve(parents.size() * 4);
+        for (std::uint64_t k : parents) {
+            const glm::ivec3 c = decodeKey(layout, level, k);
+            for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
+                        if (inside(n, cells))
+                            out.push_back(makeKey(layout, level, n));
+                    }
+        }
+        sortUnique(out);
+    }
+    auto& roots = keys[0];
+    roots.resize(std::size_t(rootCount));
+    for (std::size_t i = 0; i < roots.size(); ++i)
+        roots[i] = i;
+
+    tree.mLevelBegin.assign(std::size_t(depth) + 2, 0);
+    for (int level = 0; level <= depth; ++level)
+        tree.mLevelBegin[std::size_t(level) + 1] =
+            tree.mLevelBegin[std::size_t(level)] + keys[std::size_t(level)].size();
+    if (tree.mLevelBegin.back() >= std::numeric_limits<std::uint32_t>::max())
+        throw Error("adaptive voxel tree: " + std::to_string(tree.mLevelBegin.back()) +
+                    " elements do not fit 32-bit indices");
+
+    tree.mNodes.resize(tree.mLevelBegin[std::size_t(depth)]);
+    for (int level = 0; level < depth; ++level) {
+        const auto& parents = keys[std::size_t(level)];
+        const auto& children = keys[std::size_t(level) + 1];
+        std::size_t j = 0;
+        for (std::size_t i = 0; i < parents.size(); ++i) {
+            VoxelTreeNode& node = tree.mNodes[tree.mLevelBegin[std::size_t(level)] + i];
+            node.offset = std::uint32_t(tree.mLevelBegin[std::size_t(level) + 1] + j);
+            std::uint64_t mask = 0;
+            while (j < children.size() && (children[j] >> 6) == parents[i]) {
+                mask |= std::uint64_t(1) << (children[j] & 63u);
+                ++j;
+            }
+            node.maskLo = std::uint32_t(mask);
+            node.maskHi = std::uint32_t(mask >> 32);
+        }
+    }
+    tree.mLeafCount = keys[std::size_t(depth)].size();
+    return tree;
+}
+
+std::int64_t AdaptiveVoxelTree::find(int level, const glm::ivec3& c) const
+{
+    if (level < 0 || level > mLayout.depth || !inside(c, mLayout.getCells(level)))
+        return kAbsent;
+    const glm::ivec3 root = c >> (2 * level);
+    std::uint32_t index = std::uint32_t(
+        root.x + mLayout.rootCells.x * (root.y + mLayout.rootCells.y * root.z));
+    for (int l = 1; l <= level; ++l) {
+        const VoxelTreeNode& node = mNodes[index];
+        const std::uint64_t mask = node.getMask();
+        const int bit = getChildBit(c >> (2 * (level - l)));
+        if (((mask >> bit) & 1u) == 0)
+            return kAbsent;
+        // The talk's child index: offset + the set bits below this one (one popcnt).
+        index = node.offset + std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
+    }
+    return std::int64_t(index);
+}
+
+std::vector<glm::ivec4> AdaptiveVoxelTree::listElementCells() const
+{
+    std::vector<glm::ivec4> cells(getElementCount());
+    const glm::ivec3& roots = mLayout.rootCells;
+    for (int z = 0; z < roots.z; ++z)
+        for (int y = 0; y < roots.y; ++y)
+            for (int x = 0; x < roots.x; ++x)
+                cells[std::size_t(x + roots.x * (y + roots.y * z))] = glm::ivec4(x, y, z, 0);
+    // Nodes are in breadth-first order, so a node's cell is known before its children's.
+    for (std::size_t i = 0; i < mNodes.size(); ++i) {
+        const glm::ivec4 parent = cells[i];
+        std::uint64_t mask = mNodes[i].getMask();
+        std::uint32_t child = mNodes[i].offset;
+        while (mask != 0) {
+            const int bit = std::countr_zero(mask);
+            mask &= mask - 1;
+            const glm::ivec3 c = glm::ivec3(parent) * 4 + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4);
+            cells[child++] = glm::ivec4(c, parent.w + 1);
+        }
+    }
+    return cells;
+}
+
+AdaptiveVoxelTree::Deepest AdaptiveVoxelTree::findDeepest(const glm::ivec3& leafCell) const
+{
+    const int depth = mLayout.depth;
+    const glm::ivec3 c = glm::clamp(leafCell, glm::ivec3(0), mLayout.getCells(depth) - 1);
+    const glm::ivec3 root = c >> (2 * depth);
+    std::uint32_t index = std::uint32_t(
+        root.x + mLayout.rootCells.x * (root.y + mLayout.rootCells.y * root.z));
+    for (int l = 1; l <= depth; ++l) {
+        const VoxelTreeNode& node = mNodes[index];
+        const std::uint64_t mask = node.getMask();
+        const int bit = getChildBit(c >> (2 * (depth - l)));
+        if (((mask >> bit) & 1u) == 0)
+            return {l - 1, std::int64_t(index), mask != 0};
+        index = node.offset + std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
+    }
+    return {depth, std::int64_t(index), false};
+}
+
+namespace {
+
+struct StencilBuilder {
+    const AdaptiveVoxelTree& tree;
+    const TreeQuery& query;
+    glm::dvec3 p;
+    TreeStencil& out;
+    double dropped = 0.0;
+
+    double getCellSize(int level) const
+    {
+        return query.leafSize * std::ldexp(1.0, 2 * (tree.getDepth() - level));
+    }
+
+    void emit(std::uint32_t index, int level, const glm::ivec3& cell, double w)
+    {
+        if (glm::dot(query.normal, query.normal) > 0.0) {
+            const glm::dvec3 x = query.origin + (glm::dvec3(cell) + 0.5) * getCellSize(level);
+            const glm::dvec3 d = x - p;
+            const double len = glm::length(d);
+            if (len > 0.0) {
+                const double wrap = 0.5 * (1.0 + glm::dot(query.normal, d) / len);
+                w *= std::max(1e-3, wrap * wrap);
+            }
+        }
+        for (int i = 0; i < out.count; ++i)
+            if (out.index[std::size_t(i)] == index) {
+                out.weight[std::size_t(i)] += float(w);
+                return;
+            }
+        if (out.count == TreeStencil::kMax)
+            return; // cannot happen: see kMax
+        out.index[std::size_t(out.count)] = index;
+        out.weight[std::size_t(out.count)] = float(w);
+        ++out.count;
+    }
+
+    // Trilinear neighbourhood at `level` of the point q (continuous cell coordinates of that
+    // level, cell centres at integer + 0.5), each corner weighted by w times its trilinear weight.
+    void addNeighbourhood(int level, const glm::dvec3& q, double w)
+    {
+        const glm::ivec3 cells = tree.getLayout().getCells(level);
+        const glm::dvec3 s = q - 0.5;
+        const glm::dvec3 base = glm::floor(s);
+        const glm::dvec3 f = s - base;
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::ivec3 o(corner & 1, (corner >> 1) & 1, corner >> 2);
+            const double cw = (o.x ? f.x : 1.0 - f.x) * (o.y ? f.y : 1.0 - f.y) *
+                              (o.z ? f.z : 1.0 - f.z);
+            if (cw <= 0.0)
+                continue;
+            const glm::ivec3 cell = glm::clamp(glm::ivec3(base) + o, glm::ivec3(0), cells - 1);
+            addCorner(level, cell, w * cw);
+        }
+    }
+
+    void addCorner(int level, const glm::ivec3& cell, double w)
+    {
+        const std::int64_t index = tree.find(level, cell);
+        if (index != AdaptiveVoxelTree::kAbsent) {
+            emit(std::uint32_t(index), level, cell, w);
+            return;
+        }
+        if (query.mode == TreeInterpolation::Plain || level == 0) {
+            dropped += w;
+            return;
+        }
+        // The missing corner takes the value the parent level interpolates at its centre.
+        out.levelsUsed = std::max(out.levelsUsed, out.level - level + 2);
+        addNeighbourhood(level - 1, (glm::dvec3(cell) + 0.5) * 0.25, w);
+    }
+};
+
+} // namespace
+
+TreeStencil interpolate(const AdaptiveVoxelTree& tree, const TreeQuery& query, const glm::dvec3& p)
+{
+    TreeStencil out;
+    const int depth = tree.getDepth();
+    const glm::dvec3 leafCells(tree.getLayout().getCells(depth));
+    glm::dvec3 u = (p - query.origin) / query.leafSize;
+    for (int a = 0; a < 3; ++a)
+        u[a] = std::isfinite(u[a]) ? std::clamp(u[a], 0.0, leafCells[a] * (1.0 - 1e-12)) : 0.0;
+    const AdaptiveVoxelTree::Deepest deepest = tree.findDeepest(glm::ivec3(glm::floor(u)));
+    // The level of the neighbourhood: the leaves where the point's leaf exists, else the children
+    // of the deepest node holding it when it has any, else that node's own level. Every corner
+    // missing there has a complete neighbourhood one level up (the partial dilation).
+    out.level = deepest.level == depth ? depth
+                                       : (deepest.hasChildren ? deepest.level + 1 : deepest.level);
+    StencilBuilder b{tree, query, glm::clamp(p, query.origin, query.origin + leafCells * query.leafSize),
+                     out};
+    b.addNeighbourhood(out.level, u * std::ldexp(1.0, -2 * (depth - out.level)), 1.0);
+    double sum = 0.0;
+    for (int i = 0; i < out.count; ++i)
+        sum += out.weight[std::size_t(i)];
+    if (out.count == 0 || !(sum > 0.0)) {
+        // Plain mode with every corner missing: the deepest element holding the point.
+        out.count = 1;
+        out.index[0] = std::uint32_t(deepest.index);
+        out.weight[0] = 1.0f;
+        return out;
+    }
+    for (int i = 0; i < out.count; ++i)
+        out.weight[std::size_t(i)] = float(out.weight[std::size_t(i)] / sum);
+    return out;
+}
+
+} // namespace rtlab::voxelgi
