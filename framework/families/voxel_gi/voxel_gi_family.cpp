@@ -497,13 +497,15 @@ plugin::FamilyInfo describeVoxelGiFamily()
                                    "indirect irradiance there is light that leaked through walls "
                                    "of the given thickness."},
                        {.x = "param.resolution",
-                        .xLabel = "voxels per level and axis",
+                        .xLabel = "resolution (cascades: voxels per level and axis; "
+                                  "adaptive_voxel_tree: leaves along the box)",
                         .y = "memory.payload_bytes",
                         .yLabel = "payload (bytes)",
                         .name = "voxel_gi_memory",
                         .title = "memory against resolution",
-                        .caption = "Memory of the structure (payload: volumetric G-buffer, light "
-                                   "and pre-combined buffers) against its resolution, every scene."}}};
+                        .caption = "Memory of the structure (cascades' payload: volumetric "
+                                   "G-buffer, light and pre-combined buffers; the tree's: its "
+                                   "probes) against its resolution, every scene."}}};
     info.runtime = std::make_shared<VoxelGiFamily>();
     return info;
 }

@@ -156,25 +156,6 @@ AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::v
     return tree;
 }
 
-std::int64_t AdaptiveVoxelTree::find(int level, const glm::ivec3& c) const
-{
-    if (level < 0 || level > mLayout.depth || !inside(c, mLayout.getCells(level)))
-        return kAbsent;
-    const glm::ivec3 root = c >> (2 * level);
-    std::uint32_t index = std::uint32_t(
-        root.x + mLayout.rootCells.x * (root.y + mLayout.rootCells.y * root.z));
-    for (int l = 1; l <= level; ++l) {
-        const VoxelTreeNode& node = mNodes[index];
-        const std::uint64_t mask = node.getMask();
-        const int bit = getChildBit(c >> (2 * (level - l)));
-        if (((mask >> bit) & 1u) == 0)
-            return kAbsent;
-        // The talk's child index: offset + the set bits below this one (one popcnt).
-        index = node.offset + std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
-    }
-    return std::int64_t(index);
-}
-
 std::vector<glm::ivec4> AdaptiveVoxelTree::listElementCells() const
 {
     std::vector<glm::ivec4> cells(getElementCount());

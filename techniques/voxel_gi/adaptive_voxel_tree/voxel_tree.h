@@ -21,6 +21,7 @@
 #include <glm/vec4.hpp>
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -71,7 +72,29 @@ public:
     bool isDilated() const { return mDilated; }
 
     //! Index of the element at cell c of `level`, or kAbsent (also for c outside the grid).
-    std::int64_t find(int level, const glm::ivec3& c) const;
+    //! Inline: it is the lookup every use of the tree spends its time in.
+    std::int64_t find(int level, const glm::ivec3& c) const
+    {
+        if (unsigned(level) > unsigned(mLayout.depth) || c.x < 0 || c.y < 0 || c.z < 0)
+            return kAbsent;
+        const int shift = 2 * level;
+        const int rx = c.x >> shift, ry = c.y >> shift, rz = c.z >> shift;
+        const glm::ivec3& roots = mLayout.rootCells;
+        if (rx >= roots.x || ry >= roots.y || rz >= roots.z)
+            return kAbsent;
+        std::uint32_t index = std::uint32_t(rx + roots.x * (ry + roots.y * rz));
+        for (int s = shift - 2; s >= 0; s -= 2) {
+            const VoxelTreeNode& node = mNodes[index];
+            const std::uint64_t mask = node.getMask();
+            const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
+            if (((mask >> bit) & 1u) == 0)
+                return kAbsent;
+            // The talk's child index: offset + the set bits below this one (one POPCNT).
+            index = node.offset +
+                    std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
+        }
+        return std::int64_t(index);
+    }
     //! Every element's cell (xyz) and level (w), in index order (the inverse of find).
     std::vector<glm::ivec4> listElementCells() const;
 

@@ -1,0 +1,361 @@
+// The voxel GI structures side by side on the same voxels (the data-structure metrics of
+// metrics/structure_metrics.h): bytes per active voxel split into topology and payload, build
+// time, random and coherent lookup time, for
+//   dense_grid           one 3D texture over the scene's box at the finest voxel size (what a
+//                        single cascade level holding every voxel needs)
+//   cascades             the Tomorrow Children's clipmap: levels of 32^3 doubling in extent until
+//                        the coarsest holds the box, the finest at the same voxel size (memory
+//                        only: it holds the finest voxels only near the camera)
+//   adaptive_voxel_tree  Quantum Break's 64-ary tree (voxel_tree.h), depth 3 below root cells of
+//                        64^3 leaves, payload for every element (nodes too: the seamless
+//                        interpolation reads them); `_undilated` without the partial dilation
+//   openvdb              OpenVDB Vec3SGrid (5-4-3 tree), random lookups by the uncached
+//                        tree().getValue, coherent ones through a ValueAccessor
+//   nanovdb              NanoVDB converted from that grid (openToNanoVDB), same two lookups
+// The voxels: the cells of a lattice over the static scene (no characters, frame 0) that a
+// triangle meets (families/voxel_gi/voxelize.h listCellsMeetingTriangles), at 128, 256 and 512
+// cells along the box's longest side, for cornell_box and tomorrow_town. Payload: one RGB float
+// value (12 bytes) per voxel in every structure.
+//
+//   build/tests/families/voxel_structure_benchmark [--benchmark_filter=<regex>]
+//   build/tests/families/voxel_structure_benchmark --quick   # cornell_box at 32 and 64 (ctest)
+// Counters: voxels (active), topology_B (bytes per active voxel), payload_B, total_B, and
+// items_per_second = lookups per second for the lookup rows (ns per lookup = 1e9 / it).
+
+#include "voxel_tree.h" // techniques/voxel_gi/adaptive_voxel_tree
+
+#include "families/voxel_gi/voxelize.h"
+#include "metrics/structure_metrics.h"
+#include "scene/scene.h"
+#include "scene/scene_file.h"
+
+#include <benchmark/benchmark.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
+#include <openvdb/openvdb.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace rtlab;
+
+namespace {
+
+struct Voxels {
+    glm::ivec3 cells{0};                 //!< lattice size
+    std::vector<glm::ivec3> active;      //!< sorted by (z, y, x)
+    std::vector<glm::ivec3> randomOrder; //!< the same voxels shuffled
+};
+
+glm::vec3 payloadOf(const glm::ivec3& c) { return glm::vec3(c) * 1e-3f + 0.5f; }
+
+const Voxels& getVoxels(const std::string& sceneName, int resolution)
+{
+    static std::map<std::pair<std::string, int>, Voxels> cache;
+    auto it = cache.find({sceneName, resolution});
+    if (it != cache.end())
+        return it->second;
+    const scene::Scene s = scene::loadScene(sceneName);
+    const scene::RenderScene g = s.assembleRenderScene(s.meshSdfModels(0), {}, 0);
+    const glm::dvec3 lo(g.boundsMin), hi(g.boundsMax);
+    const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
+    const double cell = extent / resolution;
+    Voxels v;
+    v.cells = glm::max(glm::ivec3(glm::ceil((hi - lo) / cell)) + 1, glm::ivec3(1));
+    v.active = voxelgi::listCellsMeetingTriangles(g, lo - 0.5 * cell, cell, v.cells);
+    v.randomOrder = v.active;
+    std::shuffle(v.randomOrder.begin(), v.randomOrder.end(), std::mt19937(1));
+    if (v.randomOrder.size() > (1u << 18))
+        v.randomOrder.resize(1u << 18);
+    return cache.emplace(std::make_pair(sceneName, resolution), std::move(v)).first->second;
+}
+
+// One structure: build from the voxels, its footprint, and a lookup returning the payload (or 0).
+class Structure {
+public:
+    virtual ~Structure() = default;
+    virtual void build(const Voxels& v) = 0;
+    virtual metrics::StructureFootprint footprint() const = 0;
+    //! Sum of the looked-up values' x (the checksum that keeps the work).
+    virtual double lookupRandom(const std::vector<glm::ivec3>& q) const = 0;
+    virtual double lookupCoherent(const std::vector<glm::ivec3>& q) const { return lookupRandom(q); }
+    virtual bool canLookup() const { return true; }
+};
+
+class DenseGrid final : public Structure {
+public:
+    void build(const Voxels& v) override
+    {
+        mCells = v.cells;
+        mValues.assign(std::size_t(v.cells.x) * std::size_t(v.cells.y) * std::size_t(v.cells.z),
+                       glm::vec3(0.0f));
+        for (const auto& c : v.active)
+            mValues[index(c)] = payloadOf(c);
+    }
+    metrics::StructureFootprint footprint() const override
+    {
+        return {.topologyBytes = 0, .payloadBytes = metrics::usedBytes(mValues), .nodeCount = 0};
+    }
+    double lookupRandom(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        for (const auto& c : q)
+            sum += mValues[index(c)].x;
+        return sum;
+    }
+
+private:
+    std::size_t index(const glm::ivec3& c) const
+    {
+        return std::size_t(c.x) + std::size_t(mCells.x) * (std::size_t(c.y) + std::size_t(mCells.y) * std::size_t(c.z));
+    }
+    glm::ivec3 mCells{0};
+    std::vector<glm::vec3> mValues;
+};
+
+// Memory of the clipmap only: levels of 32^3 from the finest voxel size up to the level holding
+// the box, one value per voxel.
+class Cascades final : public Structure {
+public:
+    void build(const Voxels& v) override
+    {
+        const int longest = std::max({v.cells.x, v.cells.y, v.cells.z});
+        mLevels = 1;
+        while (32 * (1 << (mLevels - 1)) < longest)
+            ++mLevels;
+    }
+    metrics::StructureFootprint footprint() const override
+    {
+        return {.topologyBytes = 0,
+                .payloadBytes = std::size_t(mLevels) * 32u * 32u * 32u * sizeof(glm::vec3),
+                .nodeCount = 0};
+    }
+    double lookupRandom(const std::vector<glm::ivec3>&) const override { return 0.0; }
+    bool canLookup() const override { return false; }
+
+private:
+    int mLevels = 1;
+};
+
+class Avt final : public Structure {
+public:
+    explicit Avt(bool dilate) : mDilate(dilate) {}
+    void build(const Voxels& v) override
+    {
+        voxelgi::VoxelTreeLayout layout;
+        layout.depth = 3;
+        layout.rootCells = glm::max((v.cells + 63) / 64, glm::ivec3(1));
+        mTree = voxelgi::AdaptiveVoxelTree::build(layout, v.active, mDilate);
+        mPayload.assign(mTree.getElementCount(), glm::vec3(0.0f));
+        for (const auto& c : v.active)
+            mPayload[std::size_t(mTree.find(3, c))] = payloadOf(c);
+    }
+    metrics::StructureFootprint footprint() const override
+    {
+        return {.topologyBytes = mTree.getTopologyBytes(),
+                .payloadBytes = metrics::usedBytes(mPayload),
+                .nodeCount = mTree.getNodeCount()};
+    }
+    double lookupRandom(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        for (const auto& c : q) {
+            const std::int64_t i = mTree.find(3, c);
+            sum += i >= 0 ? mPayload[std::size_t(i)].x : 0.0f;
+        }
+        return sum;
+    }
+
+private:
+    bool mDilate;
+    voxelgi::AdaptiveVoxelTree mTree;
+    std::vector<glm::vec3> mPayload;
+};
+
+// Payload bytes of a VDB: the leaves' value buffers (512 values each, active or not); topology:
+// everything else the grid reports (nodes, masks, the root table).
+class OpenVdb final : public Structure {
+public:
+    void build(const Voxels& v) override
+    {
+        mGrid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+        auto acc = mGrid->getAccessor();
+        for (const auto& c : v.active) {
+            const glm::vec3 p = payloadOf(c);
+            acc.setValue(openvdb::Coord(c.x, c.y, c.z), openvdb::Vec3s(p.x, p.y, p.z));
+        }
+    }
+    metrics::StructureFootprint footprint() const override
+    {
+        const std::size_t total = std::size_t(mGrid->memUsage());
+        const std::size_t leaves = std::size_t(mGrid->tree().leafCount());
+        const std::size_t payload = leaves * 512u * sizeof(openvdb::Vec3s);
+        return {.topologyBytes = total - std::min(total, payload), .payloadBytes = payload,
+                .nodeCount = std::size_t(mGrid->tree().nodeCount().size())};
+    }
+    double lookupRandom(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        const auto& tree = mGrid->tree();
+        for (const auto& c : q)
+            sum += tree.getValue(openvdb::Coord(c.x, c.y, c.z)).x();
+        return sum;
+    }
+    double lookupCoherent(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        auto acc = mGrid->getConstAccessor();
+        for (const auto& c : q)
+            sum += acc.getValue(openvdb::Coord(c.x, c.y, c.z)).x();
+        return sum;
+    }
+    const openvdb::Vec3SGrid& getGrid() const { return *mGrid; }
+
+private:
+    openvdb::Vec3SGrid::Ptr mGrid;
+};
+
+class NanoVdb final : public Structure {
+public:
+    void build(const Voxels& v) override
+    {
+        if (!mSource) {
+            mSource = std::make_unique<OpenVdb>();
+            mSource->build(v); // not timed apart: the conversion is the build measured below
+        }
+        mHandle = nanovdb::openToNanoVDB(mSource->getGrid());
+        mGrid = mHandle.grid<nanovdb::Vec3f>();
+    }
+    metrics::StructureFootprint footprint() const override
+    {
+        const std::size_t total = std::size_t(mHandle.size());
+        const std::size_t leaves = std::size_t(mGrid->tree().nodeCount(0));
+        const std::size_t payload = leaves * 512u * sizeof(nanovdb::Vec3f);
+        return {.topologyBytes = total - std::min(total, payload), .payloadBytes = payload,
+                .nodeCount = leaves};
+    }
+    double lookupRandom(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        const auto& tree = mGrid->tree();
+        for (const auto& c : q)
+            sum += tree.getValue(nanovdb::Coord(c.x, c.y, c.z))[0];
+        return sum;
+    }
+    double lookupCoherent(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        auto acc = mGrid->getAccessor();
+        for (const auto& c : q)
+            sum += acc.getValue(nanovdb::Coord(c.x, c.y, c.z))[0];
+        return sum;
+    }
+
+private:
+    std::unique_ptr<OpenVdb> mSource;
+    nanovdb::GridHandle<nanovdb::HostBuffer> mHandle;
+    const nanovdb::NanoGrid<nanovdb::Vec3f>* mGrid = nullptr;
+};
+
+std::unique_ptr<Structure> makeStructure(const std::string& name)
+{
+    if (name == "dense_grid")
+        return std::make_unique<DenseGrid>();
+    if (name == "cascades")
+        return std::make_unique<Cascades>();
+    if (name == "adaptive_voxel_tree")
+        return std::make_unique<Avt>(true);
+    if (name == "adaptive_voxel_tree_undilated")
+        return std::make_unique<Avt>(false);
+    if (name == "openvdb")
+        return std::make_unique<OpenVdb>();
+    return std::make_unique<NanoVdb>();
+}
+
+void setMemoryCounters(benchmark::State& state, const Structure& s, const Voxels& v)
+{
+    const metrics::StructureFootprint f = s.footprint();
+    const double n = double(std::max<std::size_t>(v.active.size(), 1));
+    state.counters["voxels"] = double(v.active.size());
+    state.counters["topology_B"] = double(f.topologyBytes) / n;
+    state.counters["payload_B"] = double(f.payloadBytes) / n;
+    state.counters["total_B"] = double(f.topologyBytes + f.payloadBytes) / n;
+}
+
+void runBuild(benchmark::State& state, const std::string& sceneName, int resolution, const std::string& name)
+{
+    const Voxels& v = getVoxels(sceneName, resolution);
+    auto s = makeStructure(name);
+    s->build(v); // the NanoVDB source grid is made here, outside the timed loop
+    for (auto _ : state) {
+        s->build(v);
+        benchmark::ClobberMemory();
+    }
+    setMemoryCounters(state, *s, v);
+}
+
+void runLookups(benchmark::State& state, const std::string& sceneName, int resolution, const std::string& name,
+                bool coherent)
+{
+    const Voxels& v = getVoxels(sceneName, resolution);
+    auto s = makeStructure(name);
+    s->build(v);
+    // Random: active voxels in shuffled order; coherent: every active voxel in (z, y, x) order.
+    const std::vector<glm::ivec3>& q = coherent ? v.active : v.randomOrder;
+    double checksum = 0.0;
+    for (auto _ : state) {
+        checksum = coherent ? s->lookupCoherent(q) : s->lookupRandom(q);
+        benchmark::DoNotOptimize(checksum);
+    }
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(q.size()));
+    setMemoryCounters(state, *s, v);
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    openvdb::initialize();
+    bool quick = false;
+    std::vector<char*> args;
+    for (int i = 0; i < argc; ++i) {
+        if (std::strcmp(argv[i], "--quick") == 0)
+            quick = true;
+        else
+            args.push_back(argv[i]);
+    }
+    static char minTime[] = "--benchmark_min_time=0.01";
+    if (quick)
+        args.push_back(minTime);
+    int n = int(args.size());
+    benchmark::Initialize(&n, args.data());
+    const std::vector<std::string> scenes =
+        quick ? std::vector<std::string>{"cornell_box"} : std::vector<std::string>{"cornell_box", "tomorrow_town"};
+    const std::vector<int> resolutions = quick ? std::vector<int>{32, 64} : std::vector<int>{128, 256, 512};
+    for (const std::string& sceneName : scenes)
+        for (int r : resolutions)
+            for (const std::string name :
+                 {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
+                  "openvdb", "nanovdb"}) {
+                const std::string prefix = sceneName + "/" + std::to_string(r) + "/" + name;
+                benchmark::RegisterBenchmark((prefix + "/build").c_str(), [=](benchmark::State& s) {
+                    runBuild(s, sceneName, r, name);
+                })->Unit(benchmark::kMillisecond)->UseRealTime();
+                if (name == "cascades")
+                    continue;
+                for (bool coherent : {false, true})
+                    benchmark::RegisterBenchmark(
+                        (prefix + (coherent ? "/lookup_coherent" : "/lookup_random")).c_str(),
+                        [=](benchmark::State& s) { runLookups(s, sceneName, r, name, coherent); })
+                        ->Unit(benchmark::kMillisecond)
+                        ->UseRealTime();
+            }
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}
