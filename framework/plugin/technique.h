@@ -82,6 +82,9 @@ struct AcrossScenesFigure {
     std::string name;   //!< file name stem
     std::string title;
     std::string caption;
+    //! Columns that split a technique's line, e.g. {"param.anti_leak"}: a run's line is
+    //! "technique (anti_leak=false)"; runs on one line at the same x are averaged.
+    std::vector<std::string> seriesBy;
 };
 
 //! Which columns a family's figures and tables use (report/report.h).

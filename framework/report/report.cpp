@@ -175,6 +175,9 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
         if (seen)
             continue;
         for (const auto& spec : first.columns.acrossScenes) {
+            // One line per technique, split by the figure's seriesBy columns where a run has
+            // them (e.g. "adaptive_voxel_tree (anti_leak=false)"); runs on one line at the same
+            // x are averaged.
             std::map<std::string, std::map<double, std::pair<double, int>>> byTechnique;
             for (const auto& g : groups)
                 if (g.family == first.family)
@@ -182,7 +185,9 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
                         const double x = run.get(spec.x), y = run.get(spec.y);
                         if (!std::isfinite(x) || !std::isfinite(y))
                             continue;
-                        auto& cell = byTechnique[run.technique][x];
+                        const std::string setting = detail::describeRun(run, spec.seriesBy);
+                        auto& cell = byTechnique[run.technique +
+                                                 (setting.empty() ? "" : " (" + setting + ")")][x];
                         cell.first += y;
                         cell.second += 1;
                     }

@@ -35,6 +35,9 @@ namespace rtlab::plugin {
 //! What a voxel_gi technique computes, so that the ground truth computes exactly that.
 struct VoxelGiDefinition {
     int bounces = 2; //!< reflections before the light reaches the pixel (reference "indirect")
+    //! The light step is a precompute (a bake, as Quantum Break's probes): its time is reported
+    //! apart (column bake_ms) and left out of the frame's technique_ms.
+    bool precomputedLight = false;
 };
 
 //! The frame as the structure sees it: the static scene (no characters: the talk does not

@@ -23,7 +23,7 @@
 //    `payload: sh_l1`, as the L1 irradiance E(n) = a + b.n fitted to those six values (least
 //    squares; 4 RGB values). Quantum Break precomputes its GI offline: the bake is the
 //    light_injection pass, timed apart from the gather, and skipped while the geometry and
-//    lights are unchanged.
+//    lights are unchanged. Its time goes to the row's bake_ms, not technique_ms.
 // 3. gather: per pixel, the seamless trilinear interpolation of the probes around the pixel
 //    (at most two levels; corners missing at the finer level interpolated from its parent
 //    level), the weights multiplied by the normal-based anti-leak term, then the payload
@@ -129,7 +129,10 @@ public:
         return p;
     }
 
-    plugin::VoxelGiDefinition definition() const override { return {.bounces = mBounces}; }
+    plugin::VoxelGiDefinition definition() const override
+    {
+        return {.bounces = mBounces, .precomputedLight = true};
+    }
 
     plugin::VoxelGiStep voxelize(const plugin::VoxelGiFrame& frame) override
     {

@@ -3,6 +3,7 @@
 #include "core/error.h"
 
 #include <glm/geometric.hpp>
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <bit>
@@ -52,7 +53,7 @@ glm::ivec3 decodeKey(const VoxelTreeLayout& layout, int level, std::uint64_t key
 
 void sortUnique(std::vector<std::uint64_t>& keys)
 {
-    std::sort(keys.begin(), keys.end());
+    tbb::parallel_sort(keys.begin(), keys.end());
     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 }
 
