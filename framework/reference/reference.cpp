@@ -147,6 +147,21 @@ double evaluateFalloff(Falloff falloff, double x)
     return falloff == Falloff::Linear ? t : t * t * (3.0 - 2.0 * t);
 }
 
+ReferenceSettings makeFixedSampleSettings(Quantity quantity, int bounces, int samples,
+                                          std::uint64_t seed)
+{
+    ReferenceSettings s;
+    s.quantity = quantity;
+    s.bounces = bounces;
+    s.targetStdErr = 0.0;
+    s.targetRelStdErr = 0.0;
+    s.batchSize = samples;
+    s.maxSamples = samples;
+    s.seed = seed;
+    s.useCache = false;
+    return s;
+}
+
 ReferenceResult computeReference(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,
                                  const ReferenceSettings& settings)
 {

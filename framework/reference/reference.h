@@ -150,6 +150,12 @@ struct ReferenceResult {
     ReferenceStats stats;
 };
 
+//! Settings of a fixed-cost estimate by the ground truth's estimator (an equal-time baseline, a
+//! bake; not the ground truth): `samples` paths per pixel, no stopping rule, no cache, `seed`
+//! (choose one other than the ground truth's 0).
+ReferenceSettings makeFixedSampleSettings(Quantity quantity, int bounces, int samples,
+                                          std::uint64_t seed);
+
 //! The ground truth of settings.quantity at every pixel of `gbuffer`. Throws rtlab::Error for an
 //! empty or malformed scene, a G-buffer whose images do not match its size, or bad settings.
 ReferenceResult computeReference(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,

@@ -1,11 +1,18 @@
 #pragma once
-// Small scenes for the voxel_gi tests: boxes (outward or inward facing), quads, rooms.
+// Small scenes for the voxel_gi tests: boxes (outward or inward facing), quads, rooms; and a
+// technique made from its own registration function (a technique's test links only itself).
 
+#include "core/error.h"
+#include "plugin/technique.h"
 #include "scene/render_scene.h"
 
 #include <glm/vec3.hpp>
 
 #include <cstdint>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace rtlab::voxelgi::testing {
 
@@ -66,6 +73,26 @@ inline void addRoom(scene::RenderScene& s, glm::vec3 lo, glm::vec3 hi, float thi
 {
     addBox(s, lo - thickness, hi + thickness, material, false);
     addBox(s, lo, hi, material, true);
+}
+
+using ParamOverrides = std::vector<std::pair<std::string, config::ParamValue>>;
+
+//! The voxel_gi technique `name` registered by `registerTechnique`, at its defaults changed by
+//! `overrides`.
+inline std::unique_ptr<plugin::Technique> createTechnique(void (*registerTechnique)(plugin::Registry&),
+                                                          const std::string& name,
+                                                          const ParamOverrides& overrides = {})
+{
+    plugin::Registry registry;
+    plugin::registerBuiltinFamilies(registry);
+    registerTechnique(registry);
+    const auto* entry = registry.findTechnique("voxel_gi", name);
+    if (entry == nullptr)
+        throw Error("createTechnique: no voxel_gi technique " + name);
+    auto params = config::ParamSet::defaultsOf(entry->schema);
+    for (const auto& [key, value] : overrides)
+        params.set(key, value);
+    return entry->create(params);
 }
 
 } // namespace rtlab::voxelgi::testing

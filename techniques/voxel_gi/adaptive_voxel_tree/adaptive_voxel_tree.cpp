@@ -150,8 +150,9 @@ public:
         // box's faces; root cells of 4^depth leaves cover it.
         const glm::dvec3 lo(g.boundsMin), hi(g.boundsMax);
         const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
-        const double floor = 1e-6 * std::max(1.0, glm::length(glm::max(glm::abs(lo), glm::abs(hi))));
-        mLeafSize = std::max(extent, floor) / double(mResolution);
+        const double minExtent =
+            1e-6 * std::max(1.0, glm::length(glm::max(glm::abs(lo), glm::abs(hi))));
+        mLeafSize = std::max(extent, minExtent) / double(mResolution);
         mOrigin = lo - 0.5 * mLeafSize;
         voxelgi::VoxelTreeLayout layout;
         layout.depth = mDepth;
@@ -247,15 +248,8 @@ private:
                 g.materialId.at(x, y) = 0;
             }
         }
-        reference::ReferenceSettings s;
-        s.quantity = reference::Quantity::Indirect;
-        s.bounces = mBounces;
-        s.targetStdErr = 0.0;
-        s.targetRelStdErr = 0.0;
-        s.batchSize = mBakeSamples;
-        s.maxSamples = mBakeSamples;
-        s.seed = 0xba4e0000ull; // not the ground truth's seed (0)
-        s.useCache = false;
+        const reference::ReferenceSettings s = reference::makeFixedSampleSettings(
+            reference::Quantity::Indirect, mBounces, mBakeSamples, 0xba4e0000ull);
         const Image<glm::vec3> e = reference::computeReference(geometry, g, s).irradiance;
         const int m = payloadVectors();
         mPayload.assign(probes * std::size_t(m), glm::vec3(0.0f));

@@ -18,21 +18,12 @@ using namespace rtlab::voxelgi::testing;
 
 namespace {
 
-using Overrides = std::vector<std::pair<std::string, config::ParamValue>>;
+using Overrides = ParamOverrides;
 
 std::unique_ptr<plugin::Technique> make(const Overrides& overrides = {})
 {
-    static plugin::Registry registry = [] {
-        plugin::Registry r;
-        plugin::registerBuiltinFamilies(r);
-        rtlabRegisterTechnique_voxel_gi_adaptive_voxel_tree(r);
-        return r;
-    }();
-    const auto* entry = registry.findTechnique("voxel_gi", "adaptive_voxel_tree");
-    auto params = config::ParamSet::defaultsOf(entry->schema);
-    for (const auto& [name, value] : overrides)
-        params.set(name, value);
-    return entry->create(params);
+    return createTechnique(rtlabRegisterTechnique_voxel_gi_adaptive_voxel_tree,
+                           "adaptive_voxel_tree", overrides);
 }
 
 plugin::VoxelGiFrame frameOf(const scene::RenderScene& s, const std::string& geometryKey = "")

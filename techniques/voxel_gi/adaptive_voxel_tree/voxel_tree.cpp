@@ -77,6 +77,10 @@ AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::v
         throw Error("adaptive voxel tree: " + toString(layout.rootCells) + " root cells of depth " +
                     std::to_string(layout.depth) + " address more cells than 63-bit keys hold");
 
+    // The dense first level is a node per root cell: 2^24 of them take 200 MB already.
+    if (rootCount > double(1 << 24))
+        throw Error("adaptive voxel tree: " + toString(layout.rootCells) +
+                    " root cells are more than 2^24 for the dense first level; use a larger depth");
     AdaptiveVoxelTree tree;
     tree.mLayout = layout;
     tree.mDilated = dilate;

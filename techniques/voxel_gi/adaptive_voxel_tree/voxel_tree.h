@@ -56,7 +56,8 @@ public:
 
     //! Builds the tree holding the given leaves (level `depth` cells; duplicates are merged),
     //! with partial dilation of the upper levels when `dilate`. Throws rtlab::Error for a bad
-    //! layout, a leaf outside the grid, or more than 2^32 - 1 elements.
+    //! layout (depth outside [1, 8], more than 2^24 root cells), a leaf outside the grid, or more
+    //! than 2^32 - 1 elements.
     static AdaptiveVoxelTree build(const VoxelTreeLayout& layout, std::vector<glm::ivec3> leaves,
                                    bool dilate = true);
 

@@ -131,14 +131,20 @@ TEST(VoxelTree, OneVoxel)
     expectMatchesDenseGrids(layout, {glm::ivec3(17, 3, 9)}, true, "one voxel");
 }
 
+std::vector<glm::ivec3> everyCell(int n)
+{
+    std::vector<glm::ivec3> all;
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                all.push_back({x, y, z});
+    return all;
+}
+
 TEST(VoxelTree, FullGridSetsEveryMaskBit)
 {
     VoxelTreeLayout layout{.rootCells = glm::ivec3(1), .depth = 2};
-    std::vector<glm::ivec3> all;
-    for (int z = 0; z < 16; ++z)
-        for (int y = 0; y < 16; ++y)
-            for (int x = 0; x < 16; ++x)
-                all.push_back({x, y, z});
+    const std::vector<glm::ivec3> all = everyCell(16);
     const AdaptiveVoxelTree tree = AdaptiveVoxelTree::build(layout, all, true);
     EXPECT_EQ(tree.getLeafCount(), 4096u);
     EXPECT_EQ(tree.getNodeCount(), 65u);
@@ -191,6 +197,7 @@ TEST(VoxelTree, RejectsBadInput)
     EXPECT_THROW(AdaptiveVoxelTree::build({.rootCells = glm::ivec3(1), .depth = 2}, {glm::ivec3(16, 0, 0)}),
                  Error);
     EXPECT_THROW(AdaptiveVoxelTree::build({.rootCells = glm::ivec3(1 << 20), .depth = 8}, {}), Error);
+    EXPECT_THROW(AdaptiveVoxelTree::build({.rootCells = glm::ivec3(512), .depth = 1}, {}), Error);
 }
 
 // A tree with level transitions: a dense blob of leaves in one corner, a sparse scatter elsewhere.
@@ -269,11 +276,7 @@ TEST(VoxelTree, AntiLeakWeightFavoursDataPointsInFrontOfTheSurface)
 {
     // Full grid of 16^3 leaves; a surface at x = 8 facing +x; data points behind it hold 100.
     VoxelTreeLayout layout{.rootCells = glm::ivec3(1), .depth = 2};
-    std::vector<glm::ivec3> all;
-    for (int z = 0; z < 16; ++z)
-        for (int y = 0; y < 16; ++y)
-            for (int x = 0; x < 16; ++x)
-                all.push_back({x, y, z});
+    const std::vector<glm::ivec3> all = everyCell(16);
     const AdaptiveVoxelTree tree = AdaptiveVoxelTree::build(layout, all, true);
     const auto cells = tree.listElementCells();
     auto value = [&](const TreeQuery& q) {

@@ -83,16 +83,10 @@ public:
                                           glm::vec3(0.0f));
             return;
         }
-        reference::ReferenceSettings s;
-        s.quantity = reference::Quantity::Indirect;
-        s.bounces = mBounces;
-        s.targetStdErr = 0.0;
-        s.targetRelStdErr = 0.0;
-        s.batchSize = mSamples;
-        s.maxSamples = mSamples;
         // Not the ground truth's seed (0), and a new one every frame.
-        s.seed = 0x5eed0000ull + std::uint64_t(input.frameIndex);
-        s.useCache = false;
+        const reference::ReferenceSettings s = reference::makeFixedSampleSettings(
+            reference::Quantity::Indirect, mBounces, mSamples,
+            0x5eed0000ull + std::uint64_t(input.frameIndex));
         irradiance = reference::computeReference(*input.scene, *input.gbuffer, s).irradiance;
     }
 

@@ -19,16 +19,8 @@ namespace {
 
 std::unique_ptr<plugin::Technique> make(int samples)
 {
-    static plugin::Registry registry = [] {
-        plugin::Registry r;
-        plugin::registerBuiltinFamilies(r);
-        rtlabRegisterTechnique_voxel_gi_path_traced(r);
-        return r;
-    }();
-    const auto* entry = registry.findTechnique("voxel_gi", "path_traced");
-    auto params = config::ParamSet::defaultsOf(entry->schema);
-    params.set("samples_per_pixel", std::int64_t(samples));
-    return entry->create(params);
+    return createTechnique(rtlabRegisterTechnique_voxel_gi_path_traced, "path_traced",
+                           {{"samples_per_pixel", std::int64_t(samples)}});
 }
 
 TEST(PathTraced, ErrorFallsLikeOneOverRootOfThePaths)
