@@ -141,6 +141,29 @@ std::string describeRun(const RunSummary& run, const std::vector<std::string>& v
     return s;
 }
 
+std::map<std::string, std::map<double, double>>
+collectAcrossScenesLines(const std::vector<Group>& groups, const std::string& family,
+                         const plugin::AcrossScenesFigure& spec)
+{
+    std::map<std::string, std::map<double, std::pair<double, int>>> sums;
+    for (const auto& g : groups)
+        if (g.family == family)
+            for (const auto& run : g.runs) {
+                const double x = run.get(spec.x), y = run.get(spec.y);
+                if (!std::isfinite(x) || !std::isfinite(y))
+                    continue;
+                const std::string setting = describeRun(run, spec.seriesBy);
+                auto& cell = sums[run.technique + (setting.empty() ? "" : " (" + setting + ")")][x];
+                cell.first += y;
+                cell.second += 1;
+            }
+    std::map<std::string, std::map<double, double>> lines;
+    for (const auto& [name, points] : sums)
+        for (const auto& [x, sum] : points)
+            lines[name][x] = sum.first / sum.second;
+    return lines;
+}
+
 } // namespace detail
 
 ReportSummary writeStudyReport(const std::string& directory, const plugin::Registry& registry)
@@ -175,34 +198,19 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
         if (seen)
             continue;
         for (const auto& spec : first.columns.acrossScenes) {
-            // One line per technique, split by the figure's seriesBy columns where a run has
-            // them (e.g. "adaptive_voxel_tree (anti_leak=false)"); runs on one line at the same
-            // x are averaged.
-            std::map<std::string, std::map<double, std::pair<double, int>>> byTechnique;
-            for (const auto& g : groups)
-                if (g.family == first.family)
-                    for (const auto& run : g.runs) {
-                        const double x = run.get(spec.x), y = run.get(spec.y);
-                        if (!std::isfinite(x) || !std::isfinite(y))
-                            continue;
-                        const std::string setting = detail::describeRun(run, spec.seriesBy);
-                        auto& cell = byTechnique[run.technique +
-                                                 (setting.empty() ? "" : " (" + setting + ")")][x];
-                        cell.first += y;
-                        cell.second += 1;
-                    }
+            const auto lines = detail::collectAcrossScenesLines(groups, first.family, spec);
             plot::LineSpec line;
             line.title = spec.title;
             line.xLabel = spec.xLabel;
             line.yLabel = spec.yLabel;
             line.colors = plot::ColorTable(techniques);
-            for (const auto& [technique, points] : byTechnique) {
+            for (const auto& [name, points] : lines) {
                 if (points.size() < 2)
                     continue;
-                plot::Series s{technique};
-                for (const auto& [x, sum] : points) {
+                plot::Series s{name};
+                for (const auto& [x, y] : points) {
                     s.x.push_back(x);
-                    s.y.push_back(sum.first / sum.second);
+                    s.y.push_back(y);
                 }
                 line.series.push_back(std::move(s));
             }

@@ -36,6 +36,13 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows, const plu
 //! "directions=36 steps=4" from the varying parameters of a run.
 std::string describeRun(const RunSummary& run, const std::vector<std::string>& varyingParams);
 
+//! The lines of one of `family`'s across-scenes figures: one per technique, split by the
+//! figure's seriesBy columns where a run has them ("adaptive_voxel_tree (anti_leak=false)");
+//! each line maps x to the mean y of its runs there (runs without finite x and y are left out).
+std::map<std::string, std::map<double, double>>
+collectAcrossScenesLines(const std::vector<Group>& groups, const std::string& family,
+                         const plugin::AcrossScenesFigure& spec);
+
 struct Figures {
     std::vector<std::string> plots;     //!< paths without extension
     std::vector<std::string> captions;  //!< one per plot
