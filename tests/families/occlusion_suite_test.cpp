@@ -141,8 +141,9 @@ void expectValid(const plugin::OcclusionOutput& out, const SyntheticGBuffer& g, 
             const glm::vec3 b = out.bentNormal.pixels[i];
             ASSERT_TRUE(std::isfinite(b.x) && std::isfinite(b.y) && std::isfinite(b.z)) << what << ": bent at " << i;
             const bool surface = std::isfinite(g.depth.pixels[i]) && glm::dot(g.normal.pixels[i], g.normal.pixels[i]) > 0;
-            if (surface)
+            if (surface) {
                 ASSERT_NEAR(glm::length(b), 1.0f, 1e-3f) << what << ": bent normal not unit at " << i;
+            }
         }
     if (out.coneAperture.size() == out.ambient.size())
         for (std::size_t i = 0; i < out.coneAperture.pixels.size(); ++i) {
@@ -219,8 +220,9 @@ TEST_P(OcclusionSuite, MoreRadiusNeverBrightens)
             mean += a;
         mean /= double(out.ambient.size());
         EXPECT_LE(mean, previous + 1e-3) << "radius " << radius;
-        if (radius == 0.0)
+        if (radius == 0.0) {
             EXPECT_NEAR(mean, 1.0, 1e-3) << "radius 0 leaves nothing to occlude";
+        }
         previous = mean;
     }
 }
@@ -238,8 +240,9 @@ TEST_P(OcclusionSuite, AnUnoccludedPlaneIsUnoccluded)
         run(*t, g, onGpu ? &context() : nullptr, out);
         for (std::size_t i = 0; i < out.ambient.pixels.size(); ++i) {
             ASSERT_NEAR(out.ambient.pixels[i], 1.0f, 1e-3f) << (onGpu ? "gpu" : "cpu") << " pixel " << i;
-            if (out.bentNormal.size() == out.ambient.size())
+            if (out.bentNormal.size() == out.ambient.size()) {
                 ASSERT_NEAR(glm::dot(out.bentNormal.pixels[i], glm::vec3(0, 0, 1)), 1.0f, 1e-3f) << i;
+            }
         }
     }
 }
