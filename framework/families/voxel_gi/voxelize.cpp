@@ -391,6 +391,22 @@ std::size_t finalizeVoxelGrid(VoxelGrid& grid)
     return solidVoxels;
 }
 
+namespace {
+
+// Every attribute of voxel `from` of `source` into voxel `to` of `target`.
+void copyVoxel(const VoxelGrid& source, std::size_t from, VoxelGrid& target, std::size_t to)
+{
+    for (int f = 0; f < kFaceCount; ++f) {
+        target.faces[to * kFaceCount + std::size_t(f)] = source.faces[from * kFaceCount + std::size_t(f)];
+        target.emission[to * kFaceCount + std::size_t(f)] =
+            source.emission[from * kFaceCount + std::size_t(f)];
+    }
+    target.normal[to] = source.normal[from];
+    target.flags[to] = source.flags[from];
+}
+
+} // namespace
+
 // The voxels of `old` that lie in `region` (old shifted by `shift` voxels), the rest empty.
 VoxelGrid shiftVoxelGrid(const VoxelGrid& old, const VoxelRegion& region, const glm::ivec3& shift)
 {
@@ -408,22 +424,14 @@ VoxelGrid shiftVoxelGrid(const VoxelGrid& old, const VoxelRegion& region, const 
                 const glm::ivec3 o = glm::ivec3(x, y, z) + shift;
                 if (o.x < 0 || o.y < 0 || o.z < 0 || o.x >= R || o.y >= R || o.z >= R)
                     continue;
-                const std::size_t to = region.index(x, y, z), from = old.region.index(o.x, o.y, o.z);
-                for (int f = 0; f < kFaceCount; ++f) {
-                    grid.faces[to * kFaceCount + std::size_t(f)] = old.faces[from * kFaceCount + std::size_t(f)];
-                    grid.emission[to * kFaceCount + std::size_t(f)] =
-                        old.emission[from * kFaceCount + std::size_t(f)];
-                }
-                grid.normal[to] = old.normal[from];
-                grid.flags[to] = old.flags[from];
+                copyVoxel(old, old.region.index(o.x, o.y, o.z), grid, region.index(x, y, z));
             }
     return grid;
 }
 
 // (voxelize.h)
-// Copies the voxels of `part` in [begin, end) into `grid` (same region).
 void pasteVoxelBox(const VoxelGrid& part, const glm::ivec3& begin, const glm::ivec3& endIn,
-                 VoxelGrid& grid)
+                   VoxelGrid& grid)
 {
     const int R = grid.region.resolution;
     glm::ivec3 end = endIn;
@@ -433,13 +441,7 @@ void pasteVoxelBox(const VoxelGrid& part, const glm::ivec3& begin, const glm::iv
         for (int y = begin.y; y < end.y; ++y)
             for (int x = begin.x; x < end.x; ++x) {
                 const std::size_t v = grid.region.index(x, y, z);
-                for (int f = 0; f < kFaceCount; ++f) {
-                    grid.faces[v * kFaceCount + std::size_t(f)] = part.faces[v * kFaceCount + std::size_t(f)];
-                    grid.emission[v * kFaceCount + std::size_t(f)] =
-                        part.emission[v * kFaceCount + std::size_t(f)];
-                }
-                grid.normal[v] = part.normal[v];
-                grid.flags[v] = part.flags[v];
+                copyVoxel(part, v, grid, v);
             }
 }
 
