@@ -9,6 +9,10 @@
 //   adaptive_voxel_tree  Quantum Break's 64-ary tree (voxel_tree.h), depth 3 below root cells of
 //                        64^3 leaves, payload for every element (nodes too: the seamless
 //                        interpolation reads them); `_undilated` without the partial dilation
+//   svo                  Crassin et al.'s sparse voxel octree (sparse_voxel_octree.h): node tiles
+//                        of 2x2x2 with one 32-bit child pointer per node, down to the next power
+//                        of two above the lattice, payload for every node (cone tracing reads the
+//                        filtered interior nodes)
 //   openvdb              OpenVDB Vec3SGrid (5-4-3 tree), random lookups by the uncached
 //                        tree().getValue, coherent ones through a ValueAccessor
 //   nanovdb              NanoVDB converted from that grid (openToNanoVDB), same two lookups
@@ -22,7 +26,8 @@
 // Counters: voxels (active), topology_B (bytes per active voxel), payload_B, total_B, and
 // items_per_second = lookups per second for the lookup rows (ns per lookup = 1e9 / it).
 
-#include "voxel_tree.h" // techniques/voxel_gi/adaptive_voxel_tree
+#include "sparse_voxel_octree.h" // techniques/voxel_gi/svo
+#include "voxel_tree.h"          // techniques/voxel_gi/adaptive_voxel_tree
 
 #include "families/voxel_gi/voxelize.h"
 #include "metrics/structure_metrics.h"
@@ -177,6 +182,40 @@ private:
     std::vector<glm::vec3> mPayload;
 };
 
+class Svo final : public Structure {
+public:
+    void build(const Voxels& v) override
+    {
+        const int longest = std::max({v.cells.x, v.cells.y, v.cells.z});
+        int depth = 0;
+        while ((1 << depth) < longest)
+            ++depth;
+        mTopology = voxelgi::OctreeTopology::build(depth, v.active);
+        mPayload.assign(mTopology.child.size(), glm::vec3(0.0f));
+        for (std::size_t i = 0; i < v.active.size(); ++i)
+            mPayload[mTopology.leafNode[i]] = payloadOf(v.active[i]);
+    }
+    metrics::StructureFootprint footprint() const override
+    {
+        return {.topologyBytes = mTopology.getBytes(),
+                .payloadBytes = metrics::usedBytes(mPayload),
+                .nodeCount = mTopology.child.size()};
+    }
+    double lookupRandom(const std::vector<glm::ivec3>& q) const override
+    {
+        double sum = 0.0;
+        for (const auto& c : q) {
+            const std::int64_t i = mTopology.find(mTopology.depth, c);
+            sum += i >= 0 ? mPayload[std::size_t(i)].x : 0.0f;
+        }
+        return sum;
+    }
+
+private:
+    voxelgi::OctreeTopology mTopology;
+    std::vector<glm::vec3> mPayload;
+};
+
 // Payload bytes of a VDB: the leaves' value buffers (512 values each, active or not); topology:
 // everything else the grid reports (nodes, masks, the root table).
 class OpenVdb final : public Structure {
@@ -272,6 +311,8 @@ std::unique_ptr<Structure> makeStructure(const std::string& name)
         return std::make_unique<Avt>(true);
     if (name == "adaptive_voxel_tree_undilated")
         return std::make_unique<Avt>(false);
+    if (name == "svo")
+        return std::make_unique<Svo>();
     if (name == "openvdb")
         return std::make_unique<OpenVdb>();
     return std::make_unique<NanoVdb>();
@@ -341,7 +382,7 @@ int main(int argc, char** argv)
         for (int r : resolutions)
             for (const std::string name :
                  {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
-                  "openvdb", "nanovdb"}) {
+                  "svo", "openvdb", "nanovdb"}) {
                 const std::string prefix = sceneName + "/" + std::to_string(r) + "/" + name;
                 benchmark::RegisterBenchmark((prefix + "/build").c_str(), [=](benchmark::State& s) {
                     runBuild(s, sceneName, r, name);

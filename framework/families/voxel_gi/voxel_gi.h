@@ -38,6 +38,11 @@ struct VoxelGiDefinition {
     //! The light step is a precompute (a bake, as Quantum Break's probes): its time is reported
     //! apart (column bake_ms) and left out of the frame's technique_ms.
     bool precomputedLight = false;
+    //! The structure stores surfaces (with at most a thin layer inside), not the solid interior of
+    //! closed objects: a cone sample coarser than a wall sees through its unstored inside, so a
+    //! closed room loses light through thick walls. The family suite's furnace then bounds the
+    //! loss instead of requiring the closed form.
+    bool surfacesOnly = false;
 };
 
 //! The frame as the structure sees it: the static scene (no characters: the talk does not

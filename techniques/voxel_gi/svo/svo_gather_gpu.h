@@ -1,0 +1,38 @@
+#pragma once
+// The pixel gather of the sparse voxel octree on Vulkan (shaders/svo_gather.comp): the child
+// pointers and the gathered light of every node in two storage buffers, uploaded again only when
+// the tree or its light changed; positions go up relative to the cube's centre.
+
+#include "sparse_voxel_octree.h"
+
+#include "gpu/context.h"
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace rtlab::voxelgi {
+
+class OctreeGatherGpu {
+public:
+    static constexpr const char* kDispatchLabel = "svo.gather";
+
+    //! SparseVoxelOctree::gatherCones on the GPU, [pixel * 16 + cone].
+    void gatherCones(gpu::Context& context, const SparseVoxelOctree& tree,
+                     const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
+    //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/svo/shaders when set, else the source folder.
+    static std::filesystem::path getShaderDir();
+
+private:
+    gpu::Context* mContext = nullptr;
+    gpu::ComputePipeline mPipeline;
+    gpu::Buffer mChildren, mGathered, mPositions, mNormals, mOutput, mCones;
+    std::uint64_t mUploadedStamp = 0;
+    std::size_t mPixels = 0;
+    std::optional<double> mLastGpuMs;
+    std::size_t mLastUploadBytes = 0;
+};
+
+} // namespace rtlab::voxelgi
