@@ -196,7 +196,7 @@ TEST(VoxelGiSuite, WhiteFurnaceMatchesItsClosedForm)
     // A structure that declares surfacesOnly (svo) keeps the walls' surfaces and one layer inside
     // them, not their solid interior: its cones, once coarser than that layer, see through the
     // walls and out of the scene, so it must lose light, never gain it, and lose less than a
-    // fifth (measured: svo -14.7 % at its default 128 leaves; its own test shows that the leaves
+    // fifth (measured: svo -14.7 % at 128 leaves; its own test shows that the leaves
     // alone, traced with rays, hold the closed form).
     scene::RenderScene s;
     addRoom(s, glm::vec3(-0.5f), glm::vec3(0.5f), 0.5f,

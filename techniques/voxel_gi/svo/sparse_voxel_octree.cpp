@@ -292,6 +292,8 @@ void SparseVoxelOctree::build(const glm::dvec3& origin, double side, std::vector
     // rays of the voxelization see a wall only along its normal, and a cone crossing it
     // obliquely would blend in the wall's zero coverage along the other axes and see through.
     // A face the axis rays did not see takes the coverage-weighted mean colour of the others.
+    // (Emitting only what its own rays saw, 0 for a thin emitter seen edge-on, was measured
+    // worse: furnace -42 %, and a larger voxel error on both study scenes.)
     for (OctreeLeaf& l : mLeaves) {
         float coverage = 0.0f, weight = 0.0f;
         glm::vec3 albedo(0.0f), emission(0.0f);

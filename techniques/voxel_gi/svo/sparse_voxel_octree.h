@@ -42,11 +42,11 @@
 namespace rtlab::voxelgi {
 
 struct OctreeSettings {
-    int resolution = 128;   //!< leaves along the cube's side, a power of two in [2, 4096]
+    int resolution = 64;    //!< leaves along the cube's side, a power of two in [2, 4096]
     int supersampling = 4;  //!< voxelization rays per leaf column and axis, per side
     int bounces = 2;        //!< reflections gathered at the pixel (1..3)
     double coneHalfAngleDegrees = 29.0;
-    double startOffset = 1.0; //!< leaves: cone start distance and origin offset along the normal
+    double startOffset = 4.0; //!< leaves: cone start distance and origin offset along the normal
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
 };
