@@ -215,8 +215,8 @@ TEST(VoxelGiSuite, WhiteFurnaceMatchesItsClosedForm)
                     ++n;
                 }
         ASSERT_GT(n, 0);
-        const auto& gi = dynamic_cast<const plugin::VoxelGiTechnique&>(
-            *entry->create(config::ParamSet::defaultsOf(entry->schema)));
+        const auto technique = entry->create(config::ParamSet::defaultsOf(entry->schema));
+        const auto& gi = dynamic_cast<const plugin::VoxelGiTechnique&>(*technique);
         if (gi.definition().surfacesOnly) {
             EXPECT_LT(sum / n, 1.035 * expected) << entry->info.name;
             EXPECT_GT(sum / n, 0.8 * expected) << entry->info.name;

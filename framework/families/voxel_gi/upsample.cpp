@@ -280,4 +280,31 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
     return out;
 }
 
+Image<glm::vec3> gatherConesReduced(
+    const scene::GBuffer& full, int traceStep, double coneHalfAngle,
+    const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
+    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones)
+{
+    const ReducedGBuffer reduced = reduceGBuffer(full, traceStep);
+    std::vector<glm::vec3> cones;
+    traceCones(reduced.gbuffer, cones);
+    ConeCombineInputs combine;
+    combine.coneRadiance = &cones;
+    combine.reduced = &reduced;
+    combine.full = &full;
+    combine.visibility = visibility;
+    combine.capsules = capsules;
+    combine.coneHalfAngle = coneHalfAngle;
+    return combineCones(combine);
+}
+
+Image<glm::vec3> traceRaysReduced(const scene::GBuffer& full, int traceStep,
+                                  const std::function<void(const scene::GBuffer&, Image<glm::vec3>&)>& traceRays)
+{
+    const ReducedGBuffer reduced = reduceGBuffer(full, traceStep);
+    Image<glm::vec3> low;
+    traceRays(reduced.gbuffer, low);
+    return upsampleIrradiance(low, reduced, full);
+}
+
 } // namespace rtlab::voxelgi

@@ -13,6 +13,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <functional>
 #include <vector>
 
 namespace rtlab::voxelgi {
@@ -53,6 +54,20 @@ struct ConeCombineInputs {
     double coneHalfAngle = 0.5;                                 //!< radians
 };
 Image<glm::vec3> combineCones(const ConeCombineInputs& in);
+
+//! A cone-traced structure's pixel gather as the family runs it (cascades, svo): the G-buffer
+//! reduced to one pixel per traceStep^2 block, `traceCones(reduced, coneRadiance)` fills
+//! [low-res pixel * 16 + cone] there, and combineCones brings it back to full resolution with the
+//! cone visibilities and capsules (either may be null).
+Image<glm::vec3> gatherConesReduced(
+    const scene::GBuffer& full, int traceStep, double coneHalfAngle,
+    const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
+    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones);
+
+//! The error split's rays (voxel_gi.h traceVoxelRays) at the same representative pixels as
+//! gatherConesReduced, upsampled the same way: `traceRays(reduced, irradiance)`.
+Image<glm::vec3> traceRaysReduced(const scene::GBuffer& full, int traceStep,
+                                  const std::function<void(const scene::GBuffer&, Image<glm::vec3>&)>& traceRays);
 
 //! Share of a cone (axis `dir`, half-angle `coneHalfAngle`) from `p` that a capsule hides: the
 //! capsule is replaced by the sphere on its segment nearest the cone's axis, and the overlap of

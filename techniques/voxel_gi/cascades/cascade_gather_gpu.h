@@ -5,6 +5,7 @@
 
 #include "cascade_volume.h"
 
+#include "families/voxel_gi/cone_gather_gpu.h"
 #include "gpu/context.h"
 
 #include <filesystem>
@@ -29,12 +30,10 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
-    gpu::Context* mContext = nullptr;
-    gpu::ComputePipeline mPipeline;
-    gpu::Buffer mLevels, mCombined, mPositions, mNormals, mOutput, mCones;
+    PixelConeDispatch mDispatch;
+    gpu::Buffer mLevels, mCombined;
     std::size_t mCombinedLevelVoxels = 0;
     int mCombinedLevelCount = 0;
-    std::size_t mPixels = 0;
     std::vector<std::uint64_t> mUploadedStamps;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;

@@ -210,34 +210,27 @@ public:
     {
         // The Vulkan gather reads the pre-combined buffers; without them the C++ path runs.
         // Reduced resolution ("Trace at a lower resolution"): one pixel per trace_step^2 block,
-        // the cones' radiance upsampled by depth and normal.
+        // each cone's radiance upsampled by depth and normal, times the pixel's own visibilities
+        // (bent-cone SSDO) and the characters' capsules.
         mGatheredOnGpu = mOnGpu && mSettings.precombine && input.gpu != nullptr;
-        const voxelgi::ReducedGBuffer reduced = voxelgi::reduceGBuffer(*input.gbuffer, mTraceStep);
-        std::vector<glm::vec3> cones;
-        if (mGatheredOnGpu)
-            mGpu.gatherCones(*input.gpu, *mVolume, reduced.gbuffer, cones);
-        else
-            mVolume->gatherCones(reduced.gbuffer, cones);
-        // The final combine at full resolution: each cone upsampled, times the pixel's own
-        // visibilities (bent-cone SSDO) and the characters' capsules.
-        voxelgi::ConeCombineInputs combine;
-        combine.coneRadiance = &cones;
-        combine.reduced = &reduced;
-        combine.full = input.gbuffer;
-        combine.visibility = input.coneVisibility;
-        combine.capsules = input.capsules;
-        combine.coneHalfAngle = mVolume->getCones().halfAngle;
-        irradiance = voxelgi::combineCones(combine);
+        irradiance = voxelgi::gatherConesReduced(
+            *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
+            input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+                if (mGatheredOnGpu)
+                    mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
+                else
+                    mVolume->gatherCones(reduced, cones);
+            });
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
                         Image<glm::vec3>& irradiance) override
     {
         // At the same representative pixels as the cones, upsampled the same way.
-        const voxelgi::ReducedGBuffer reduced = voxelgi::reduceGBuffer(*input.gbuffer, mTraceStep);
-        Image<glm::vec3> low;
-        mVolume->gatherRays(reduced.gbuffer, raysPerPixel, low);
-        irradiance = voxelgi::upsampleIrradiance(low, reduced, *input.gbuffer);
+        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mTraceStep,
+                                               [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
+                                                   mVolume->gatherRays(reduced, raysPerPixel, low);
+                                               });
         return true;
     }
 

@@ -177,29 +177,23 @@ public:
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
         mGatheredOnGpu = mOnGpu && input.gpu != nullptr;
-        const voxelgi::ReducedGBuffer reduced = voxelgi::reduceGBuffer(*input.gbuffer, mTraceStep);
-        std::vector<glm::vec3> cones;
-        if (mGatheredOnGpu)
-            mGpu.gatherCones(*input.gpu, *mTree, reduced.gbuffer, cones);
-        else
-            mTree->gatherCones(reduced.gbuffer, cones);
-        voxelgi::ConeCombineInputs combine;
-        combine.coneRadiance = &cones;
-        combine.reduced = &reduced;
-        combine.full = input.gbuffer;
-        combine.visibility = input.coneVisibility;
-        combine.capsules = input.capsules;
-        combine.coneHalfAngle = mTree->getCones().halfAngle;
-        irradiance = voxelgi::combineCones(combine);
+        irradiance = voxelgi::gatherConesReduced(
+            *input.gbuffer, mTraceStep, mTree->getCones().halfAngle, input.coneVisibility,
+            input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+                if (mGatheredOnGpu)
+                    mGpu.gatherCones(*input.gpu, *mTree, reduced, cones);
+                else
+                    mTree->gatherCones(reduced, cones);
+            });
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
                         Image<glm::vec3>& irradiance) override
     {
-        const voxelgi::ReducedGBuffer reduced = voxelgi::reduceGBuffer(*input.gbuffer, mTraceStep);
-        Image<glm::vec3> low;
-        mTree->gatherRays(reduced.gbuffer, raysPerPixel, low);
-        irradiance = voxelgi::upsampleIrradiance(low, reduced, *input.gbuffer);
+        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mTraceStep,
+                                               [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
+                                                   mTree->gatherRays(reduced, raysPerPixel, low);
+                                               });
         return true;
     }
 

@@ -5,6 +5,7 @@
 
 #include "sparse_voxel_octree.h"
 
+#include "families/voxel_gi/cone_gather_gpu.h"
 #include "gpu/context.h"
 
 #include <filesystem>
@@ -26,11 +27,9 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
-    gpu::Context* mContext = nullptr;
-    gpu::ComputePipeline mPipeline;
-    gpu::Buffer mChildren, mGathered, mPositions, mNormals, mOutput, mCones;
+    PixelConeDispatch mDispatch;
+    gpu::Buffer mChildren, mGathered;
     std::uint64_t mUploadedStamp = 0;
-    std::size_t mPixels = 0;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;
 };

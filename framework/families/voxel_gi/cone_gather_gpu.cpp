@@ -1,0 +1,84 @@
+#include "families/voxel_gi/cone_gather_gpu.h"
+
+#include "gpu/shader_compiler.h"
+
+#include <glm/vec4.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace rtlab::voxelgi {
+
+void PixelConeDispatch::create(gpu::Context& context, const std::filesystem::path& shader,
+                               const std::string& label, std::size_t pushConstantSize, const ConeSet& cones)
+{
+    *this = PixelConeDispatch();
+    mContext = &context;
+    mLabel = label;
+    const gpu::ShaderCompiler compiler;
+    gpu::ComputePipelineDesc desc;
+    desc.name = label;
+    desc.spirv = compiler.compileFile(shader).spirv;
+    for (std::uint32_t b = 0; b < 6; ++b)
+        desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
+    desc.pushConstantSize = std::uint32_t(pushConstantSize);
+    mPipeline = context.createPipeline(desc);
+    std::vector<glm::vec4> directions(kConeCount);
+    for (int k = 0; k < kConeCount; ++k)
+        directions[std::size_t(k)] = glm::vec4(glm::vec3(cones.directions[std::size_t(k)]), 0.0f);
+    mCones = makeBuffer(directions.size() * sizeof(glm::vec4), "cone_gather.cones");
+    mCones.uploadSpan<glm::vec4>(directions);
+}
+
+gpu::Buffer PixelConeDispatch::makeBuffer(std::size_t bytes, const char* name)
+{
+    return mContext->createBuffer({std::max<std::size_t>(bytes, 16), name});
+}
+
+std::size_t PixelConeDispatch::uploadPixels(const scene::GBuffer& gbuffer, const glm::dvec3& anchor)
+{
+    const int w = gbuffer.width, h = gbuffer.height;
+    const std::size_t pixels = std::size_t(w) * std::size_t(h);
+    if (mPixels != pixels) {
+        mPositions = makeBuffer(pixels * sizeof(glm::vec4), "cone_gather.positions");
+        mNormals = makeBuffer(pixels * sizeof(glm::vec4), "cone_gather.normals");
+        mOutput = makeBuffer(pixels * kConeCount * sizeof(glm::vec4), "cone_gather.cone_radiance");
+        mPixels = pixels;
+    }
+    mWidth = w;
+    mHeight = h;
+    std::vector<glm::vec4> positions(pixels), normals(pixels);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+            const glm::dvec3 p(gbuffer.position.at(x, y));
+            const bool surface = gbuffer.hasSurface(x, y) && std::isfinite(p.x + p.y + p.z);
+            positions[i] = glm::vec4(glm::vec3(surface ? p - anchor : glm::dvec3(0.0)), surface ? 1.0f : 0.0f);
+            normals[i] = glm::vec4(gbuffer.normal.at(x, y), 0.0f);
+        }
+    mPositions.uploadSpan<glm::vec4>(positions);
+    mNormals.uploadSpan<glm::vec4>(normals);
+    return 2 * pixels * sizeof(glm::vec4);
+}
+
+std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& second,
+                                             const gpu::PushConstants& constants, std::vector<glm::vec3>& out)
+{
+    const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
+        cmd.dispatch(mPipeline,
+                     {gpu::Binding::storageBuffer(0, first), gpu::Binding::storageBuffer(1, second),
+                      gpu::Binding::storageBuffer(2, mPositions), gpu::Binding::storageBuffer(3, mNormals),
+                      gpu::Binding::storageBuffer(4, mOutput), gpu::Binding::storageBuffer(5, mCones)},
+                     constants,
+                     gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(mWidth), 8),
+                                     gpu::computeGroupCount(std::uint64_t(mHeight), 8), 1},
+                     mLabel.c_str());
+    });
+    const std::vector<glm::vec4> e = mOutput.downloadVector<glm::vec4>(mPixels * kConeCount);
+    out.resize(mPixels * kConeCount);
+    for (std::size_t i = 0; i < out.size(); ++i)
+        out[i] = glm::vec3(e[i]);
+    return result.sumGpuMs(mLabel);
+}
+
+} // namespace rtlab::voxelgi
