@@ -19,6 +19,17 @@
 
 namespace rtlab::voxelgi {
 
+//! The pixel's surface point and unit normal; false without a surface, with a non-finite
+//! position or without a normal (no indirect light there).
+inline bool readPixelSurface(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& p, glm::dvec3& n)
+{
+    if (!gbuffer.hasSurface(x, y))
+        return false;
+    p = glm::dvec3(gbuffer.position.at(x, y));
+    n = glm::dvec3(gbuffer.normal.at(x, y));
+    return glm::dot(n, n) >= 0.5 && std::isfinite(p.x + p.y + p.z);
+}
+
 //! The radiance of each cone above the surface at every pixel, [pixel * 16 + cone], 0 elsewhere
 //! (the field kDirect of the sampler's result: the gathered light). Returns the mean number of
 //! steps per cone traced.

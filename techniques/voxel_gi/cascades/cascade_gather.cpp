@@ -14,11 +14,8 @@ namespace rtlab::voxelgi {
 bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
                                  glm::dvec3& n, ConeMarchSettings& march) const
 {
-    if (!gbuffer.hasSurface(x, y))
-        return false;
-    const glm::dvec3 p(gbuffer.position.at(x, y));
-    n = glm::dvec3(gbuffer.normal.at(x, y));
-    if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
+    glm::dvec3 p;
+    if (!readPixelSurface(gbuffer, x, y, p, n))
         return false;
     const double start = selectLevel(p, 0.0);
     if (start < 0.0)

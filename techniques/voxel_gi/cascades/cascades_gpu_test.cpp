@@ -20,26 +20,9 @@ using namespace rtlab::voxelgi::testing;
 
 namespace {
 
-// A room with a window-less wall opening to the sky on one side, a box inside, a point light:
-// sky, point light and both bounces all contribute.
-scene::RenderScene makeScene(glm::vec3 offset)
-{
-    scene::RenderScene s;
-    const auto white = addMaterial(s, glm::vec3(0.7f));
-    const auto red = addMaterial(s, {0.7f, 0.1f, 0.1f});
-    addBox(s, offset + glm::vec3(-1.2f, -1.2f, -1.2f), offset + glm::vec3(1.2f, -1.0f, 1.2f), white);
-    addBox(s, offset + glm::vec3(-1.2f, -1.0f, -1.2f), offset + glm::vec3(-1.0f, 1.0f, 1.2f), red);
-    addBox(s, offset + glm::vec3(-1.0f, -1.0f, -1.2f), offset + glm::vec3(1.2f, 1.0f, -1.0f), white);
-    addBox(s, offset + glm::vec3(-0.3f, -1.0f, -0.4f), offset + glm::vec3(0.2f, -0.3f, 0.1f), white);
-    s.pointLights.push_back({offset + glm::vec3(0.5f, 0.6f, 0.3f), glm::vec3(2.0f)});
-    s.sky.kind = scene::Sky::Kind::Constant;
-    s.sky.constant = glm::vec3(0.5f, 0.6f, 0.8f);
-    return s;
-}
-
 void compare(const glm::vec3& offset, const CascadeSettings& settings)
 {
-    const scene::RenderScene s = makeScene(offset);
+    const scene::RenderScene s = makeOpenRoom(offset);
     scene::Camera camera;
     camera.position = offset + glm::vec3(0.8f, 0.4f, 1.6f);
     camera.target = offset + glm::vec3(-0.5f, -0.7f, -0.5f);

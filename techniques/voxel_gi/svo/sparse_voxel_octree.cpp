@@ -331,8 +331,13 @@ void SparseVoxelOctree::build(const glm::dvec3& origin, double side, std::vector
     ++mStamp;
 }
 
-void SparseVoxelOctree::filterAlphaUp()
+template <class Get>
+void SparseVoxelOctree::filterUp(const Get& get)
 {
+    // Per parent face: along the face's axis each of the 4 columns of two children composited
+    // front to back as that face's viewer sees them (value_front + (1 - alpha_front) value_back,
+    // premultiplied), the columns averaged. `get(face index)` is the value filtered (the
+    // occupancy itself, or a light field); the children's levels are final before their parents'.
     for (int level = mDepth - 1; level >= 0; --level) {
         const auto& nodes = mTopology.levelNodes[std::size_t(level)];
         tbb::parallel_for(std::size_t(0), nodes.size(), [&](std::size_t i) {
@@ -341,46 +346,29 @@ void SparseVoxelOctree::filterAlphaUp()
             for (int f = 0; f < kFaceCount; ++f) {
                 const int axis = f / 2;
                 const std::uint32_t frontBit = (f % 2 == 0) ? (1u << axis) : 0u;
-                float sum = 0.0f;
+                auto sum = get(0) * 0.0f;
                 for (std::uint32_t octant = 0; octant < 8; ++octant) {
                     if ((octant & (1u << axis)) != frontBit)
                         continue; // one front child per column of two
-                    const std::uint32_t back = octant ^ (1u << axis);
-                    const float af = mGathered[std::size_t(tile + octant) * kFaceCount + std::size_t(f)].a;
-                    const float ab = mGathered[std::size_t(tile + back) * kFaceCount + std::size_t(f)].a;
-                    sum += af + (1.0f - af) * ab;
+                    const std::size_t front = std::size_t(tile + octant) * kFaceCount + std::size_t(f);
+                    const std::size_t back = std::size_t(tile + (octant ^ (1u << axis))) * kFaceCount + std::size_t(f);
+                    sum += get(front) + (1.0f - mGathered[front].a) * get(back);
                 }
-                mGathered[std::size_t(node) * kFaceCount + std::size_t(f)].a = 0.25f * sum;
+                get(std::size_t(node) * kFaceCount + std::size_t(f)) = 0.25f * sum;
             }
         });
     }
 }
 
+void SparseVoxelOctree::filterAlphaUp()
+{
+    filterUp([this](std::size_t i) -> float& { return mGathered[i].a; });
+}
+
 void SparseVoxelOctree::filterFieldUp(int field)
 {
     auto& light = mLight[std::size_t(field)];
-    for (int level = mDepth - 1; level >= 0; --level) {
-        const auto& nodes = mTopology.levelNodes[std::size_t(level)];
-        tbb::parallel_for(std::size_t(0), nodes.size(), [&](std::size_t i) {
-            const std::uint32_t node = nodes[i];
-            const std::uint32_t tile = mTopology.child[node];
-            for (int f = 0; f < kFaceCount; ++f) {
-                const int axis = f / 2;
-                const std::uint32_t frontBit = (f % 2 == 0) ? (1u << axis) : 0u;
-                glm::vec3 sum(0.0f);
-                for (std::uint32_t octant = 0; octant < 8; ++octant) {
-                    if ((octant & (1u << axis)) != frontBit)
-                        continue;
-                    const std::uint32_t back = octant ^ (1u << axis);
-                    const std::size_t front = std::size_t(tile + octant) * kFaceCount + std::size_t(f);
-                    const float af = mGathered[front].a;
-                    sum += light[front] +
-                           (1.0f - af) * light[std::size_t(tile + back) * kFaceCount + std::size_t(f)];
-                }
-                light[std::size_t(node) * kFaceCount + std::size_t(f)] = 0.25f * sum;
-            }
-        });
-    }
+    filterUp([&light](std::size_t i) -> glm::vec3& { return light[i]; });
 }
 
 void SparseVoxelOctree::injectLight(const scene::RenderScene& geometry)
@@ -534,11 +522,8 @@ bool SparseVoxelOctree::sampleGathered(const glm::dvec3& p, double diameter, con
 bool SparseVoxelOctree::preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
                                      glm::dvec3& n, ConeMarchSettings& march) const
 {
-    if (!gbuffer.hasSurface(x, y))
-        return false;
-    const glm::dvec3 p(gbuffer.position.at(x, y));
-    n = glm::dvec3(gbuffer.normal.at(x, y));
-    if (glm::dot(n, n) < 0.5 || !std::isfinite(p.x + p.y + p.z))
+    glm::dvec3 p;
+    if (!readPixelSurface(gbuffer, x, y, p, n))
         return false;
     const glm::dvec3 rel = (p - mOrigin) / mSide;
     if (!(rel.x >= 0.0 && rel.y >= 0.0 && rel.z >= 0.0 && rel.x <= 1.0 && rel.y <= 1.0 && rel.z <= 1.0))

@@ -181,6 +181,8 @@ private:
     template <bool Gathered>
     void sampleLevel(int level, const glm::dvec3& p, const glm::dvec3& dir, float weight,
                      ConeSample& out) const;
+    template <class Get>
+    void filterUp(const Get& get);
     //! Filters the occupancy (mGathered's a) up the tree.
     void filterAlphaUp();
     //! Filters light field `field` up the tree (front-to-back composite with the filtered

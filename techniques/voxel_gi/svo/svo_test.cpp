@@ -47,23 +47,6 @@ scene::Camera lookAt(glm::vec3 position, glm::vec3 target)
     return c;
 }
 
-// A room open to the sky on two sides, a box inside, a point light: sky, point light and both
-// bounces contribute.
-scene::RenderScene makeOpenRoom(glm::vec3 offset)
-{
-    scene::RenderScene s;
-    const auto white = addMaterial(s, glm::vec3(0.7f));
-    const auto red = addMaterial(s, {0.7f, 0.1f, 0.1f});
-    addBox(s, offset + glm::vec3(-1.2f, -1.2f, -1.2f), offset + glm::vec3(1.2f, -1.0f, 1.2f), white);
-    addBox(s, offset + glm::vec3(-1.2f, -1.0f, -1.2f), offset + glm::vec3(-1.0f, 1.0f, 1.2f), red);
-    addBox(s, offset + glm::vec3(-1.0f, -1.0f, -1.2f), offset + glm::vec3(1.2f, 1.0f, -1.0f), white);
-    addBox(s, offset + glm::vec3(-0.3f, -1.0f, -0.4f), offset + glm::vec3(0.2f, -0.3f, 0.1f), white);
-    s.pointLights.push_back({offset + glm::vec3(0.5f, 0.6f, 0.3f), glm::vec3(2.0f)});
-    s.sky.kind = scene::Sky::Kind::Constant;
-    s.sky.constant = glm::vec3(0.5f, 0.6f, 0.8f);
-    return s;
-}
-
 } // namespace
 
 TEST(Svo, RegistersWithItsParameters)
