@@ -188,7 +188,8 @@ std::vector<OctreeLeaf> SparseVoxelOctree::voxelizeLeaves(const scene::RenderSce
     surface.reserve(leaves.size());
     for (std::size_t i = 0; i < leaves.size(); ++i)
         surface.emplace(encodeMorton(leaves[i].coord), std::int32_t(i));
-    const std::size_t surfaceCount = leaves.size();
+    if (leaves.size() > std::size_t(INT32_MAX))
+        throw Error("svo: more than 2^31 surface leaves");
     for (auto& b : solidPerBlock)
         for (OctreeLeaf& l : b)
             for (int f = 0; f < kFaceCount; ++f) {
@@ -203,8 +204,6 @@ std::vector<OctreeLeaf> SparseVoxelOctree::voxelizeLeaves(const scene::RenderSce
                 leaves.push_back(l);
                 break;
             }
-    if (leaves.size() > surfaceCount && leaves.size() > std::size_t(INT32_MAX))
-        throw Error("svo: more than 2^31 leaves");
     return leaves;
 }
 

@@ -13,12 +13,13 @@
 //
 // Algorithm (sparse_voxel_octree.h):
 // 1. voxelize: the static scene's box (padded by a leaf) as a cube of resolution^3 leaves; the
-//    blocks of chunk^3 leaves a triangle meets are voxelized (families/voxel_gi/voxelize.h,
-//    supersampled coverage, no solid fill) and their surface voxels are the voxel fragments;
-//    the octree is built top-down over them (node tiles of 2x2x2, one child pointer per node)
-//    and their occupancy filtered up the tree anisotropically (6 faces, front-to-back per
-//    column). Rebuilt only when the static geometry changes.
-// 2. inject light: per leaf, the family's 16-cone gather through the octree (emission, sky as 16
+//    blocks of 32^3 leaves a triangle meets are voxelized (families/voxel_gi/voxelize.h,
+//    supersampled coverage); their surface voxels are the voxel fragments, and the solid voxels
+//    just inside closed surfaces join them as an inner layer that mirrors the surface's light;
+//    leaves are isotropic (the paper's); the octree is built top-down over them (node tiles of
+//    2x2x2, one child pointer per node) and their occupancy filtered up the tree anisotropically
+//    (6 faces, front-to-back per column). Rebuilt only when the static geometry changes.
+// 2. inject light: per surface leaf, the family's 16-cone gather through the octree (emission, sky as 16
 //    lobes, point lights with shadow cones), three passes (direct, bounce 1, bounce 2), each
 //    filtered up the tree before the next reads it. Skipped while the tree and lights are
 //    unchanged.
@@ -27,7 +28,10 @@
 //    normal and multiplied by the occlusion family's cone visibilities and the characters'
 //    capsules (families/voxel_gi/upsample.h), as cascades.
 // The gather runs on Vulkan (shaders/svo_gather.comp) or in C++; build and injection in C++ (TBB).
-// Not yet: bricks (3^3 with shared borders), empty-space skipping, a local rebuild after a dig.
+// Declares surfacesOnly: the walls' interior beyond the inner layer is not stored, so coarse cone
+// samples see through thick walls (the family's furnace loses light; the leak rooms leak).
+// Not yet: bricks (3^3 with shared borders), empty-space skipping, constant (solid) nodes, a
+// start level chosen by the distance to the camera, a local rebuild after a dig.
 //
 // Parameters
 // | name          | type  | default | range / choices | unit                          |
