@@ -122,8 +122,9 @@ double CsgEdit::evaluatePrimitive(const glm::dvec3& pw) const
 
 void CsgEdit::getBounds(glm::dvec3& lo, glm::dvec3& hi) const
 {
-    // Local half extents, then the world box of the rotated local box.
-    glm::dvec3 e;
+    // Local half extents, then the world box of the rotated local box. (Every shape sets e; the
+    // initial value only keeps the compiler from warning that an out-of-range enum would not.)
+    glm::dvec3 e(0.0);
     switch (shape) {
     case CsgShape::Sphere: e = glm::dvec3(size.x); break;
     case CsgShape::Box:
