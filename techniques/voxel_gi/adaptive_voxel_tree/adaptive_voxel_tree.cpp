@@ -31,7 +31,8 @@
 //    cube, a + b.n (clamped at 0) for sh_l1. `interpolation: plain` uses one level only (missing
 //    corners dropped), the comparison the talk makes.
 // Characters and the occlusion family's cone visibilities are not used (the probes are static).
-// Not yet: the tree as a structure for the 16-cone tracing of cascades ([8] (b)), Vulkan lookups.
+// The tree as the structure of the 16-cone tracing: technique adaptive_voxel_tree_cones.
+// Not yet: Vulkan lookups.
 //
 // Parameters
 // | name          | type | default       | range / choices        | unit                        |

@@ -27,6 +27,7 @@
 // the paper's 3^3 bricks with shared borders trade payload memory for one descent per sample.
 
 #include "families/voxel_gi/cone_tracing.h"
+#include "families/voxel_gi/sparse_leaves.h"
 #include "families/voxel_gi/voxelize.h"
 #include "core/image.h"
 #include "scene/gbuffer.h"
@@ -49,6 +50,7 @@ struct OctreeSettings {
     double startOffset = 4.0; //!< leaves: cone start distance and origin offset along the normal
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
+    int innerLayers = 1;      //!< layers of solid leaves inside closed surfaces (sparse_leaves.h)
 };
 
 //! The octree's topology alone (the node pool of the paper): what every payload is indexed by.
@@ -84,15 +86,7 @@ struct OctreeTopology {
 };
 
 //! One surface voxel of the scene: the octree's input (a "voxel fragment").
-struct OctreeLeaf {
-    glm::ivec3 coord{0};                  //!< leaf lattice coordinates
-    std::array<glm::vec4, kFaceCount> faces{}; //!< albedo, occupancy per face
-    std::array<glm::vec3, kFaceCount> emission{};
-    glm::vec3 normal{0.0f};
-    //! -1 for a surface voxel; for a voxel of the layer just inside a closed surface, the index
-    //! of the surface leaf beside it whose light it mirrors (it is not lit itself).
-    std::int32_t inwardOf = -1;
-};
+using OctreeLeaf = SurfaceLeaf;
 
 class SparseVoxelOctree {
 public:
@@ -128,7 +122,7 @@ public:
     const std::vector<std::uint32_t>& getChildPointers() const { return mTopology.child; }
     //! [node * 6 + face]: rgb = the light a pixel gathers (the reflected fields up to `bounces`,
     //! premultiplied; 0 until injectLight), a = occupancy (filtered from the leaves by build).
-    const std::vector<glm::vec4>& getGathered() const { return mGathered; }
+    const std::vector<glm::vec4>& getGathered() const { return mPayload.gathered; }
     std::uint64_t getStamp() const { return mStamp; } //!< changes when the tree or its light change
 
     //! The node holding voxel `coord` of `level`, or -1 (OctreeTopology::find).
@@ -136,7 +130,7 @@ public:
     //! Occupancy of `face` of a node (filtered for interior nodes).
     float getAlpha(std::size_t node, int face) const
     {
-        return mGathered[node * kFaceCount + std::size_t(face)].a;
+        return mPayload.gathered[node * kFaceCount + std::size_t(face)].a;
     }
 
     //! Quadrilinear sample (see the header comment): the light fields (injection) or the
@@ -178,12 +172,9 @@ public:
 private:
     template <bool Gathered>
     bool sampleAt(const glm::dvec3& p, double diameter, const glm::dvec3& dir, ConeSample& out) const;
-    template <bool Gathered>
-    void sampleLevel(int level, const glm::dvec3& p, const glm::dvec3& dir, float weight,
-                     ConeSample& out) const;
     template <class Get>
     void filterUp(const Get& get);
-    //! Filters the occupancy (mGathered's a) up the tree.
+    //! Filters the occupancy (the gathered payload's a) up the tree.
     void filterAlphaUp();
     //! Filters light field `field` up the tree (front-to-back composite with the filtered
     //! occupancy of the children).
@@ -196,9 +187,8 @@ private:
     double mSide = 1.0;
     OctreeTopology mTopology;     //!< leafNode indexes mLeaves
     std::vector<OctreeLeaf> mLeaves;
-    //! [node * 6 + face], premultiplied: the light fields, during injectLight only.
-    std::array<std::vector<glm::vec3>, kFieldCount> mLight;
-    std::vector<glm::vec4> mGathered;
+    //! [node * 6 + face]: gathered light and occupancy; the light fields during injectLight.
+    SparsePayload mPayload;
     std::uint64_t mStamp = 0;
     double mMeanStepsPerCone = 0.0;
 };

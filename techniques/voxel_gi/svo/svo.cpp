@@ -45,6 +45,7 @@
 // | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled     |
 // | trace_step    | int   | 4       | [1, 8]          | pixels                        |
 // | device        | enum  | vulkan  | vulkan, cpu     | where the pixel gather runs   |
+// | inner_layers  | int   | 1       | [1, 8]          | leaves of solid kept inside closed surfaces |
 //
 // resolution 64: the pixel's cones start a fixed number of leaves out (there is no start level
 // chosen by the distance to the camera), so finer leaves bring the self-occlusion back and the
@@ -102,6 +103,8 @@ public:
         schema.addInt("trace_step", 4, 1, 8, "pixels",
                       "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
         schema.addEnum("device", "vulkan", {"vulkan", "cpu"}, "where the pixel gather runs");
+        schema.addInt("inner_layers", 1, 1, 8, "leaves",
+                      "layers of solid leaves kept inside closed surfaces (the rest of a solid is not stored)");
         return schema;
     }
 
@@ -119,6 +122,7 @@ public:
         mSettings.stepScale = p.getFloat("step_scale");
         mTraceStep = int(p.getInt("trace_step"));
         mOnGpu = p.getString("device") == "vulkan";
+        mSettings.innerLayers = int(p.getInt("inner_layers"));
     }
 
     config::ParamSet effectiveParams() const override
@@ -133,6 +137,7 @@ public:
         p.set("step_scale", mSettings.stepScale);
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
+        p.set("inner_layers", std::int64_t(mSettings.innerLayers));
         return p;
     }
 
