@@ -28,10 +28,10 @@
 //    each sample trilinear at the two levels around the footprint (4x apart) and linear between
 //    them; upsampled by depth and normal and multiplied by the occlusion family's cone
 //    visibilities and the characters' capsules (upsample.h), as cascades and svo.
-// In C++ (TBB). Declares surfacesOnly, like svo: the walls' interior beyond the inner layer is
-// not stored.
-// Not yet: the gather on Vulkan (two 32-bit bitCount for the 64-bit popcount), a local rebuild
-// after a dig.
+// The gather runs on Vulkan (shaders/tree_cone_gather.comp, the 64-bit popcount as two 32-bit
+// bitCounts) or in C++; build and injection in C++ (TBB). Declares surfacesOnly, like svo: the
+// walls' interior beyond the inner layers is not stored.
+// Not yet: a local rebuild after a dig.
 //
 // Parameters
 // | name          | type  | default | range / choices | unit                              |
@@ -45,6 +45,7 @@
 // | start_offset  | float | 4       | [0, 8]          | leaves                            |
 // | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled         |
 // | trace_step    | int   | 4       | [1, 8]          | pixels                            |
+// | device        | enum  | vulkan  | vulkan, cpu     | where the pixel gather runs       |
 // | inner_layers  | int   | 4       | [1, 8]          | leaves of solid kept inside closed surfaces |
 //
 // start_offset 4 as svo (the same leaves, the same self-occlusion at a smaller offset).
@@ -59,6 +60,7 @@
 //   techniques:
 //     voxel_gi: {technique: adaptive_voxel_tree_cones, params: {resolution: 128, depth: 3}}
 
+#include "tree_cone_gather_gpu.h"
 #include "voxel_tree_cones.h"
 
 #include "families/voxel_gi/upsample.h"
@@ -96,6 +98,7 @@ public:
         schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
         schema.addInt("trace_step", 4, 1, 8, "pixels",
                       "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
+        schema.addEnum("device", "vulkan", {"vulkan", "cpu"}, "where the pixel gather runs");
         schema.addInt("inner_layers", 4, 1, 8, "leaves",
                       "layers of solid leaves kept inside closed surfaces (the rest of a solid is not stored)");
         return schema;
@@ -113,6 +116,7 @@ public:
         mSettings.stepScale = p.getFloat("step_scale");
         mTraceStep = int(p.getInt("trace_step"));
         mSettings.innerLayers = int(p.getInt("inner_layers"));
+        mOnGpu = p.getString("device") == "vulkan";
         mTree.emplace(mSettings); // checks the settings
     }
 
@@ -129,6 +133,7 @@ public:
         p.set("step_scale", mSettings.stepScale);
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("inner_layers", std::int64_t(mSettings.innerLayers));
+        p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
         return p;
     }
 
@@ -184,9 +189,15 @@ public:
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
+        mGatheredOnGpu = mOnGpu && input.gpu != nullptr;
         irradiance = voxelgi::gatherConesReduced(
             *input.gbuffer, mTraceStep, mTree->getCones().halfAngle, input.coneVisibility, input.capsules,
-            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) { mTree->gatherCones(reduced, cones); });
+            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+                if (mGatheredOnGpu)
+                    mGpu.gatherCones(*input.gpu, *mTree, reduced, cones);
+                else
+                    mTree->gatherCones(reduced, cones);
+            });
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
@@ -213,7 +224,10 @@ public:
                 {"leaves", double(mTree->getLeaves().size())},
                 {"nodes", double(mTree->getTree()->getNodeCount())},
                 {"elements", double(mTree->getTree()->getElementCount())},
-                {"steps_per_cone", mTree->getMeanStepsPerCone()}};
+                {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mTree->getMeanStepsPerCone()},
+                {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
+                {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
+                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
     }
 
 private:
@@ -224,6 +238,9 @@ private:
     int mResolution = 64;
     double mLeafSize = 0.0;
     int mTraceStep = 4;
+    bool mOnGpu = true;
+    bool mGatheredOnGpu = false;
+    voxelgi::TreeConeGatherGpu mGpu;
 };
 
 } // namespace

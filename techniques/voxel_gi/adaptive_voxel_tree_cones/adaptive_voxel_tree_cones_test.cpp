@@ -1,8 +1,13 @@
 // Unit tests of adaptive_voxel_tree_cones as a voxel_gi technique: its parameters, the furnace's
 // closed form at the pixels and along the error split's rays, what is skipped when nothing
-// changed, and the same leaves as svo's voxelization of the same lattice.
+// changed, the leaves of non-cubic lattices and their inner layers, and the Vulkan gather against
+// the C++ one (near and far from the origin).
 
+#include "tree_cone_gather_gpu.h"
 #include "voxel_tree_cones.h"
+
+#include "families/voxel_gi/voxel_gi_gpu_parity.h"
+#include "gpu/context.h"
 
 #include "families/voxel_gi/voxel_gi.h"
 #include "families/voxel_gi/voxel_gi_test_scenes.h"
@@ -203,4 +208,53 @@ TEST(AdaptiveVoxelTreeCones, InnerLayersAreTheSolidVoxelsWithinThatManyStepsOfTh
     }
     EXPECT_GT(expected.size(), 10000u);
     EXPECT_EQ(inner, expected);
+}
+
+namespace {
+
+// The Vulkan gather against the C++ one on the same tree and G-buffer (positions relative to the
+// lattice's centre in the shader), with the tolerance stated in voxel_gi_gpu_parity.h. Two root
+// cells along x, so that the dense first level is indexed too.
+void compareGpu(glm::vec3 offset)
+{
+    const scene::RenderScene s = makeOpenRoom(offset);
+    scene::Camera camera;
+    camera.position = offset + glm::vec3(0.8f, 0.4f, 1.6f);
+    camera.target = offset + glm::vec3(-0.5f, -0.7f, -0.5f);
+    camera.nearPlane = 1e-3f;
+    const scene::GBuffer g = reference::castGBuffer(s, camera, 48, 32);
+    VoxelTreeCones tree({.depth = 2, .supersampling = 2});
+    glm::dvec3 origin;
+    double leaf = 0.0;
+    glm::ivec3 roots;
+    VoxelTreeCones::computeLattice(glm::dvec3(s.boundsMin), glm::dvec3(s.boundsMax), 32, 2, 0.0, origin, leaf, roots);
+    ASSERT_GT(roots.x * roots.y * roots.z, 1);
+    LeafLattice lattice;
+    lattice.origin = origin;
+    lattice.leafSize = leaf;
+    lattice.cells = roots * 16;
+    lattice.supersampling = 2;
+    tree.build(origin, leaf, roots, voxelizeSurfaceLeaves(s, lattice, "test"));
+    tree.injectLight(s);
+    std::vector<glm::vec3> cpuCones, gpuCones;
+    tree.gatherCones(g, cpuCones);
+    gpu::Context context;
+    TreeConeGatherGpu gather;
+    gather.gatherCones(context, tree, g, gpuCones);
+    expectGpuConesMatchCpu(cpuCones, gpuCones, g, tree.getCones().halfAngle);
+    // A second call uploads only the pixels (the tree and its light are unchanged).
+    gather.gatherCones(context, tree, g, gpuCones);
+    EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
+}
+
+} // namespace
+
+TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesTheCppGather)
+{
+    compareGpu(glm::vec3(0.0f));
+}
+
+TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesFarFromTheOrigin)
+{
+    compareGpu(glm::vec3(1e5f, 0.0f, -1e5f));
 }

@@ -89,6 +89,7 @@ void VoxelTreeCones::build(const glm::dvec3& origin, double leafSize, const glm:
             mPayload.gathered[std::size_t(mLeafElement[i]) * kFaceCount + std::size_t(f)].a =
                 std::clamp(mLeaves[i].faces[std::size_t(f)].a, 0.0f, 1.0f);
     filterUp([this](std::size_t g) -> float& { return mPayload.gathered[g].a; });
+    ++mStamp;
 }
 
 template <class Get>
@@ -124,6 +125,7 @@ void VoxelTreeCones::injectLight(const scene::RenderScene& geometry)
         auto& light = mPayload.fields[std::size_t(field)];
         filterUp([&light](std::size_t g) -> glm::vec3& { return light[g]; });
     });
+    ++mStamp;
 }
 
 template <bool Gathered>

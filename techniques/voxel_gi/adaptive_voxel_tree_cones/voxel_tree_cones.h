@@ -67,6 +67,8 @@ public:
     const std::vector<glm::vec4>& getGathered() const { return mPayload.gathered; }
     glm::dvec3 getOrigin() const { return mOrigin; }
     double getLeafSize() const { return mLeafSize; }
+    glm::dvec3 getBoxSize() const { return mBoxSize; } //!< the lattice's extent
+    std::uint64_t getStamp() const { return mStamp; }  //!< changes when the tree or its light change
     //! Filtered occupancy of `face` of element `element`.
     float getAlpha(std::size_t element, int face) const
     {
@@ -120,6 +122,7 @@ private:
     std::vector<std::uint32_t> mLeafElement; //!< [leaf]: its element index in the tree
     SparsePayload mPayload;
     double mMeanStepsPerCone = 0.0;
+    std::uint64_t mStamp = 0;
 };
 
 } // namespace rtlab::voxelgi

@@ -1,0 +1,139 @@
+#version 450
+// The pixel gather of the adaptive voxel tree on Vulkan: per G-buffer pixel, the 16 fixed cones
+// above the surface marched front to back through the tree's gathered light, each sample
+// trilinear at the two levels around the cone footprint (4x apart) and linear between them; every
+// corner found by a descent from its dense root cell. The child index is Quantum Break's offset +
+// popcount of the mask bits below the child's (Silvennoinen & Timonen, SIGGRAPH 2015, "Adaptive
+// Voxel Tree"), the 64-bit popcount as two 32-bit bitCounts. The same algorithm as
+// VoxelTreeCones::gatherCones (voxel_tree_cones.cpp, cone_tracing.h marchCone), in float.
+// Positions are relative to the lattice's centre (precision far from the origin).
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+// [node * 3 + 0, 1, 2]: child mask low and high 32 bits, offset of the first child.
+layout(std430, binding = 0) readonly buffer NodeBuffer { uint nodes[]; };
+// [element * 6 + face]: rgb = gathered light premultiplied by the occupancy, a = occupancy.
+layout(std430, binding = 1) readonly buffer GatheredBuffer { vec4 gathered[]; };
+layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
+layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
+layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
+layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
+
+layout(push_constant) uniform Constants {
+    ivec4 size;  // width, height, depth (levels below the roots), max steps
+    vec4 march;  // leaf size, tan(half-angle), start offset (leaves), step scale
+    vec4 box;    // xyz: min corner relative to the centre
+    ivec4 roots; // xyz: root cells per axis
+} pc;
+
+// The element at cell c of `level`, or -1 (outside the lattice or an empty region).
+int findElement(int level, ivec3 c)
+{
+    const int shift = 2 * level;
+    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c >> shift, pc.roots.xyz)))
+        return -1;
+    const ivec3 r = c >> shift;
+    uint index = uint(r.x + pc.roots.x * (r.y + pc.roots.y * r.z));
+    for (int s = shift - 2; s >= 0; s -= 2) {
+        const uint lo = nodes[3u * index], hi = nodes[3u * index + 1u], offset = nodes[3u * index + 2u];
+        const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
+        uint below;
+        if (bit < 32) {
+            if (((lo >> uint(bit)) & 1u) == 0u)
+                return -1;
+            below = uint(bitCount(lo & ((1u << uint(bit)) - 1u)));
+        } else {
+            const uint b = uint(bit - 32);
+            if (((hi >> b) & 1u) == 0u)
+                return -1;
+            below = uint(bitCount(lo)) + uint(bitCount(hi & ((1u << b) - 1u)));
+        }
+        index = offset + below;
+    }
+    return int(index);
+}
+
+vec4 sampleLevel(int level, vec3 p, vec3 dir)
+{
+    const float size = pc.march.x * exp2(float(2 * (pc.size.z - level)));
+    const vec3 c = (p - pc.box.xyz) / size - 0.5;
+    const vec3 f = floor(c);
+    const ivec3 i0 = ivec3(f);
+    const vec3 t = c - f;
+    // The face a cone travelling along +axis sees is the voxel's -axis face.
+    const ivec3 faceSeen = ivec3(0, 2, 4) + ivec3(greaterThan(dir, vec3(0.0)));
+    const vec3 axisWeight = dir * dir;
+    vec4 acc = vec4(0.0);
+    for (int corner = 0; corner < 8; ++corner) {
+        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
+        const float w = w3.x * w3.y * w3.z;
+        if (w == 0.0)
+            continue;
+        const int e = findElement(level, i0 + d);
+        if (e < 0)
+            continue;
+        const uint base = uint(e) * 6u;
+        acc += w * (axisWeight.x * gathered[base + uint(faceSeen.x)] +
+                    axisWeight.y * gathered[base + uint(faceSeen.y)] +
+                    axisWeight.z * gathered[base + uint(faceSeen.z)]);
+    }
+    return acc;
+}
+
+bool insideBox(vec3 p)
+{
+    const vec3 extent = vec3(pc.roots.xyz) * (pc.march.x * exp2(float(2 * pc.size.z)));
+    const vec3 rel = (p - pc.box.xyz) / extent;
+    return all(greaterThanEqual(rel, vec3(0.0))) && all(lessThanEqual(rel, vec3(1.0)));
+}
+
+void main()
+{
+    const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
+    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y)
+        return;
+    const int index = pixel.y * pc.size.x + pixel.x;
+    for (int k = 0; k < 16; ++k)
+        coneRadiance[index * 16 + k] = vec4(0.0);
+    const vec4 position = positions[index];
+    const vec3 n = normals[index].xyz;
+    if (position.w == 0.0 || dot(n, n) < 0.5 || !insideBox(position.xyz))
+        return;
+    const float leaf = pc.march.x;
+    const int depth = pc.size.z;
+    const vec3 origin = position.xyz + n * (0.5 * pc.march.z * leaf);
+    const float startDistance = pc.march.z * leaf;
+    for (int k = 0; k < 16; ++k) {
+        if (dot(cones[k].xyz, n) <= 0.0)
+            continue;
+        const vec3 dir = cones[k].xyz;
+        float occupied = 0.0;
+        vec3 light = vec3(0.0);
+        float t = startDistance;
+        for (int step = 0; step < pc.size.w; ++step) {
+            const vec3 q = origin + t * dir;
+            if (!insideBox(q))
+                break; // left the lattice: no indirect light from beyond
+            const float diameter = 2.0 * t * pc.march.y;
+            const float m = min(float(depth), diameter > leaf ? 0.5 * log2(diameter / leaf) : 0.0);
+            const int m0 = int(floor(m));
+            const float frac = m - float(m0);
+            vec4 s = (1.0 - frac) * sampleLevel(depth - m0, q, dir);
+            if (frac > 0.0 && m0 < depth)
+                s += frac * sampleLevel(depth - m0 - 1, q, dir);
+            const float voxelSize = leaf * exp2(2.0 * m);
+            const float dt = pc.march.w * voxelSize;
+            const float a = clamp(s.a, 0.0, 1.0);
+            if (a > 0.0) {
+                const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
+                light += ((1.0 - occupied) * corrected / a) * s.rgb;
+                occupied += (1.0 - occupied) * corrected;
+                if (occupied >= 0.99)
+                    break;
+            }
+            t += dt;
+        }
+        coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+    }
+}

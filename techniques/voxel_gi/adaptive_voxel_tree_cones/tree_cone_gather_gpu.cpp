@@ -1,0 +1,68 @@
+#include "tree_cone_gather_gpu.h"
+
+#include <glm/vec4.hpp>
+
+#include <cstdlib>
+
+namespace rtlab::voxelgi {
+
+namespace {
+
+struct GatherConstants {
+    glm::ivec4 size{0};  // width, height, depth, max steps
+    glm::vec4 march{0};  // leaf size, tan(half-angle), start offset, step scale
+    glm::vec4 box{0};    // min corner relative to the centre
+    glm::ivec4 roots{0}; // root cells per axis
+};
+static_assert(sizeof(GatherConstants) == 64, "must match tree_cone_gather.comp");
+static_assert(sizeof(VoxelTreeNode) == 3 * sizeof(std::uint32_t), "the shader reads 3 uints per node");
+
+} // namespace
+
+std::filesystem::path TreeConeGatherGpu::getShaderDir()
+{
+    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
+        return std::filesystem::path(root) / "techniques" / "voxel_gi" / "adaptive_voxel_tree_cones" / "shaders";
+    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+}
+
+void TreeConeGatherGpu::gatherCones(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
+                                    std::vector<glm::vec3>& out)
+{
+    if (!mDispatch.isReadyFor(context)) {
+        *this = TreeConeGatherGpu();
+        mDispatch.create(context, getShaderDir() / "tree_cone_gather.comp", kDispatchLabel, sizeof(GatherConstants),
+                         tree.getCones());
+    }
+    const AdaptiveVoxelTree* t = tree.getTree();
+    if (t == nullptr) {
+        out.assign(std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount, glm::vec3(0.0f));
+        return;
+    }
+    mLastUploadBytes = 0;
+    if (mUploadedStamp != tree.getStamp()) {
+        const auto& nodes = t->getNodes();
+        const auto& gathered = tree.getGathered();
+        const std::size_t nodeBytes = nodes.size() * sizeof(VoxelTreeNode);
+        if (!mNodes.isValid() || mNodes.getSize() < nodeBytes)
+            mNodes = mDispatch.makeBuffer(nodeBytes, "adaptive_voxel_tree_cones.nodes");
+        if (!mGathered.isValid() || mGathered.getSize() < gathered.size() * sizeof(glm::vec4))
+            mGathered = mDispatch.makeBuffer(gathered.size() * sizeof(glm::vec4), "adaptive_voxel_tree_cones.gathered");
+        mNodes.uploadSpan<VoxelTreeNode>(nodes);
+        mGathered.uploadSpan<glm::vec4>(gathered);
+        mLastUploadBytes += nodeBytes + gathered.size() * sizeof(glm::vec4);
+        mUploadedStamp = tree.getStamp();
+    }
+    const glm::dvec3 anchor = tree.getOrigin() + 0.5 * tree.getBoxSize();
+    mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
+    const TreeConeSettings& s = tree.getSettings();
+    GatherConstants constants;
+    constants.size = {gbuffer.width, gbuffer.height, s.depth, 1024};
+    constants.march = {float(tree.getLeafSize()), float(tree.getCones().tanHalfAngle), float(s.startOffset),
+                       float(s.stepScale)};
+    constants.box = glm::vec4(glm::vec3(tree.getOrigin() - anchor), 0.0f);
+    constants.roots = glm::ivec4(t->getLayout().rootCells, 0);
+    mLastGpuMs = mDispatch.run(mNodes, mGathered, gpu::PushConstants(constants), out);
+}
+
+} // namespace rtlab::voxelgi

@@ -1,0 +1,39 @@
+#pragma once
+// The pixel gather of the adaptive voxel tree on Vulkan (shaders/tree_cone_gather.comp): the
+// tree's nodes (mask low, mask high, offset) and the gathered light of every element in two
+// storage buffers, uploaded again only when the tree or its light changed; positions go up
+// relative to the lattice's centre.
+
+#include "voxel_tree_cones.h"
+
+#include "families/voxel_gi/cone_gather_gpu.h"
+#include "gpu/context.h"
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+namespace rtlab::voxelgi {
+
+class TreeConeGatherGpu {
+public:
+    static constexpr const char* kDispatchLabel = "adaptive_voxel_tree_cones.gather";
+
+    //! VoxelTreeCones::gatherCones on the GPU, [pixel * 16 + cone].
+    void gatherCones(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
+                     std::vector<glm::vec3>& out);
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
+    //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/adaptive_voxel_tree_cones/shaders when set, else the
+    //! source folder.
+    static std::filesystem::path getShaderDir();
+
+private:
+    PixelConeDispatch mDispatch;
+    gpu::Buffer mNodes, mGathered;
+    std::uint64_t mUploadedStamp = 0;
+    std::optional<double> mLastGpuMs;
+    std::size_t mLastUploadBytes = 0;
+};
+
+} // namespace rtlab::voxelgi
