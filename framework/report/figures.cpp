@@ -27,12 +27,35 @@ std::string makeFileName(std::string s)
 
 namespace {
 
-Image<glm::vec3> toGrey(const Image<float>& image)
+Image<glm::vec3> toGrey(const Image<float>& image, float scale = 1.0f)
 {
     Image<glm::vec3> out(image.width, image.height);
     for (std::size_t i = 0; i < image.pixels.size(); ++i)
-        out.pixels[i] = glm::vec3(std::isfinite(image.pixels[i]) ? image.pixels[i] : 0.0f);
+        out.pixels[i] = glm::vec3(std::isfinite(image.pixels[i]) ? scale * image.pixels[i] : 0.0f);
     return out;
+}
+
+std::string formatScale(float v)
+{
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3g", double(v));
+    return text;
+}
+
+// 1 for images in [0, 1] (occlusion); for an unbounded quantity (irradiance), 1 / the reference's
+// 99th percentile, so that the grid's images share one exposure and the reference fills it.
+float computeDisplayScale(const Image<float>& reference)
+{
+    std::vector<float> v;
+    v.reserve(reference.pixels.size());
+    for (const float x : reference.pixels)
+        if (std::isfinite(x))
+            v.push_back(x);
+    if (v.empty())
+        return 1.0f;
+    const std::size_t k = std::min(v.size() - 1, std::size_t(0.99 * double(v.size())));
+    std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(k), v.end());
+    return v[k] > 1.0f ? 1.0f / v[k] : 1.0f;
 }
 
 // The crop around the largest absolute error, a sixth of the image wide, inside the image.
@@ -299,40 +322,60 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             "Time per pass of the runs on each technique's Pareto front on " + group.title + ".");
     }
 
-    // 4. Images (screen-space families): reference | each technique's lowest-error run, over
-    //    their error maps, with crops around the worst error.
+    // 4. Images (families that write them, findRunImages): reference | each technique's
+    //    lowest-error run, over their error maps, with crops around the worst error. A study of
+    //    one technique shows up to 4 of its runs instead, lowest error first (its variants side
+    //    by side: the discontinuity of an interpolation, an ablation).
     plot::ImageGridSpec grid;
-    grid.title = group.title + ": frame 0 of each technique's lowest-error run";
+    std::vector<std::pair<std::string, const RunSummary*>> shown;
+    if (byTechnique.size() == 1) {
+        std::vector<const RunSummary*> runs = byTechnique.begin()->second;
+        std::stable_sort(runs.begin(), runs.end(), [&](const RunSummary* a, const RunSummary* b) {
+            return a->get(columns.error) < b->get(columns.error);
+        });
+        for (std::size_t i = 0; i < runs.size() && i < 4; ++i)
+            shown.emplace_back(byTechnique.begin()->first, runs[i]);
+        grid.title = group.title + ": frame 0 of " + byTechnique.begin()->first + "'s runs, lowest error first";
+    } else {
+        for (const auto& [technique, runs] : byTechnique) {
+            const RunSummary* best = nullptr;
+            for (const RunSummary* run : runs)
+                if (!best || run->get(columns.error) < best->get(columns.error))
+                    best = run;
+            shown.emplace_back(technique, best);
+        }
+        grid.title = group.title + ": frame 0 of each technique's lowest-error run";
+    }
     std::vector<plot::GridCell> images, errors;
     Image<float> firstError;
-    for (const auto& [technique, runs] : byTechnique) {
-        const RunSummary* best = nullptr;
-        for (const RunSummary* run : runs)
-            if (!best || run->get(columns.error) < best->get(columns.error))
-                best = run;
-        const auto& frame0 = best->frames.front();
-        if (!frame0.count("image.technique") ||
-            !std::filesystem::exists(frame0.at("image.technique")))
+    float displayScale = 1.0f;
+    for (const auto& [technique, best] : shown) {
+        const RunImages files = findRunImages(best->frames.front());
+        if (!files.valid() || !std::filesystem::exists(files.technique))
             continue;
         if (images.empty()) {
             grid.columnTitles.push_back("reference");
-            images.push_back(plot::makeColorCell(
-                toGrey(experiment::readExrScalar(frame0.at("image.reference")))));
+            const Image<float> reference = experiment::readExrScalar(files.reference);
+            displayScale = computeDisplayScale(reference);
+            images.push_back(plot::makeColorCell(toGrey(reference, displayScale)));
             // Under the reference: its own noise floor (per-pixel standard error), on the same
             // scale as the techniques' errors.
-            std::string stderrPath = frame0.at("image.reference");
-            stderrPath.replace(stderrPath.rfind("reference.exr"), 13, "reference_stderr.exr");
+            std::string stderrPath = files.reference;
+            if (const std::size_t at = stderrPath.rfind("reference.exr"); at != std::string::npos)
+                stderrPath.replace(at, 13, "reference_stderr.exr");
+            else
+                stderrPath.clear();
             // A family whose reference is exact writes no noise floor: it is zero.
-            const Image<float> reference = experiment::readExrScalar(frame0.at("image.reference"));
             errors.push_back(
                 plot::makeErrorCell(std::filesystem::exists(stderrPath)
                                         ? experiment::readExrScalar(stderrPath)
                                         : Image<float>(reference.width, reference.height, 0.0f)));
         }
-        grid.columnTitles.push_back(technique + " " + describeRun(*best, group.varyingParams));
-        images.push_back(
-            plot::makeColorCell(toGrey(experiment::readExrScalar(frame0.at("image.technique")))));
-        Image<float> error = experiment::readExrScalar(frame0.at("image.error"));
+        // One technique: the figure's title names it, the columns their parameters.
+        const std::string params = describeRun(*best, group.varyingParams);
+        grid.columnTitles.push_back(byTechnique.size() == 1 ? params : technique + "\n" + params);
+        images.push_back(plot::makeColorCell(toGrey(experiment::readExrScalar(files.technique), displayScale)));
+        Image<float> error = experiment::readExrScalar(files.error);
         for (auto& e : error.pixels)
             e = std::abs(e);
         if (firstError.width == 0)
@@ -351,7 +394,10 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
         figures.captions.push_back(
             "Reference and each technique's lowest-error run on " + group.title +
             " (frame 0), over their absolute error maps; the crop is the region of the "
-            "largest error, magnified.");
+            "largest error, magnified." +
+            (displayScale != 1.0f ? " Images scaled by " + formatScale(displayScale) +
+                                        " (1 / the reference's 99th percentile)."
+                                  : std::string()));
     }
     Figures lit = writeLitFrameFigures(group, directory, colors);
     figures.plots.insert(figures.plots.end(), lit.plots.begin(), lit.plots.end());

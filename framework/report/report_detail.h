@@ -61,6 +61,16 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory, c
 //! beside every run frame's EXRs that lacks them; returns how many frames were written.
 int writeRunImages(const std::vector<experiment::Row>& rows, float errorRange);
 
+//! A run frame's images: the technique's output, its reference and the signed error (EXR paths).
+//! Families name them image.technique / image.reference / image.error, or, for a family that
+//! measures a named quantity q, image.q / image.q_reference / image.q_error (voxel_gi:
+//! image.indirect). All empty when the frame has no such triple.
+struct RunImages {
+    std::string technique, reference, error;
+    bool valid() const { return !technique.empty(); }
+};
+RunImages findRunImages(const experiment::Row& row);
+
 //! The HTML page.
 void writeHtml(const std::string& directory, const std::vector<Group>& groups,
                const std::vector<Figures>& figures, const std::string& manifestJson);

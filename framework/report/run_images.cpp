@@ -58,19 +58,42 @@ void writeHeatPng(const Image<float>& error, float maxAbs, const std::string& pa
 
 } // namespace
 
+RunImages findRunImages(const experiment::Row& row)
+{
+    const auto get = [&](const std::string& key) {
+        const auto it = row.find(key);
+        return it == row.end() ? std::string() : std::string(it->second);
+    };
+    RunImages images{get("image.technique"), get("image.reference"), get("image.error")};
+    if (images.technique.empty())
+        for (const auto& [key, value] : row) {
+            // image.q with image.q_reference and image.q_error beside it.
+            if (key.rfind("image.", 0) != 0)
+                continue;
+            const std::string reference = get(key + "_reference"), error = get(key + "_error");
+            if (!reference.empty() && !error.empty()) {
+                images = {std::string(value), reference, error};
+                break;
+            }
+        }
+    if (images.reference.empty() || images.error.empty())
+        return {};
+    return images;
+}
+
 int writeRunImages(const std::vector<experiment::Row>& rows, float errorRange)
 {
     int written = 0;
     for (const auto& row : rows) {
-        const auto technique = row.find("image.technique");
-        if (technique == row.end() || !std::filesystem::exists(technique->second))
+        const RunImages images = findRunImages(row);
+        if (!images.valid() || !std::filesystem::exists(images.technique))
             continue;
-        const std::string dir = std::filesystem::path(technique->second).parent_path().string();
+        const std::string dir = std::filesystem::path(images.technique).parent_path().string();
         if (std::filesystem::exists(dir + "/error.png"))
             continue;  // made by an earlier report
-        writeGreyPng(experiment::readExrScalar(technique->second), dir + "/technique.png");
-        writeGreyPng(experiment::readExrScalar(row.at("image.reference")), dir + "/reference.png");
-        writeHeatPng(experiment::readExrScalar(row.at("image.error")), errorRange, dir + "/error.png");
+        writeGreyPng(experiment::readExrScalar(images.technique), dir + "/technique.png");
+        writeGreyPng(experiment::readExrScalar(images.reference), dir + "/reference.png");
+        writeHeatPng(experiment::readExrScalar(images.error), errorRange, dir + "/error.png");
         ++written;
     }
     return written;

@@ -18,7 +18,7 @@
 //                           rays (traceVoxelRays) against its cones and against the truth
 //   metric.indirect_flicker the frame-to-frame change of the error along the camera path
 //                           (remember_indirect keeps the previous frame for it)
-//   images_indirect         technique, reference and signed error as EXR
+//   images_indirect         technique, reference (and its standard error) and signed error as EXR
 // (names of their own, so that the family runs beside the occlusion family in one frame)
 
 #include "families/voxel_gi/voxel_gi.h"
@@ -414,6 +414,10 @@ private:
                                   error.pixels[i] = a.pixels[i] - t.pixels[i];
                           experiment::writeExr(a, dir + "/indirect.exr");
                           experiment::writeExr(t, dir + "/indirect_reference.exr");
+                          // Its noise floor, beside it (the report's image grid shows it under
+                          // the reference).
+                          if (const auto& se = ctx.read(truth).irradianceStdErr; se.width == t.width)
+                              experiment::writeExr(se, dir + "/indirect_reference_stderr.exr");
                           experiment::writeExr(error, dir + "/indirect_error.exr");
                           mRow->set("image.indirect", dir + "/indirect.exr")
                               .set("image.indirect_reference", dir + "/indirect_reference.exr")
