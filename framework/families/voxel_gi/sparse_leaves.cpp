@@ -1,4 +1,5 @@
 #include "families/voxel_gi/sparse_leaves.h"
+#include "families/voxel_gi/sparse_cone_params.h"
 
 #include "core/error.h"
 
@@ -240,6 +241,57 @@ void makeLeavesIsotropic(std::vector<SurfaceLeaf>& leaves, const std::string& wh
     for (SurfaceLeaf& l : leaves)
         if (l.inwardOf >= 0)
             l.emission = leaves[std::size_t(l.inwardOf)].emission;
+}
+
+} // namespace rtlab::voxelgi
+
+namespace rtlab::voxelgi {
+
+void SparseConeParams::declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault)
+{
+    schema.addInt("resolution", 64, 8, 4096, "leaves", resolutionHelp);
+    schema.addFloat("voxel_size", 0.0, 0.0, 1e6, "world units", "leaf size; 0 = fit the scene's box");
+    schema.addInt("supersampling", 4, 1, 16, "rays per leaf side",
+                  "voxelization rays per leaf column and axis, per side (coverage)");
+    schema.addInt("bounces", 2, 1, 3, "", "reflections gathered at the pixel");
+    schema.addFloat("cone_angle", 29.0, 5.0, 60.0, "degrees", "cone half-angle");
+    schema.addFloat("start_offset", 4.0, 0.0, 8.0, "leaves", "cone start distance and origin offset along the normal");
+    schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
+    schema.addInt("trace_step", 4, 1, 8, "pixels",
+                  "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
+    schema.addEnum("device", "vulkan", {"vulkan", "cpu"}, "where the pixel gather runs");
+    schema.addInt("inner_layers", innerLayersDefault, 1, 8, "leaves",
+                  "layers of solid leaves kept inside closed surfaces (the rest of a solid is not stored)");
+}
+
+SparseConeParams SparseConeParams::read(const config::ParamSet& p)
+{
+    SparseConeParams s;
+    s.resolution = int(p.getInt("resolution"));
+    s.voxelSize = p.getFloat("voxel_size");
+    s.supersampling = int(p.getInt("supersampling"));
+    s.bounces = int(p.getInt("bounces"));
+    s.coneAngle = p.getFloat("cone_angle");
+    s.startOffset = p.getFloat("start_offset");
+    s.stepScale = p.getFloat("step_scale");
+    s.traceStep = int(p.getInt("trace_step"));
+    s.onGpu = p.getString("device") == "vulkan";
+    s.innerLayers = int(p.getInt("inner_layers"));
+    return s;
+}
+
+void SparseConeParams::write(config::ParamSet& p) const
+{
+    p.set("resolution", std::int64_t(resolution));
+    p.set("voxel_size", voxelSize);
+    p.set("supersampling", std::int64_t(supersampling));
+    p.set("bounces", std::int64_t(bounces));
+    p.set("cone_angle", coneAngle);
+    p.set("start_offset", startOffset);
+    p.set("step_scale", stepScale);
+    p.set("trace_step", std::int64_t(traceStep));
+    p.set("device", std::string(onGpu ? "vulkan" : "cpu"));
+    p.set("inner_layers", std::int64_t(innerLayers));
 }
 
 } // namespace rtlab::voxelgi

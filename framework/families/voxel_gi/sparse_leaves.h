@@ -16,6 +16,7 @@
 //    that does not exist is empty (its filtered value is exactly 0).
 
 #include "families/voxel_gi/cone_tracing.h"
+#include "families/voxel_gi/pixel_cones.h"
 #include "families/voxel_gi/voxelize.h"
 #include "scene/render_scene.h"
 
@@ -256,6 +257,44 @@ void injectLeafLight(const scene::RenderScene& geometry, const ConeSet& cones, c
     });
     for (auto& field : payload.fields)
         std::vector<glm::vec3>().swap(field);
+}
+
+//! cone_tracing.h Samplers of a sparse structure S (its light fields during injection, its
+//! gathered light for the pixels): S has sampleFields and sampleGathered(p, diameter, dir, out).
+template <class S>
+struct SparseFieldSampler {
+    const S* structure;
+    bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& out) const
+    {
+        return structure->sampleFields(p, d, dir, out);
+    }
+};
+template <class S>
+struct SparseGatheredSampler {
+    const S* structure;
+    bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& out) const
+    {
+        return structure->sampleGathered(p, d, dir, out);
+    }
+};
+
+//! The 16 cones of every pixel through a sparse structure S (S::preparePixel says where they
+//! start): pixel_cones.h traceGBufferCones. Returns the mean number of steps per cone.
+template <class S>
+double traceSparsePixelCones(const S& structure, const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+{
+    const auto prepare = [&](const scene::GBuffer& g, int x, int y, glm::dvec3& origin, glm::dvec3& n,
+                             ConeMarchSettings& march) { return structure.preparePixel(g, x, y, origin, n, march); };
+    return traceGBufferCones(gbuffer, structure.getCones(), prepare, SparseGatheredSampler<S>{&structure}, out);
+}
+
+//! `rays` zero-aperture rays per pixel through a sparse structure S: pixel_cones.h traceGBufferRays.
+template <class S>
+void traceSparsePixelRays(const S& structure, const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out)
+{
+    const auto prepare = [&](const scene::GBuffer& g, int x, int y, glm::dvec3& origin, glm::dvec3& n,
+                             ConeMarchSettings& march) { return structure.preparePixel(g, x, y, origin, n, march); };
+    traceGBufferRays(gbuffer, rays, prepare, SparseGatheredSampler<S>{&structure}, out);
 }
 
 } // namespace rtlab::voxelgi

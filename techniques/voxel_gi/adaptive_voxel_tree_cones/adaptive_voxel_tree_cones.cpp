@@ -63,6 +63,7 @@
 #include "tree_cone_gather_gpu.h"
 #include "voxel_tree_cones.h"
 
+#include "families/voxel_gi/sparse_cone_params.h"
 #include "families/voxel_gi/upsample.h"
 #include "families/voxel_gi/voxel_gi.h"
 
@@ -86,54 +87,28 @@ public:
     static config::ParamSchema declareParams()
     {
         config::ParamSchema schema;
-        schema.addInt("resolution", 64, 8, 4096, "leaves", "leaves along the longest side of the static scene's box");
+        voxelgi::SparseConeParams::declare(schema, "leaves along the longest side of the static scene's box", 4);
         schema.addInt("depth", 3, 1, 6, "", "tree levels below the dense root cells (4^depth leaves per root cell and axis)");
-        schema.addFloat("voxel_size", 0.0, 0.0, 1e6, "world units", "leaf size; 0 = the lattice fits the scene's box");
-        schema.addInt("supersampling", 4, 1, 16, "rays per leaf side",
-                      "voxelization rays per leaf column and axis, per side (coverage)");
-        schema.addInt("bounces", 2, 1, 3, "", "reflections gathered at the pixel");
-        schema.addFloat("cone_angle", 29.0, 5.0, 60.0, "degrees", "cone half-angle");
-        schema.addFloat("start_offset", 4.0, 0.0, 8.0, "leaves",
-                        "cone start distance and origin offset along the normal");
-        schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
-        schema.addInt("trace_step", 4, 1, 8, "pixels",
-                      "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
-        schema.addEnum("device", "vulkan", {"vulkan", "cpu"}, "where the pixel gather runs");
-        schema.addInt("inner_layers", 4, 1, 8, "leaves",
-                      "layers of solid leaves kept inside closed surfaces (the rest of a solid is not stored)");
         return schema;
     }
 
-    explicit AdaptiveVoxelTreeCones(const config::ParamSet& p)
+    explicit AdaptiveVoxelTreeCones(const config::ParamSet& p) : mParams(voxelgi::SparseConeParams::read(p))
     {
-        mResolution = int(p.getInt("resolution"));
         mSettings.depth = int(p.getInt("depth"));
-        mLeafSize = p.getFloat("voxel_size");
-        mSettings.supersampling = int(p.getInt("supersampling"));
-        mSettings.bounces = int(p.getInt("bounces"));
-        mSettings.coneHalfAngleDegrees = p.getFloat("cone_angle");
-        mSettings.startOffset = p.getFloat("start_offset");
-        mSettings.stepScale = p.getFloat("step_scale");
-        mTraceStep = int(p.getInt("trace_step"));
-        mSettings.innerLayers = int(p.getInt("inner_layers"));
-        mOnGpu = p.getString("device") == "vulkan";
+        mSettings.supersampling = mParams.supersampling;
+        mSettings.bounces = mParams.bounces;
+        mSettings.coneHalfAngleDegrees = mParams.coneAngle;
+        mSettings.startOffset = mParams.startOffset;
+        mSettings.stepScale = mParams.stepScale;
+        mSettings.innerLayers = mParams.innerLayers;
         mTree.emplace(mSettings); // checks the settings
     }
 
     config::ParamSet effectiveParams() const override
     {
         config::ParamSet p;
-        p.set("resolution", std::int64_t(mResolution));
+        mParams.write(p);
         p.set("depth", std::int64_t(mSettings.depth));
-        p.set("voxel_size", mLeafSize);
-        p.set("supersampling", std::int64_t(mSettings.supersampling));
-        p.set("bounces", std::int64_t(mSettings.bounces));
-        p.set("cone_angle", mSettings.coneHalfAngleDegrees);
-        p.set("start_offset", mSettings.startOffset);
-        p.set("step_scale", mSettings.stepScale);
-        p.set("trace_step", std::int64_t(mTraceStep));
-        p.set("inner_layers", std::int64_t(mSettings.innerLayers));
-        p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
         return p;
     }
 
@@ -157,8 +132,8 @@ public:
         if (g.triangleCount() == 0) {
             mTree->build(origin, leaf, roots, {});
         } else {
-            voxelgi::VoxelTreeCones::computeLattice(glm::dvec3(g.boundsMin), glm::dvec3(g.boundsMax), mResolution,
-                                                    mSettings.depth, mLeafSize, origin, leaf, roots);
+            voxelgi::VoxelTreeCones::computeLattice(glm::dvec3(g.boundsMin), glm::dvec3(g.boundsMax), mParams.resolution,
+                                                    mSettings.depth, mParams.voxelSize, origin, leaf, roots);
             voxelgi::LeafLattice lattice;
             lattice.origin = origin;
             lattice.leafSize = leaf;
@@ -189,9 +164,9 @@ public:
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
-        mGatheredOnGpu = mOnGpu && input.gpu != nullptr;
+        mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
         irradiance = voxelgi::gatherConesReduced(
-            *input.gbuffer, mTraceStep, mTree->getCones().halfAngle, input.coneVisibility, input.capsules,
+            *input.gbuffer, mParams.traceStep, mTree->getCones().halfAngle, input.coneVisibility, input.capsules,
             [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
                 if (mGatheredOnGpu)
                     mGpu.gatherCones(*input.gpu, *mTree, reduced, cones);
@@ -202,7 +177,7 @@ public:
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
     {
-        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mTraceStep,
+        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mParams.traceStep,
                                                [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
                                                    mTree->gatherRays(reduced, raysPerPixel, low);
                                                });
@@ -231,14 +206,11 @@ public:
     }
 
 private:
+    voxelgi::SparseConeParams mParams;
     voxelgi::TreeConeSettings mSettings;
     std::optional<voxelgi::VoxelTreeCones> mTree;
     std::string mGeometryKey, mLightsKey;
     bool mBuilt = false;
-    int mResolution = 64;
-    double mLeafSize = 0.0;
-    int mTraceStep = 4;
-    bool mOnGpu = true;
     bool mGatheredOnGpu = false;
     voxelgi::TreeConeGatherGpu mGpu;
 };

@@ -1,7 +1,6 @@
 #include "voxel_tree_cones.h"
 
 #include "core/error.h"
-#include "families/voxel_gi/pixel_cones.h"
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
@@ -121,7 +120,7 @@ void VoxelTreeCones::injectLight(const scene::RenderScene& geometry)
     s.bounces = mSettings.bounces;
     s.startOffset = mSettings.startOffset;
     s.stepScale = mSettings.stepScale;
-    injectLeafLight(geometry, mCones, mLeaves, mLeafElement, s, mPayload, FieldSampler{this}, [this](int field) {
+    injectLeafLight(geometry, mCones, mLeaves, mLeafElement, s, mPayload, SparseFieldSampler<VoxelTreeCones>{this}, [this](int field) {
         auto& light = mPayload.fields[std::size_t(field)];
         filterUp([&light](std::size_t g) -> glm::vec3& { return light[g]; });
     });
@@ -181,16 +180,12 @@ bool VoxelTreeCones::preparePixel(const scene::GBuffer& gbuffer, int x, int y, g
 
 void VoxelTreeCones::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
-    const auto prepare = [this](const scene::GBuffer& g, int x, int y, glm::dvec3& origin, glm::dvec3& n,
-                                ConeMarchSettings& march) { return preparePixel(g, x, y, origin, n, march); };
-    mMeanStepsPerCone = traceGBufferCones(gbuffer, mCones, prepare, GatheredSampler{this}, out);
+    mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out);
 }
 
 void VoxelTreeCones::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
 {
-    const auto prepare = [this](const scene::GBuffer& g, int x, int y, glm::dvec3& origin, glm::dvec3& n,
-                                ConeMarchSettings& march) { return preparePixel(g, x, y, origin, n, march); };
-    traceGBufferRays(gbuffer, rays, prepare, GatheredSampler{this}, out);
+    traceSparsePixelRays(*this, gbuffer, rays, out);
 }
 
 std::size_t VoxelTreeCones::getPayloadBytes() const

@@ -78,20 +78,6 @@ public:
     //! Quadrilinear sample (see the header comment). False outside the lattice.
     bool sampleFields(const glm::dvec3& p, double diameter, const glm::dvec3& dir, ConeSample& out) const;
     bool sampleGathered(const glm::dvec3& p, double diameter, const glm::dvec3& dir, ConeSample& out) const;
-    struct FieldSampler {
-        const VoxelTreeCones* tree;
-        bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& out) const
-        {
-            return tree->sampleFields(p, d, dir, out);
-        }
-    };
-    struct GatheredSampler {
-        const VoxelTreeCones* tree;
-        bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& out) const
-        {
-            return tree->sampleGathered(p, d, dir, out);
-        }
-    };
 
     //! The radiance of each of the 16 cones at every pixel, [pixel * 16 + cone] (pixel_cones.h).
     void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);

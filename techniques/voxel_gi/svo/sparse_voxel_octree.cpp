@@ -1,7 +1,6 @@
 #include "sparse_voxel_octree.h"
 
 #include "core/error.h"
-#include "families/voxel_gi/pixel_cones.h"
 
 #include <glm/common.hpp>
 #include <glm/gtc/constants.hpp>
@@ -204,7 +203,7 @@ void SparseVoxelOctree::injectLight(const scene::RenderScene& geometry)
     s.bounces = mSettings.bounces;
     s.startOffset = mSettings.startOffset;
     s.stepScale = mSettings.stepScale;
-    injectLeafLight(geometry, mCones, mLeaves, mTopology.leafNode, s, mPayload, FieldSampler{this},
+    injectLeafLight(geometry, mCones, mLeaves, mTopology.leafNode, s, mPayload, SparseFieldSampler<SparseVoxelOctree>{this},
                     [this](int field) { filterFieldUp(field); });
     ++mStamp;
 }
@@ -265,20 +264,12 @@ bool SparseVoxelOctree::preparePixel(const scene::GBuffer& gbuffer, int x, int y
 
 void SparseVoxelOctree::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
-    const auto prepare = [this](const scene::GBuffer& g, int x, int y, glm::dvec3& origin,
-                                glm::dvec3& n, ConeMarchSettings& march) {
-        return preparePixel(g, x, y, origin, n, march);
-    };
-    mMeanStepsPerCone = traceGBufferCones(gbuffer, mCones, prepare, GatheredSampler{this}, out);
+    mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out);
 }
 
 void SparseVoxelOctree::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
 {
-    const auto prepare = [this](const scene::GBuffer& g, int x, int y, glm::dvec3& origin,
-                                glm::dvec3& n, ConeMarchSettings& march) {
-        return preparePixel(g, x, y, origin, n, march);
-    };
-    traceGBufferRays(gbuffer, rays, prepare, GatheredSampler{this}, out);
+    traceSparsePixelRays(*this, gbuffer, rays, out);
 }
 
 std::size_t SparseVoxelOctree::getPayloadBytes() const

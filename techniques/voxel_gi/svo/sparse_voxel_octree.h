@@ -137,20 +137,6 @@ public:
     //! gathered light (pixels). False outside the cube.
     bool sampleFields(const glm::dvec3& p, double diameter, const glm::dvec3& dir, ConeSample& out) const;
     bool sampleGathered(const glm::dvec3& p, double diameter, const glm::dvec3& dir, ConeSample& out) const;
-    struct FieldSampler {
-        const SparseVoxelOctree* tree;
-        bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& out) const
-        {
-            return tree->sampleFields(p, d, dir, out);
-        }
-    };
-    struct GatheredSampler {
-        const SparseVoxelOctree* tree;
-        bool sample(const glm::dvec3& p, double d, int, const glm::dvec3& dir, ConeSample& out) const
-        {
-            return tree->sampleGathered(p, d, dir, out);
-        }
-    };
 
     //! The radiance of each of the 16 cones at every pixel, [pixel * 16 + cone]; 0 for cones
     //! below the surface and pixels without a surface or outside the cube.

@@ -66,6 +66,7 @@
 #include "svo_gather_gpu.h"
 
 #include "core/error.h"
+#include "families/voxel_gi/sparse_cone_params.h"
 #include "families/voxel_gi/upsample.h"
 #include "families/voxel_gi/voxel_gi.h"
 
@@ -90,54 +91,27 @@ public:
     static config::ParamSchema declareParams()
     {
         config::ParamSchema schema;
-        schema.addInt("resolution", 64, 8, 4096, "leaves", "leaves along the cube's side (a power of two)");
-        schema.addFloat("voxel_size", 0.0, 0.0, 1e6, "world units",
-                        "leaf size; 0 = the cube fits the scene's box");
-        schema.addInt("supersampling", 4, 1, 16, "rays per leaf side",
-                      "voxelization rays per leaf column and axis, per side (coverage)");
-        schema.addInt("bounces", 2, 1, 3, "", "reflections gathered at the pixel");
-        schema.addFloat("cone_angle", 29.0, 5.0, 60.0, "degrees", "cone half-angle");
-        schema.addFloat("start_offset", 4.0, 0.0, 8.0, "leaves",
-                        "cone start distance and origin offset along the normal");
-        schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
-        schema.addInt("trace_step", 4, 1, 8, "pixels",
-                      "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
-        schema.addEnum("device", "vulkan", {"vulkan", "cpu"}, "where the pixel gather runs");
-        schema.addInt("inner_layers", 1, 1, 8, "leaves",
-                      "layers of solid leaves kept inside closed surfaces (the rest of a solid is not stored)");
+        voxelgi::SparseConeParams::declare(schema, "leaves along the cube's side (a power of two)", 1);
         return schema;
     }
 
-    explicit Svo(const config::ParamSet& p)
+    explicit Svo(const config::ParamSet& p) : mParams(voxelgi::SparseConeParams::read(p))
     {
-        mSettings.resolution = int(p.getInt("resolution"));
-        if (!std::has_single_bit(unsigned(mSettings.resolution)))
-            throw Error("svo: resolution must be a power of two, found " +
-                        std::to_string(mSettings.resolution));
-        mLeafSize = p.getFloat("voxel_size");
-        mSettings.supersampling = int(p.getInt("supersampling"));
-        mSettings.bounces = int(p.getInt("bounces"));
-        mSettings.coneHalfAngleDegrees = p.getFloat("cone_angle");
-        mSettings.startOffset = p.getFloat("start_offset");
-        mSettings.stepScale = p.getFloat("step_scale");
-        mTraceStep = int(p.getInt("trace_step"));
-        mOnGpu = p.getString("device") == "vulkan";
-        mSettings.innerLayers = int(p.getInt("inner_layers"));
+        if (!std::has_single_bit(unsigned(mParams.resolution)))
+            throw Error("svo: resolution must be a power of two, found " + std::to_string(mParams.resolution));
+        mSettings.resolution = mParams.resolution;
+        mSettings.supersampling = mParams.supersampling;
+        mSettings.bounces = mParams.bounces;
+        mSettings.coneHalfAngleDegrees = mParams.coneAngle;
+        mSettings.startOffset = mParams.startOffset;
+        mSettings.stepScale = mParams.stepScale;
+        mSettings.innerLayers = mParams.innerLayers;
     }
 
     config::ParamSet effectiveParams() const override
     {
         config::ParamSet p;
-        p.set("resolution", std::int64_t(mSettings.resolution));
-        p.set("voxel_size", mLeafSize);
-        p.set("supersampling", std::int64_t(mSettings.supersampling));
-        p.set("bounces", std::int64_t(mSettings.bounces));
-        p.set("cone_angle", mSettings.coneHalfAngleDegrees);
-        p.set("start_offset", mSettings.startOffset);
-        p.set("step_scale", mSettings.stepScale);
-        p.set("trace_step", std::int64_t(mTraceStep));
-        p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
-        p.set("inner_layers", std::int64_t(mSettings.innerLayers));
+        mParams.write(p);
         return p;
     }
 
@@ -162,7 +136,7 @@ public:
             mTree->build(glm::dvec3(0.0), 1.0, {});
         } else {
             voxelgi::SparseVoxelOctree::computeCube(glm::dvec3(g.boundsMin), glm::dvec3(g.boundsMax),
-                                                    mSettings.resolution, origin, side, mLeafSize);
+                                                    mSettings.resolution, origin, side, mParams.voxelSize);
             mTree->build(origin, side,
                          voxelgi::SparseVoxelOctree::voxelizeLeaves(g, origin, side, mSettings));
         }
@@ -185,9 +159,9 @@ public:
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
-        mGatheredOnGpu = mOnGpu && input.gpu != nullptr;
+        mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
         irradiance = voxelgi::gatherConesReduced(
-            *input.gbuffer, mTraceStep, mTree->getCones().halfAngle, input.coneVisibility,
+            *input.gbuffer, mParams.traceStep, mTree->getCones().halfAngle, input.coneVisibility,
             input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
                 if (mGatheredOnGpu)
                     mGpu.gatherCones(*input.gpu, *mTree, reduced, cones);
@@ -199,7 +173,7 @@ public:
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
                         Image<glm::vec3>& irradiance) override
     {
-        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mTraceStep,
+        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mParams.traceStep,
                                                [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
                                                    mTree->gatherRays(reduced, raysPerPixel, low);
                                                });
@@ -227,13 +201,11 @@ public:
     }
 
 private:
+    voxelgi::SparseConeParams mParams;
     voxelgi::OctreeSettings mSettings;
     std::optional<voxelgi::SparseVoxelOctree> mTree;
     voxelgi::OctreeGatherGpu mGpu;
     std::string mGeometryKey, mLightsKey;
-    double mLeafSize = 0.0;
-    int mTraceStep = 4;
-    bool mOnGpu = true;
     bool mGatheredOnGpu = false;
 };
 

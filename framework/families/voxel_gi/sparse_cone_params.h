@@ -1,0 +1,28 @@
+#pragma once
+// The parameters of the sparse cone-traced structures (svo, adaptive_voxel_tree_cones): the same
+// names, ranges and meaning in both, so that a sweep over one sweeps the other like for like.
+
+#include "config/param.h"
+
+namespace rtlab::voxelgi {
+
+struct SparseConeParams {
+    int resolution = 64;      //!< leaves along the scene's box
+    double voxelSize = 0.0;   //!< leaf size in world units; 0 = fit the scene's box
+    int supersampling = 4;    //!< voxelization rays per leaf column and axis, per side
+    int bounces = 2;          //!< reflections gathered at the pixel (1..3)
+    double coneAngle = 29.0;  //!< degrees, half-angle
+    double startOffset = 4.0; //!< leaves: cone start distance and origin offset along the normal
+    double stepScale = 0.5;   //!< march step / size of the voxels sampled
+    int traceStep = 4;        //!< pixels: one traced per trace_step^2 block, then upsampled
+    bool onGpu = true;        //!< device: the pixel gather on Vulkan or in C++
+    int innerLayers = 1;      //!< layers of solid leaves kept inside closed surfaces
+
+    //! Declares resolution (described by `resolutionHelp`), voxel_size, supersampling, bounces,
+    //! cone_angle, start_offset, step_scale, trace_step, device and inner_layers.
+    static void declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault);
+    static SparseConeParams read(const config::ParamSet& p);
+    void write(config::ParamSet& p) const;
+};
+
+} // namespace rtlab::voxelgi
