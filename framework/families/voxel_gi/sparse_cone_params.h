@@ -12,14 +12,15 @@ struct SparseConeParams {
     int supersampling = 4;    //!< voxelization rays per leaf column and axis, per side
     int bounces = 2;          //!< reflections gathered at the pixel (1..3)
     double coneAngle = 29.0;  //!< degrees, half-angle
-    double startOffset = 4.0; //!< leaves: cone start distance and origin offset along the normal
+    double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
+    double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int traceStep = 4;        //!< pixels: one traced per trace_step^2 block, then upsampled
     bool onGpu = true;        //!< device: the pixel gather on Vulkan or in C++
     int innerLayers = 1;      //!< layers of solid leaves kept inside closed surfaces
 
     //! Declares resolution (described by `resolutionHelp`), voxel_size, supersampling, bounces,
-    //! cone_angle, start_offset, step_scale, trace_step, device and inner_layers.
+    //! cone_angle, start_offset, inject_offset, step_scale, trace_step, device and inner_layers.
     static void declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault);
     static SparseConeParams read(const config::ParamSet& p);
     void write(config::ParamSet& p) const;

@@ -255,7 +255,10 @@ void SparseConeParams::declare(config::ParamSchema& schema, const char* resoluti
                   "voxelization rays per leaf column and axis, per side (coverage)");
     schema.addInt("bounces", 2, 1, 3, "", "reflections gathered at the pixel");
     schema.addFloat("cone_angle", 29.0, 5.0, 60.0, "degrees", "cone half-angle");
-    schema.addFloat("start_offset", 4.0, 0.0, 8.0, "leaves", "cone start distance and origin offset along the normal");
+    schema.addFloat("start_offset", 4.0, 0.0, 8.0, "leaves",
+                    "the pixel cones' start distance and origin offset along the normal");
+    schema.addFloat("inject_offset", 4.0, 0.0, 8.0, "leaves",
+                    "the same for the leaves' cones of light injection");
     schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
     schema.addInt("trace_step", 4, 1, 8, "pixels",
                   "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
@@ -273,6 +276,7 @@ SparseConeParams SparseConeParams::read(const config::ParamSet& p)
     s.bounces = int(p.getInt("bounces"));
     s.coneAngle = p.getFloat("cone_angle");
     s.startOffset = p.getFloat("start_offset");
+    s.injectOffset = p.getFloat("inject_offset");
     s.stepScale = p.getFloat("step_scale");
     s.traceStep = int(p.getInt("trace_step"));
     s.onGpu = p.getString("device") == "vulkan";
@@ -288,6 +292,7 @@ void SparseConeParams::write(config::ParamSet& p) const
     p.set("bounces", std::int64_t(bounces));
     p.set("cone_angle", coneAngle);
     p.set("start_offset", startOffset);
+    p.set("inject_offset", injectOffset);
     p.set("step_scale", stepScale);
     p.set("trace_step", std::int64_t(traceStep));
     p.set("device", std::string(onGpu ? "vulkan" : "cpu"));

@@ -42,13 +42,16 @@
 // | supersampling | int   | 4       | [1, 16]         | rays per leaf column and axis, per side |
 // | bounces       | int   | 2       | [1, 3]          |                                   |
 // | cone_angle    | float | 29      | [5, 60]         | degrees (half-angle)              |
-// | start_offset  | float | 4       | [0, 8]          | leaves                            |
+// | start_offset  | float | 4       | [0, 8]          | leaves (pixel cones)              |
+// | inject_offset | float | 4       | [0, 8]          | leaves (the leaves' cones)        |
 // | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled         |
 // | trace_step    | int   | 4       | [1, 8]          | pixels                            |
 // | device        | enum  | vulkan  | vulkan, cpu     | where the pixel gather runs       |
 // | inner_layers  | int   | 4       | [1, 8]          | leaves of solid kept inside closed surfaces |
 //
-// start_offset 4 as svo (the same leaves, the same self-occlusion at a smaller offset).
+// start_offset 4 as svo (the same leaves, the same self-occlusion at a smaller offset);
+// inject_offset 4 as svo: at 1 / 2 / 4 leaves, leak room with 0.5-leaf walls 0.52 / 0.70 / 0.91
+// inside, cornell_box RMSE 0.166 / 0.133 / 0.133, tomorrow_town 0.178 / 0.149 / 0.118.
 // inner_layers 4 (svo's default is 1): a wall stored at least as thick as the cones' start
 // distance, so that no cone starts beyond it; the coarse levels, 4x apart, see through thin
 // stored walls sooner than the octree's. Family furnace at 64 leaves: -14.4 % with 4 layers,
@@ -99,6 +102,7 @@ public:
         mSettings.bounces = mParams.bounces;
         mSettings.coneHalfAngleDegrees = mParams.coneAngle;
         mSettings.startOffset = mParams.startOffset;
+        mSettings.injectOffset = mParams.injectOffset;
         mSettings.stepScale = mParams.stepScale;
         mSettings.innerLayers = mParams.innerLayers;
         mTree.emplace(mSettings); // checks the settings

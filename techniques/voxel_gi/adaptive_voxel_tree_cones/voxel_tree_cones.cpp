@@ -118,7 +118,7 @@ void VoxelTreeCones::injectLight(const scene::RenderScene& geometry)
     s.origin = mOrigin;
     s.leafSize = mLeafSize;
     s.bounces = mSettings.bounces;
-    s.startOffset = mSettings.startOffset;
+    s.startOffset = mSettings.injectOffset;
     s.stepScale = mSettings.stepScale;
     injectLeafLight(geometry, mCones, mLeaves, mLeafElement, s, mPayload, SparseFieldSampler<VoxelTreeCones>{this}, [this](int field) {
         auto& light = mPayload.fields[std::size_t(field)];

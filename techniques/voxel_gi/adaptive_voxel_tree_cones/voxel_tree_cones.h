@@ -35,7 +35,8 @@ struct TreeConeSettings {
     int supersampling = 4;  //!< voxelization rays per leaf column and axis, per side
     int bounces = 2;        //!< reflections gathered at the pixel (1..3)
     double coneHalfAngleDegrees = 29.0;
-    double startOffset = 4.0; //!< leaves: cone start distance and origin offset along the normal
+    double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
+    double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
     int innerLayers = 1;      //!< layers of solid leaves inside closed surfaces (sparse_leaves.h)

@@ -201,7 +201,7 @@ void SparseVoxelOctree::injectLight(const scene::RenderScene& geometry)
     s.origin = mOrigin;
     s.leafSize = getLeafSize();
     s.bounces = mSettings.bounces;
-    s.startOffset = mSettings.startOffset;
+    s.startOffset = mSettings.injectOffset;
     s.stepScale = mSettings.stepScale;
     injectLeafLight(geometry, mCones, mLeaves, mTopology.leafNode, s, mPayload, SparseFieldSampler<SparseVoxelOctree>{this},
                     [this](int field) { filterFieldUp(field); });
