@@ -72,7 +72,7 @@ TEST(AdaptiveVoxelTreeCones, FurnaceMatchesItsClosedFormAtThePixelsAndAlongRays)
     // footprint twice a leaf already reads half from cells 4 leaves wide).
     scene::RenderScene s;
     addRoom(s, glm::vec3(-0.5f), glm::vec3(0.5f), 0.5f, addMaterial(s, glm::vec3(0.5f), glm::vec3(1.0f)));
-    auto technique = make({{"resolution", std::int64_t(32)}, {"depth", std::int64_t(2)}, {"start_offset", 1.0}});
+    auto technique = make({{"resolution", std::int64_t(32)}, {"depth", std::int64_t(2)}, {"start_offset", 1.0}, {"inject_offset", 1.0}});
     auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*technique);
     gi.voxelize(frameOf(s));
     gi.injectLight(frameOf(s));

@@ -72,10 +72,10 @@ TEST(Svo, FurnaceMatchesItsClosedFormAtThePixelsAndAlongRays)
     // than a fifth (measured: -7.7 % at 32 leaves; rays -2.4 %).
     scene::RenderScene s;
     addRoom(s, glm::vec3(-0.5f), glm::vec3(0.5f), 0.5f, addMaterial(s, glm::vec3(0.5f), glm::vec3(1.0f)));
-    // 32 leaves across (the room is 15 leaves wide inside): cones start 1 leaf out, not the
-    // default 4, which would start them past the room's corners.
+    // 32 leaves across (the room is 15 leaves wide inside): the pixels' and the leaves'
+    // cones start 1 leaf out, not the default 4, which would start them past the room's corners.
     auto technique = make({{"resolution", std::int64_t(32)}, {"device", std::string("cpu")},
-                           {"start_offset", 1.0}});
+                           {"start_offset", 1.0}, {"inject_offset", 1.0}});
     auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*technique);
     gi.voxelize(frameOf(s));
     gi.injectLight(frameOf(s));
