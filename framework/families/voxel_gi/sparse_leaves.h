@@ -5,8 +5,8 @@
 // element at a cell of a level (its topology) and in how many children a node has per axis.
 //
 //  * Leaves: the surface voxels of the family's voxelization (the "voxel fragments" of Crassin
-//    et al. 2011), voxelized block by block over the lattice, plus the layer of solid voxels just
-//    inside closed surfaces that mirrors the light of the surface leaf beside it.
+//    et al. 2011), voxelized block by block over the lattice, plus layers of solid voxels just
+//    inside closed surfaces that mirror the light of the surface leaf they were reached from.
 //  * Payload per element and face: rgb = the light a pixel gathers, a = occupancy
 //    ("gathered"), and the light fields of cone_tracing.h during injection (premultiplied).
 //  * Filtering: a parent's face is the mean over the columns of its children along the face's
@@ -35,15 +35,16 @@
 
 namespace rtlab::voxelgi {
 
-//! One leaf of a sparse structure: a surface voxel, or a voxel of the layer just inside a closed
+//! One leaf of a sparse structure: a surface voxel, or a voxel of the layers just inside a closed
 //! surface.
 struct SurfaceLeaf {
     glm::ivec3 coord{0};                       //!< leaf lattice coordinates
     std::array<glm::vec4, kFaceCount> faces{}; //!< albedo, occupancy per face
     std::array<glm::vec3, kFaceCount> emission{};
     glm::vec3 normal{0.0f};
-    //! -1 for a surface voxel; for a voxel of the layer just inside a closed surface, the index
-    //! of the surface leaf beside it whose light it mirrors (it is not lit itself).
+    //! -1 for a surface voxel; for a voxel of the layers just inside a closed surface, the index
+    //! of the surface leaf whose light it mirrors (the one it was reached from; it is not lit
+    //! itself).
     std::int32_t inwardOf = -1;
 };
 
@@ -61,8 +62,9 @@ struct LeafLattice {
 //! The leaves of `geometry` in the lattice: the blocks of chunk^3 leaves a triangle meets (exact
 //! test, listCellsMeetingTriangles) voxelized each on its own (voxelizeTriangles), their surface
 //! voxels, and the solid voxels within innerLayers face steps of one (inwardOf set; blocks that
-//! no triangle meets are not voxelized, so a layer thicker than a block stops there). Leaves outside `cells`
-//! are left out. `who` names the caller in errors. Throws rtlab::Error for a bad lattice or more
+//! no triangle meets are not voxelized, so a layer thicker than a block stops there). A block
+//! voxelizes every triangle its columns meet along some axis, however far, so that its solid
+//! spans close between their entry and exit faces. Leaves outside `cells` are left out. `who` names the caller in errors. Throws rtlab::Error for a bad lattice or more
 //! than 2^31 surface leaves.
 std::vector<SurfaceLeaf> voxelizeSurfaceLeaves(const scene::RenderScene& geometry, const LeafLattice& lattice,
                                                const std::string& who);
