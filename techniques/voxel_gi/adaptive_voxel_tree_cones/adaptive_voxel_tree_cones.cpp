@@ -66,18 +66,16 @@
 #include "tree_cone_gather_gpu.h"
 #include "voxel_tree_cones.h"
 
-#include "families/voxel_gi/sparse_cone_params.h"
-#include "families/voxel_gi/upsample.h"
-#include "families/voxel_gi/voxel_gi.h"
+#include "families/voxel_gi/sparse_cone_technique.h"
 
-#include <cmath>
-#include <optional>
+#include <string>
 
 namespace {
 
 using namespace rtlab;
 
-class AdaptiveVoxelTreeCones final : public plugin::VoxelGiTechnique {
+class AdaptiveVoxelTreeCones final
+    : public voxelgi::SparseConeTechnique<voxelgi::VoxelTreeCones, voxelgi::TreeConeGatherGpu> {
 public:
     static plugin::TechniqueInfo describe()
     {
@@ -95,128 +93,57 @@ public:
         return schema;
     }
 
-    explicit AdaptiveVoxelTreeCones(const config::ParamSet& p) : mParams(voxelgi::SparseConeParams::read(p))
+    explicit AdaptiveVoxelTreeCones(const config::ParamSet& p) : SparseConeTechnique(p)
     {
-        mSettings.depth = int(p.getInt("depth"));
-        mSettings.supersampling = mParams.supersampling;
-        mSettings.bounces = mParams.bounces;
-        mSettings.coneHalfAngleDegrees = mParams.coneAngle;
-        mSettings.startOffset = mParams.startOffset;
-        mSettings.injectOffset = mParams.injectOffset;
-        mSettings.stepScale = mParams.stepScale;
-        mSettings.innerLayers = mParams.innerLayers;
-        mTree.emplace(mSettings); // checks the settings
+        voxelgi::TreeConeSettings settings;
+        settings.depth = int(p.getInt("depth"));
+        settings.supersampling = mParams.supersampling;
+        settings.bounces = mParams.bounces;
+        settings.coneHalfAngleDegrees = mParams.coneAngle;
+        settings.startOffset = mParams.startOffset;
+        settings.injectOffset = mParams.injectOffset;
+        settings.stepScale = mParams.stepScale;
+        settings.innerLayers = mParams.innerLayers;
+        mStructure.emplace(settings); // checks the settings
     }
 
-    config::ParamSet effectiveParams() const override
+private:
+    std::string build(const scene::RenderScene& g) override
     {
-        config::ParamSet p;
-        mParams.write(p);
-        p.set("depth", std::int64_t(mSettings.depth));
-        return p;
-    }
-
-    plugin::VoxelGiDefinition definition() const override
-    {
-        return {.bounces = mSettings.bounces, .surfacesOnly = true};
-    }
-
-    plugin::VoxelGiStep voxelize(const plugin::VoxelGiFrame& frame) override
-    {
-        if (mBuilt && frame.geometryKey == mGeometryKey && !frame.force)
-            return plugin::VoxelGiStep::skipped("the static geometry is unchanged since the build");
-        const std::string why = !mBuilt ? "first build"
-                                : frame.geometryKey != mGeometryKey ? "geometry changed"
-                                                                    : "culling off";
-        mBuilt = true;
-        const scene::RenderScene& g = *frame.geometry;
+        voxelgi::VoxelTreeCones& tree = *mStructure;
+        const voxelgi::TreeConeSettings& s = tree.getSettings();
         glm::dvec3 origin(0.0);
         double leaf = 1.0;
         glm::ivec3 roots(1);
         if (g.triangleCount() == 0) {
-            mTree->build(origin, leaf, roots, {});
+            tree.build(origin, leaf, roots, {});
         } else {
             voxelgi::VoxelTreeCones::computeLattice(glm::dvec3(g.boundsMin), glm::dvec3(g.boundsMax), mParams.resolution,
-                                                    mSettings.depth, mParams.voxelSize, origin, leaf, roots);
+                                                    s.depth, mParams.voxelSize, origin, leaf, roots);
             voxelgi::LeafLattice lattice;
             lattice.origin = origin;
             lattice.leafSize = leaf;
-            lattice.cells = roots * (1 << (2 * mSettings.depth));
-            lattice.supersampling = mSettings.supersampling;
-            lattice.chunk = mSettings.chunk;
-            lattice.innerLayers = mSettings.innerLayers;
-            mTree->build(origin, leaf, roots, voxelgi::voxelizeSurfaceLeaves(g, lattice, "adaptive_voxel_tree_cones"));
+            lattice.cells = roots * (1 << (2 * s.depth));
+            lattice.supersampling = s.supersampling;
+            lattice.chunk = s.chunk;
+            lattice.innerLayers = s.innerLayers;
+            tree.build(origin, leaf, roots, voxelgi::voxelizeSurfaceLeaves(g, lattice, "adaptive_voxel_tree_cones"));
         }
-        mGeometryKey = frame.geometryKey;
-        mLightsKey.clear();
-        return plugin::VoxelGiStep::done(why + ": " + std::to_string(mTree->getLeaves().size()) + " leaves, " +
-                                         std::to_string(mTree->getTree()->getNodeCount()) + " nodes (" +
-                                         std::to_string(roots.x) + "x" + std::to_string(roots.y) + "x" +
-                                         std::to_string(roots.z) + " root cells)");
+        return std::to_string(tree.getLeaves().size()) + " leaves, " + std::to_string(tree.getTree()->getNodeCount()) +
+               " nodes (" + std::to_string(roots.x) + "x" + std::to_string(roots.y) + "x" + std::to_string(roots.z) +
+               " root cells)";
     }
 
-    plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
+    void writeStructureParams(config::ParamSet& p) const override
     {
-        const std::string lightsKey = voxelgi::computeLightsKey(*frame.geometry);
-        if (lightsKey == mLightsKey && !frame.force)
-            return plugin::VoxelGiStep::skipped("the tree and the lights are unchanged since it was lit");
-        mTree->injectLight(*frame.geometry);
-        mLightsKey = lightsKey;
-        return plugin::VoxelGiStep::done("lit " + std::to_string(mTree->getLeaves().size()) + " leaves, " +
-                                         std::to_string(mSettings.bounces) + " passes");
+        p.set("depth", std::int64_t(mStructure->getSettings().depth));
     }
 
-    void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
+    std::vector<std::pair<std::string, double>> structureCounters() const override
     {
-        mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
-        irradiance = voxelgi::gatherConesReduced(
-            *input.gbuffer, mParams.traceStep, mTree->getCones().halfAngle, input.coneVisibility, input.capsules,
-            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                if (mGatheredOnGpu)
-                    mGpu.gatherCones(*input.gpu, *mTree, reduced, cones);
-                else
-                    mTree->gatherCones(reduced, cones);
-            });
+        return {{"nodes", double(mStructure->getTree()->getNodeCount())},
+                {"elements", double(mStructure->getTree()->getElementCount())}};
     }
-
-    bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
-    {
-        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mParams.traceStep,
-                                               [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
-                                                   mTree->gatherRays(reduced, raysPerPixel, low);
-                                               });
-        return true;
-    }
-
-    plugin::VoxelGiMemory memory() const override
-    {
-        if (!mBuilt)
-            return {};
-        return {.topologyBytes = mTree->getTopologyBytes(), .payloadBytes = mTree->getPayloadBytes()};
-    }
-
-    std::vector<std::pair<std::string, double>> counters() const override
-    {
-        if (!mBuilt || !mTree->getTree())
-            return {};
-        return {{"voxel_size", mTree->getLeafSize()},
-                {"leaves", double(mTree->getLeaves().size())},
-                {"nodes", double(mTree->getTree()->getNodeCount())},
-                {"elements", double(mTree->getTree()->getElementCount())},
-                {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mTree->getMeanStepsPerCone()},
-                {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
-                {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
-                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
-    }
-
-private:
-    voxelgi::SparseConeParams mParams;
-    voxelgi::TreeConeSettings mSettings;
-    std::optional<voxelgi::VoxelTreeCones> mTree;
-    std::string mGeometryKey, mLightsKey;
-    bool mBuilt = false;
-    bool mGatheredOnGpu = false;
-    voxelgi::TreeConeGatherGpu mGpu;
 };
 
 } // namespace

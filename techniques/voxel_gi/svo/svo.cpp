@@ -71,19 +71,16 @@
 #include "svo_gather_gpu.h"
 
 #include "core/error.h"
-#include "families/voxel_gi/sparse_cone_params.h"
-#include "families/voxel_gi/upsample.h"
-#include "families/voxel_gi/voxel_gi.h"
+#include "families/voxel_gi/sparse_cone_technique.h"
 
 #include <bit>
-#include <cmath>
-#include <optional>
+#include <string>
 
 namespace {
 
 using namespace rtlab;
 
-class Svo final : public plugin::VoxelGiTechnique {
+class Svo final : public voxelgi::SparseConeTechnique<voxelgi::SparseVoxelOctree, voxelgi::OctreeGatherGpu> {
 public:
     static plugin::TechniqueInfo describe()
     {
@@ -100,119 +97,42 @@ public:
         return schema;
     }
 
-    explicit Svo(const config::ParamSet& p) : mParams(voxelgi::SparseConeParams::read(p))
+    explicit Svo(const config::ParamSet& p) : SparseConeTechnique(p)
     {
         if (!std::has_single_bit(unsigned(mParams.resolution)))
             throw Error("svo: resolution must be a power of two, found " + std::to_string(mParams.resolution));
-        mSettings.resolution = mParams.resolution;
-        mSettings.supersampling = mParams.supersampling;
-        mSettings.bounces = mParams.bounces;
-        mSettings.coneHalfAngleDegrees = mParams.coneAngle;
-        mSettings.startOffset = mParams.startOffset;
-        mSettings.injectOffset = mParams.injectOffset;
-        mSettings.stepScale = mParams.stepScale;
-        mSettings.innerLayers = mParams.innerLayers;
-    }
-
-    config::ParamSet effectiveParams() const override
-    {
-        config::ParamSet p;
-        mParams.write(p);
-        return p;
-    }
-
-    plugin::VoxelGiDefinition definition() const override
-    {
-        return {.bounces = mSettings.bounces, .surfacesOnly = true};
-    }
-
-    plugin::VoxelGiStep voxelize(const plugin::VoxelGiFrame& frame) override
-    {
-        if (mTree && frame.geometryKey == mGeometryKey && !frame.force)
-            return plugin::VoxelGiStep::skipped("the static geometry is unchanged since the build");
-        const std::string why = !mTree ? "first build"
-                                : frame.geometryKey != mGeometryKey ? "geometry changed"
-                                                                    : "culling off";
-        if (!mTree)
-            mTree.emplace(mSettings);
-        glm::dvec3 origin;
-        double side = 0.0;
-        const scene::RenderScene& g = *frame.geometry;
-        if (g.triangleCount() == 0) {
-            mTree->build(glm::dvec3(0.0), 1.0, {});
-        } else {
-            voxelgi::SparseVoxelOctree::computeCube(glm::dvec3(g.boundsMin), glm::dvec3(g.boundsMax),
-                                                    mSettings.resolution, origin, side, mParams.voxelSize);
-            mTree->build(origin, side,
-                         voxelgi::SparseVoxelOctree::voxelizeLeaves(g, origin, side, mSettings));
-        }
-        mGeometryKey = frame.geometryKey;
-        mLightsKey.clear();
-        return plugin::VoxelGiStep::done(why + ": " + std::to_string(mTree->getLeaves().size()) +
-                                         " leaves, " + std::to_string(mTree->getNodeCount()) + " nodes");
-    }
-
-    plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
-    {
-        const std::string lightsKey = voxelgi::computeLightsKey(*frame.geometry);
-        if (lightsKey == mLightsKey && !frame.force)
-            return plugin::VoxelGiStep::skipped("the tree and the lights are unchanged since it was lit");
-        mTree->injectLight(*frame.geometry);
-        mLightsKey = lightsKey;
-        return plugin::VoxelGiStep::done("lit " + std::to_string(mTree->getLeaves().size()) + " leaves, " +
-                                         std::to_string(mSettings.bounces) + " passes");
-    }
-
-    void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
-    {
-        mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
-        irradiance = voxelgi::gatherConesReduced(
-            *input.gbuffer, mParams.traceStep, mTree->getCones().halfAngle, input.coneVisibility,
-            input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                if (mGatheredOnGpu)
-                    mGpu.gatherCones(*input.gpu, *mTree, reduced, cones);
-                else
-                    mTree->gatherCones(reduced, cones);
-            });
-    }
-
-    bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
-                        Image<glm::vec3>& irradiance) override
-    {
-        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mParams.traceStep,
-                                               [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
-                                                   mTree->gatherRays(reduced, raysPerPixel, low);
-                                               });
-        return true;
-    }
-
-    plugin::VoxelGiMemory memory() const override
-    {
-        if (!mTree)
-            return {};
-        return {.topologyBytes = mTree->getTopologyBytes(), .payloadBytes = mTree->getPayloadBytes()};
-    }
-
-    std::vector<std::pair<std::string, double>> counters() const override
-    {
-        if (!mTree)
-            return {};
-        return {{"voxel_size", mTree->getLeafSize()},
-                {"leaves", double(mTree->getLeaves().size())},
-                {"nodes", double(mTree->getNodeCount())},
-                {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mTree->getMeanStepsPerCone()},
-                {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
-                {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
-                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
+        voxelgi::OctreeSettings settings;
+        settings.resolution = mParams.resolution;
+        settings.supersampling = mParams.supersampling;
+        settings.bounces = mParams.bounces;
+        settings.coneHalfAngleDegrees = mParams.coneAngle;
+        settings.startOffset = mParams.startOffset;
+        settings.injectOffset = mParams.injectOffset;
+        settings.stepScale = mParams.stepScale;
+        settings.innerLayers = mParams.innerLayers;
+        mStructure.emplace(settings); // checks the settings
     }
 
 private:
-    voxelgi::SparseConeParams mParams;
-    voxelgi::OctreeSettings mSettings;
-    std::optional<voxelgi::SparseVoxelOctree> mTree;
-    voxelgi::OctreeGatherGpu mGpu;
-    std::string mGeometryKey, mLightsKey;
-    bool mGatheredOnGpu = false;
+    std::string build(const scene::RenderScene& g) override
+    {
+        voxelgi::SparseVoxelOctree& tree = *mStructure;
+        if (g.triangleCount() == 0) {
+            tree.build(glm::dvec3(0.0), 1.0, {});
+        } else {
+            glm::dvec3 origin;
+            double side = 0.0;
+            voxelgi::SparseVoxelOctree::computeCube(glm::dvec3(g.boundsMin), glm::dvec3(g.boundsMax),
+                                                    mParams.resolution, origin, side, mParams.voxelSize);
+            tree.build(origin, side, voxelgi::SparseVoxelOctree::voxelizeLeaves(g, origin, side, tree.getSettings()));
+        }
+        return std::to_string(tree.getLeaves().size()) + " leaves, " + std::to_string(tree.getNodeCount()) + " nodes";
+    }
+
+    std::vector<std::pair<std::string, double>> structureCounters() const override
+    {
+        return {{"nodes", double(mStructure->getNodeCount())}};
+    }
 };
 
 } // namespace

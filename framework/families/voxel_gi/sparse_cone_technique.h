@@ -1,0 +1,132 @@
+#pragma once
+// The voxel_gi technique around a sparse cone-traced structure (svo, adaptive_voxel_tree_cones):
+// rebuilt only when the static geometry changes and re-lit only when it or the lights change
+// (each skip recorded with its reason), the pixel gather on Vulkan or in C++ at one pixel per
+// trace_step^2 block upsampled with the occlusion family's cone visibilities and the characters'
+// capsules, the error split's rays, memory and counters. A technique gives its structure, its
+// Vulkan gather and how the structure is built over a scene.
+//
+// Structure: injectLight(scene), getCones(), gatherCones(gbuffer, out), gatherRays(gbuffer, rays,
+// out), getLeaves(), getLeafSize(), getMeanStepsPerCone(), getTopologyBytes(), getPayloadBytes().
+// Gpu: gatherCones(context, structure, gbuffer, out), getLastGpuMs(), getLastUploadBytes().
+
+#include "families/voxel_gi/sparse_cone_params.h"
+#include "families/voxel_gi/upsample.h"
+#include "families/voxel_gi/voxel_gi.h"
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace rtlab::voxelgi {
+
+template <class Structure, class Gpu>
+class SparseConeTechnique : public plugin::VoxelGiTechnique {
+public:
+    config::ParamSet effectiveParams() const override
+    {
+        config::ParamSet p;
+        mParams.write(p);
+        writeStructureParams(p);
+        return p;
+    }
+
+    plugin::VoxelGiDefinition definition() const override
+    {
+        // The walls' interior beyond the inner layers is not stored (voxel_gi.h surfacesOnly).
+        return {.bounces = mParams.bounces, .surfacesOnly = true};
+    }
+
+    plugin::VoxelGiStep voxelize(const plugin::VoxelGiFrame& frame) override
+    {
+        if (mBuilt && frame.geometryKey == mGeometryKey && !frame.force)
+            return plugin::VoxelGiStep::skipped("the static geometry is unchanged since the build");
+        const std::string why = !mBuilt                              ? "first build"
+                                : frame.geometryKey != mGeometryKey ? "geometry changed"
+                                                                    : "culling off";
+        const std::string what = build(*frame.geometry);
+        mBuilt = true;
+        mGeometryKey = frame.geometryKey;
+        mLightsKey.clear();
+        return plugin::VoxelGiStep::done(why + ": " + what);
+    }
+
+    plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
+    {
+        const std::string lightsKey = computeLightsKey(*frame.geometry);
+        if (lightsKey == mLightsKey && !frame.force)
+            return plugin::VoxelGiStep::skipped("the structure and the lights are unchanged since it was lit");
+        mStructure->injectLight(*frame.geometry);
+        mLightsKey = lightsKey;
+        return plugin::VoxelGiStep::done("lit " + std::to_string(mStructure->getLeaves().size()) + " leaves, " +
+                                         std::to_string(mParams.bounces) + " passes");
+    }
+
+    void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
+    {
+        mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
+        irradiance = gatherConesReduced(*input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
+                                        input.coneVisibility, input.capsules,
+                                        [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+                                            if (mGatheredOnGpu)
+                                                mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
+                                            else
+                                                mStructure->gatherCones(reduced, cones);
+                                        });
+    }
+
+    bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
+    {
+        irradiance = traceRaysReduced(*input.gbuffer, mParams.traceStep,
+                                      [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
+                                          mStructure->gatherRays(reduced, raysPerPixel, low);
+                                      });
+        return true;
+    }
+
+    plugin::VoxelGiMemory memory() const override
+    {
+        if (!mBuilt)
+            return {};
+        return {.topologyBytes = mStructure->getTopologyBytes(), .payloadBytes = mStructure->getPayloadBytes()};
+    }
+
+    std::vector<std::pair<std::string, double>> counters() const override
+    {
+        if (!mBuilt)
+            return {};
+        std::vector<std::pair<std::string, double>> c = {
+            {"voxel_size", mStructure->getLeafSize()},
+            {"leaves", double(mStructure->getLeaves().size())},
+            {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mStructure->getMeanStepsPerCone()},
+            {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
+            {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
+            {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
+        for (auto& extra : structureCounters())
+            c.push_back(std::move(extra));
+        return c;
+    }
+
+protected:
+    explicit SparseConeTechnique(const config::ParamSet& p) : mParams(SparseConeParams::read(p)) {}
+
+    //! Builds mStructure over the scene's static geometry; returns what it built, for the row.
+    virtual std::string build(const scene::RenderScene& geometry) = 0;
+    //! The parameters of the structure beyond SparseConeParams.
+    virtual void writeStructureParams(config::ParamSet&) const {}
+    //! Counters of the structure beyond the shared ones (its node counts).
+    virtual std::vector<std::pair<std::string, double>> structureCounters() const { return {}; }
+
+    SparseConeParams mParams;
+    std::optional<Structure> mStructure;
+
+private:
+    Gpu mGpu;
+    std::string mGeometryKey, mLightsKey;
+    bool mBuilt = false;
+    bool mGatheredOnGpu = false;
+};
+
+} // namespace rtlab::voxelgi
