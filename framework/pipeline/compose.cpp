@@ -147,13 +147,104 @@ Compose::Compose(FrameStart& start, ComposeOptions options)
 
 Compose::~Compose() = default;
 
+void Compose::addSlotUploads(FrameGraph& graph)
+{
+    gpu::Context& gpuContext = mStart.getGpu();
+    const auto ao = ambientOcclusionSlot(mWidth, mHeight);
+    const auto cones = coneVisibilitySlot(mWidth, mHeight);
+    const auto indirect = indirectIrradianceSlot(mWidth, mHeight);
+    const auto aoGpu = ambientOcclusionGpuSlot(mWidth, mHeight);
+    const auto conesGpu = coneVisibilityGpuSlot(mWidth, mHeight);
+    const auto indirectGpu = indirectIrradianceGpuSlot(mWidth, mHeight);
+
+    // Occlusion: AO or cone visibilities from the CPU slots, unless the family wrote the GPU ones.
+    const bool occlusionOnGpu =
+        graph.declares(kAmbientOcclusionGpu) || graph.declares(kConeVisibilityGpu);
+    const bool hasAo = graph.declares(kAmbientOcclusion);
+    const bool hasCones = graph.declares(kConeVisibility);
+    if (!occlusionOnGpu && (hasAo || hasCones)) {
+        // Kept across frames (persistent): the slots point into them.
+        const auto aoImage = makeGpuImageResource(gpuContext, "occlusion.ambient_upload",
+                                                  gpu::Format::R32Float, mWidth, mHeight);
+        std::array<Resource<gpu::Image>, 4> coneImages;
+        std::vector<ResourceRef> writes = {aoGpu, conesGpu, aoImage};
+        std::vector<std::string> kept = {aoImage.name};
+        for (std::size_t g = 0; g < 4; ++g) {
+            coneImages[g] = makeGpuImageResource(
+                gpuContext, "occlusion.cone_visibility_upload" + std::to_string(g),
+                gpu::Format::RGBA32Float, mWidth, mHeight);
+            writes.push_back(coneImages[g]);
+            kept.push_back(coneImages[g].name);
+        }
+        std::vector<ResourceRef> reads;
+        if (hasAo)
+            reads.push_back(ao);
+        if (hasCones)
+            reads.push_back(cones);
+        graph.addPass({.name = "occlusion_upload",
+                       .reads = reads,
+                       .writes = writes,
+                       .persistent = kept},
+                      [ao, cones, hasAo, hasCones, aoGpu, conesGpu, aoImage,
+                       coneImages](PassContext& ctx) {
+                          std::array<const gpu::Image*, 4> coneSlot{};
+                          const gpu::Image* aoSlot = nullptr;
+                          if (hasCones && ctx.read(cones).size() ==
+                                              std::size_t(scene::kConeDirectionCount)) {
+                              std::array<gpu::Image*, 4> targets{};
+                              for (std::size_t g = 0; g < 4; ++g)
+                                  targets[g] = &ctx.write(coneImages[g]);
+                              render::uploadConeVisibility(targets, ctx.read(cones));
+                              std::copy(targets.begin(), targets.end(), coneSlot.begin());
+                          } else if (hasAo) {
+                              gpu::Image& image = ctx.write(aoImage);
+                              render::uploadInto(image, ctx.read(ao));
+                              aoSlot = &image;
+                          }
+                          ctx.write(aoGpu) = aoSlot;
+                          ctx.write(conesGpu) = coneSlot;
+                          return PassOutcome{};
+                      });
+    } else if (!occlusionOnGpu) {
+        graph.addExternal(aoGpu, false, "no occlusion technique in the run");
+        graph.addExternal(conesGpu, false, "no occlusion technique in the run");
+    } else {
+        if (!graph.declares(kAmbientOcclusionGpu))
+            graph.addExternal(aoGpu, false, "the occlusion technique gives cone visibilities");
+        if (!graph.declares(kConeVisibilityGpu))
+            graph.addExternal(conesGpu, false, "the occlusion technique gives no cones");
+    }
+
+    // Indirect irradiance.
+    if (!graph.declares(kIndirectIrradianceGpu) && graph.declares(kIndirectIrradiance)) {
+        const auto image = makeGpuImageResource(gpuContext, "indirect_irradiance_upload",
+                                                gpu::Format::RGBA32Float, mWidth, mHeight);
+        graph.addPass({.name = "indirect_upload",
+                       .reads = {indirect},
+                       .writes = {indirectGpu, image},
+                       .persistent = {image.name}},
+                      [indirect, indirectGpu, image](PassContext& ctx) {
+                          gpu::Image& target = ctx.write(image);
+                          render::uploadInto(target, ctx.read(indirect));
+                          ctx.write(indirectGpu) = &target;
+                          return PassOutcome{};
+                      });
+    } else if (!graph.declares(kIndirectIrradianceGpu)) {
+        graph.addExternal(indirectGpu, false, "no voxel_gi technique in the run");
+    }
+    // CPU slots nobody fills (CPU readers read them optionally).
+    if (!graph.declares(kAmbientOcclusion))
+        graph.addExternal(ao, false, "no occlusion technique in the run");
+    if (!graph.declares(kConeVisibility))
+        graph.addExternal(cones, false, "no occlusion technique in the run");
+    if (!graph.declares(kIndirectIrradiance))
+        graph.addExternal(indirect, false, "no voxel_gi technique in the run");
+}
+
 void Compose::addPasses(FrameGraph& graph)
 {
     const auto geometry = mStart.geometry();
     const auto gbuffer = mStart.gbuffer();
-    const auto ao = ambientOcclusionSlot(mWidth, mHeight);
-    const auto cones = coneVisibilitySlot(mWidth, mHeight);
-    const auto indirect = indirectIrradianceSlot(mWidth, mHeight);
     const auto lit = litFrame();
     const Resource<const render::ShadowPass*> shadowMaps{
         "shadow_maps",
@@ -167,21 +258,19 @@ void Compose::addPasses(FrameGraph& graph)
     const auto ldr =
         makeGpuImageResource(gpuContext, "lit_ldr", gpu::Format::RGBA8Unorm, mWidth, mHeight);
 
-    // Slots that no family of the run fills.
-    if (!graph.declares(kAmbientOcclusion))
-        graph.addExternal(ao, false, "no occlusion technique in the run");
-    if (!graph.declares(kConeVisibility))
-        graph.addExternal(cones, false, "no occlusion technique in the run");
-    if (!graph.declares(kIndirectIrradiance))
-        graph.addExternal(indirect, false, "no voxel_gi technique in the run");
     const bool indirectFilled =
         graph.passes().end() !=
         std::find_if(graph.passes().begin(), graph.passes().end(), [](const PassDesc& p) {
-            return std::any_of(p.writes.begin(), p.writes.end(),
-                               [](const ResourceRef& w) { return w.name == kIndirectIrradiance; });
+            return std::any_of(p.writes.begin(), p.writes.end(), [](const ResourceRef& w) {
+                return w.name == kIndirectIrradiance || w.name == kIndirectIrradianceGpu;
+            });
         });
     mStats.indirect =
         indirectFilled ? "indirect_irradiance" : "none (no voxel_gi technique in the run)";
+    addSlotUploads(graph);
+    const auto aoGpu = ambientOcclusionGpuSlot(mWidth, mHeight);
+    const auto conesGpu = coneVisibilityGpuSlot(mWidth, mHeight);
+    const auto indirectGpu = indirectIrradianceGpuSlot(mWidth, mHeight);
 
     graph.addPass(
         {.name = "shadow_maps",
@@ -280,10 +369,11 @@ void Compose::addPasses(FrameGraph& graph)
     graph.addPass(
         {.name = "lighting",
          .reads = {gbuffer, geometry},
-         .optionalReads = {shadowMaps, ao, cones, indirect},
+         .optionalReads = {shadowMaps, aoGpu, conesGpu, indirectGpu},
          .writes = {hdr, direct},
          .timing = PassTiming::Repeated},
-        [this, gbuffer, geometry, shadowMaps, ao, cones, indirect, hdr, direct](PassContext& ctx) {
+        [this, gbuffer, geometry, shadowMaps, aoGpu, conesGpu, indirectGpu, hdr,
+         direct](PassContext& ctx) {
             gpu::Context& gpu = mStart.getGpu();
             if (!mLighting) {
                 render::LightingPassOptions options;
@@ -299,32 +389,20 @@ void Compose::addPasses(FrameGraph& graph)
             inputs.camera = gb.camera;
             const auto* shadows = ctx.tryRead(shadowMaps);
             inputs.shadows = shadows ? *shadows : nullptr;
-            // CPU outputs of the families go up here; once their techniques keep them
-            // on the GPU these uploads disappear.
-            gpu::Image aoImage, indirectImage;
-            gpu::Buffer coneBuffer;
-            const auto* coneImages = ctx.tryRead(cones);
-            const auto* aoCpu = ctx.tryRead(ao);
+            // The families' results, on the GPU already (slots filled on the CPU were uploaded
+            // by their own pass, see addSlotUploads).
             mStats.visibility = "none";
-            if (coneImages && coneImages->size() == std::size_t(scene::kConeDirectionCount)) {
-                const std::size_t pixels = std::size_t(mWidth) * std::size_t(mHeight);
-                std::vector<float> packed(pixels * std::size_t(scene::kConeDirectionCount));
-                for (std::size_t k = 0; k < coneImages->size(); ++k)
-                    for (std::size_t i = 0; i < pixels; ++i)
-                        packed[i * coneImages->size() + k] = (*coneImages)[k].pixels[i];
-                coneBuffer = gpu.createBuffer({packed.size() * sizeof(float), "cone visibility"});
-                coneBuffer.uploadSpan<float>(packed);
-                inputs.coneVisibility = &coneBuffer;
+            const auto* coneImages = ctx.tryRead(conesGpu);
+            const auto* aoImage = ctx.tryRead(aoGpu);
+            if (coneImages && (*coneImages)[0] != nullptr) {
+                inputs.coneVisibility = *coneImages;
                 mStats.visibility = "cones";
-            } else if (aoCpu) {
-                aoImage = render::createImageFrom(gpu, *aoCpu, "ambient occlusion");
-                inputs.ambientOcclusion = &aoImage;
+            } else if (aoImage && *aoImage != nullptr) {
+                inputs.ambientOcclusion = *aoImage;
                 mStats.visibility = "ambient_occlusion";
             }
-            if (const auto* e = ctx.tryRead(indirect)) {
-                indirectImage = render::createImageFrom(gpu, *e, "indirect irradiance");
-                inputs.indirectIrradiance = &indirectImage;
-            }
+            if (const auto* e = ctx.tryRead(indirectGpu))
+                inputs.indirectIrradiance = *e;
             inputs.outHdr = &ctx.write(hdr);
             inputs.outDirect = &ctx.write(direct);
             mLighting->draw(g, inputs);
@@ -338,7 +416,10 @@ void Compose::addPasses(FrameGraph& graph)
                                          ctx.write(ldr));
                       return PassOutcome{};
                   });
-    graph.addPass({.name = "frame_readback", .reads = {hdr, direct, ldr}, .writes = {lit}},
+    graph.addPass({.name = "frame_readback",
+                   .reads = {hdr, direct, ldr},
+                   .writes = {lit},
+                   .forReaders = true},
                   [hdr, direct, ldr, lit](PassContext& ctx) {
                       LitFrame& out = ctx.write(lit);
                       out.hdr = render::downloadRgb(ctx.read(hdr));

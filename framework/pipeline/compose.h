@@ -22,7 +22,13 @@
 //   frame_readback  HDR, direct and tonemapped frames to the CPU (metrics and files)
 //
 // Resources a family writes for the frame use the slot names below with these types; a slot
-// nobody writes is an unavailable external, so the lighting pass reads it optionally.
+// nobody writes is an unavailable external, so the lighting pass reads it optionally. Each slot
+// has a CPU form (for CPU readers: voxel GI's gather reads the cone visibilities) and a GPU form
+// (what the lighting pass binds). A family whose technique keeps its result on the GPU writes
+// the GPU slot itself (the occlusion family binds the technique's own images: no round trip
+// through the CPU); for a slot a family fills on the CPU only, the compose passes add an upload
+// pass (`occlusion_upload`, `indirect_upload`) into images the graph keeps across frames, timed
+// and culled like any other pass.
 
 #include "core/image.h"
 #include "pipeline/frame_graph.h"
@@ -30,6 +36,7 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -83,6 +90,9 @@ public:
     static constexpr const char* kConeVisibility = "occlusion.cone_visibility";
     static constexpr const char* kIndirectIrradiance = "indirect_irradiance";
     static constexpr const char* kLitFrame = "lit_frame";
+    static constexpr const char* kAmbientOcclusionGpu = "occlusion.ambient_gpu";
+    static constexpr const char* kConeVisibilityGpu = "occlusion.cone_visibility_gpu";
+    static constexpr const char* kIndirectIrradianceGpu = "indirect_irradiance_gpu";
 
     Compose(FrameStart& start, ComposeOptions options);
     ~Compose();
@@ -105,12 +115,34 @@ public:
     {
         return {kIndirectIrradiance, ResourceType::cpuImage("vec3", width, height)};
     }
+    //! The GPU forms: the image (R32Float) holding the AO, null when the producer gives none.
+    static Resource<const gpu::Image*> ambientOcclusionGpuSlot(int width, int height)
+    {
+        return {kAmbientOcclusionGpu, ResourceType::gpuImage("r32f", width, height)};
+    }
+    //! Four RGBA32Float images, cone k in channel k % 4 of image k / 4 (render/lighting_pass.h);
+    //! all null when the producer gives no cone visibilities.
+    static Resource<std::array<const gpu::Image*, 4>> coneVisibilityGpuSlot(int width, int height)
+    {
+        return {kConeVisibilityGpu,
+                ResourceType::gpuImage("4 x rgba32f (cone k: channel k % 4 of image k / 4)", width,
+                                       height)};
+    }
+    //! RGBA32Float, irradiance in rgb.
+    static Resource<const gpu::Image*> indirectIrradianceGpuSlot(int width, int height)
+    {
+        return {kIndirectIrradianceGpu, ResourceType::gpuImage("rgba32f", width, height)};
+    }
     Resource<LitFrame> litFrame() const
     {
         return {kLitFrame, ResourceType::cpuImage("lit frame: hdr, direct, ldr", mWidth, mHeight)};
     }
 
 private:
+    //! The upload passes for slots filled on the CPU only, and unavailable externals for slots
+    //! nobody fills.
+    void addSlotUploads(FrameGraph& graph);
+
     FrameStart& mStart;
     ComposeOptions mOptions;
     int mWidth = 0;

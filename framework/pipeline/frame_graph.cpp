@@ -275,6 +275,31 @@ std::vector<PassRecord> FrameGraph::plan(const scene::FeatureSet& features,
         if (records[i].ran)
             records[i].reason.clear();
     }
+    // A pass that prepares data for its readers (PassDesc::forReaders) and runs only for
+    // measurements is one: every running pass that reads one of its outputs measures, and the
+    // run asks for none of them (the G-buffer copied to the CPU for the ground truth is not part
+    // of the frame's time). Readers come later, so one backward sweep decides.
+    const std::set<std::string> requested(outputs.begin(), outputs.end());
+    for (std::size_t k = n; k-- > 0;) {
+        if (!records[k].ran || records[k].measurement || !mPasses[k].forReaders)
+            continue;
+        bool read = false, onlyMeasured = true;
+        for (const auto& w : mPasses[k].writes) {
+            if (requested.count(w.name) > 0)
+                onlyMeasured = false;
+            for (std::size_t j = k + 1; j < n && onlyMeasured; ++j) {
+                if (!records[j].ran)
+                    continue;
+                for (const auto* list : {&mPasses[j].reads, &mPasses[j].optionalReads})
+                    for (const auto& r : *list)
+                        if (r.name == w.name) {
+                            read = true;
+                            onlyMeasured = onlyMeasured && records[j].measurement;
+                        }
+            }
+        }
+        records[k].measurement = read && onlyMeasured;
+    }
     return records;
 }
 

@@ -156,6 +156,10 @@ struct PassDesc {
     //! True for passes that measure the frame rather than make it (ground truths, metrics, image
     //! files): they are left out of the frame's time.
     bool measurement = false;
+    //! True for a pass that only prepares data for its readers (a read-back of GPU results to
+    //! the CPU, a CPU view of the G-buffer): in a frame where only measurements read its outputs
+    //! it counts as a measurement too (its record says so), so the frame's time leaves it out.
+    bool forReaders = false;
     //! PassTiming::Repeated with other warm-up and repeats than the run's (e.g. an expensive
     //! preparation timed once).
     std::optional<metrics::TimingOptions> timingOptions;
@@ -167,7 +171,9 @@ struct PassRecord {
     bool ran = false;
     std::string reason; //!< why it was skipped; empty when it ran
     PassTiming timing = PassTiming::Once;
-    bool measurement = false; //!< from PassDesc
+    //! From PassDesc, or derived for a pass PassDesc::forReaders whose outputs only
+    //! measurements read this frame.
+    bool measurement = false;
     //! When it ran: the CPU wall time (and GPU pass times) the graph measured.
     std::optional<metrics::TimingReport> time;
 };

@@ -171,14 +171,18 @@ void FrameStart::addPasses(FrameGraph& graph)
                                       ? "the G-buffer is unchanged since frame " +
                                             std::to_string(mReadFrame) + ": its CPU copy is reused"
                                       : std::string();
-                       }},
+                       },
+                   .forReaders = true},
                   [this, gbufferCpuRes](PassContext& ctx) {
                       ctx.write(gbufferCpuRes) = mGBufferPass->readBack();
                       mReadKey = mDrawnKey;
                       mReadFrame = ctx.frame();
                       return PassOutcome{};
                   });
-    graph.addPass({.name = "view_inputs", .reads = {gbufferCpuRes}, .writes = {viewRes}},
+    graph.addPass({.name = "view_inputs",
+                   .reads = {gbufferCpuRes},
+                   .writes = {viewRes},
+                   .forReaders = true},
                   [gbufferCpuRes, viewRes](PassContext& ctx) {
                       const scene::GBuffer& g = ctx.read(gbufferCpuRes);
                       ViewInputs& v = ctx.write(viewRes);

@@ -43,6 +43,66 @@ gpu::Image createImageFrom(gpu::Context& context, const Image<glm::vec3>& image,
 
 namespace {
 
+void requireTarget(const gpu::Image& target, gpu::Format format, int width, int height,
+                   const char* what)
+{
+    const gpu::ImageDesc& d = target.getDesc();
+    if (d.format != format || d.dimension != gpu::ImageDimension::Image2D ||
+        int(d.width) != width || int(d.height) != height || d.depth != 1)
+        throw Error(std::string("uploadInto: ") + what + " of " + std::to_string(width) + "x" +
+                    std::to_string(height) + " needs a 2D " + std::string(gpu::getFormatName(format)) +
+                    " image of that size, the target is " +
+                    std::string(gpu::getFormatName(d.format)) + " " +
+                    std::to_string(d.width) + "x" + std::to_string(d.height) + "x" +
+                    std::to_string(d.depth));
+}
+
+} // namespace
+
+void uploadInto(gpu::Image& target, const Image<float>& image)
+{
+    requireTarget(target, gpu::Format::R32Float, image.width, image.height, "a float image");
+    target.upload(image.pixels.data(), image.pixels.size() * sizeof(float));
+}
+
+void uploadInto(gpu::Image& target, const Image<glm::vec3>& image)
+{
+    requireTarget(target, gpu::Format::RGBA32Float, image.width, image.height, "an RGB image");
+    std::vector<float> texels(image.pixels.size() * 4);
+    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
+        texels[4 * i + 0] = image.pixels[i].x;
+        texels[4 * i + 1] = image.pixels[i].y;
+        texels[4 * i + 2] = image.pixels[i].z;
+        texels[4 * i + 3] = 1.0f;
+    }
+    target.upload(texels.data(), texels.size() * sizeof(float));
+}
+
+void uploadConeVisibility(const std::array<gpu::Image*, 4>& targets,
+                          const std::vector<Image<float>>& cones)
+{
+    if (cones.size() != 16)
+        throw Error("uploadConeVisibility: 16 cone images expected, found " +
+                    std::to_string(cones.size()));
+    const int w = cones[0].width, h = cones[0].height;
+    for (const Image<float>& c : cones)
+        if (c.width != w || c.height != h)
+            throw Error("uploadConeVisibility: the cone images differ in size");
+    const std::size_t pixels = std::size_t(w) * std::size_t(h);
+    std::vector<float> texels(pixels * 4);
+    for (std::size_t g = 0; g < 4; ++g) {
+        if (targets[g] == nullptr)
+            throw Error("uploadConeVisibility: target image " + std::to_string(g) + " is null");
+        requireTarget(*targets[g], gpu::Format::RGBA32Float, w, h, "cone visibilities");
+        for (std::size_t i = 0; i < pixels; ++i)
+            for (std::size_t c = 0; c < 4; ++c)
+                texels[4 * i + c] = cones[4 * g + c].pixels[i];
+        targets[g]->upload(texels.data(), texels.size() * sizeof(float));
+    }
+}
+
+namespace {
+
 // Every channel of every texel as float, channel-interleaved.
 std::vector<float> downloadAsFloats(const gpu::Image& image)
 {

@@ -16,10 +16,12 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace rtlab::render {
 
@@ -31,6 +33,16 @@ gpu::Image createImageFrom(gpu::Context& context, const Image<float>& image,
 //! A 2D RGBA32Float image (storage and sampled) holding `image` with alpha 1.
 gpu::Image createImageFrom(gpu::Context& context, const Image<glm::vec3>& image,
                            const std::string& name);
+
+//! Uploads `image` into `target`, an R32Float (Image<float>) or RGBA32Float (Image<glm::vec3>,
+//! alpha 1) image of its size. Throws rtlab::Error for another size or format.
+void uploadInto(gpu::Image& target, const Image<float>& image);
+void uploadInto(gpu::Image& target, const Image<glm::vec3>& image);
+//! The 16 cone visibilities of scene::getConeDirections() packed as the lighting pass reads them
+//! (render/lighting_pass.h): cone k in channel k % 4 of targets[k / 4], four RGBA32Float images
+//! of the cones' size. Throws rtlab::Error unless there are 16 images of one size.
+void uploadConeVisibility(const std::array<gpu::Image*, 4>& targets,
+                          const std::vector<Image<float>>& cones);
 
 //! The first three channels of a 2D RGBA32Float, RGBA16Float or RGBA8Unorm (as value / 255)
 //! image. Throws rtlab::Error for other formats or 3D images.

@@ -157,7 +157,7 @@ struct LightingPass::State {
     // Stand-ins bound where an input is absent (the pipeline binds every slot).
     gpu::Image noShadows;
     gpu::Image noOcclusion;
-    gpu::Buffer noCones;
+    gpu::Image noCones;
     gpu::Image noIndirect;
 
     gpu::Buffer lights;
@@ -238,8 +238,8 @@ LightingPass::LightingPass(gpu::Context& context, LightingPassOptions options)
     const gpu::ShaderCompiler compiler(compilerOptions);
     using gpu::BindingType;
     std::vector<gpu::BindingSlot> slots;
-    for (std::uint32_t b = 0; b <= 11; ++b) {
-        const bool buffer = b == 5 || b == 6 || b == 8;
+    for (std::uint32_t b = 0; b <= 14; ++b) {
+        const bool buffer = b == 5 || b == 6;
         slots.push_back({b, buffer ? BindingType::StorageBuffer : BindingType::StorageImage});
     }
     s.lighting = createComputePipeline(context, compiler, "lighting.comp", "lighting", slots,
@@ -256,14 +256,14 @@ LightingPass::LightingPass(gpu::Context& context, LightingPassOptions options)
     s.noShadows = context.createImage(atlas);
     s.noOcclusion = createImage2D(context, gpu::Format::R32Float, 1, 1, "lighting no occlusion");
     s.noIndirect = createImage2D(context, gpu::Format::RGBA32Float, 1, 1, "lighting no indirect");
-    s.noCones = context.createBuffer({kLobes * sizeof(float), "lighting no cones"});
+    s.noCones = createImage2D(context, gpu::Format::RGBA32Float, 1, 1, "lighting no cones");
     // Stand-ins are never read, but give them defined contents.
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     s.noShadows.upload(zero, sizeof(float));
     s.noOcclusion.upload(zero, sizeof(float));
     s.noIndirect.upload(zero, sizeof(zero));
-    const std::vector<float> ones(kLobes, 1.0f);
-    s.noCones.uploadSpan<float>(ones);
+    const float ones[4] = {1.0f, 1.0f, 1.0f, 1.0f};
+    s.noCones.upload(ones, sizeof(ones));
 }
 
 LightingPass::~LightingPass() = default;
@@ -280,18 +280,20 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
         throw Error("LightingPass::draw: the render target is not a G-buffer");
     const std::uint32_t w = target.getWidth();
     const std::uint32_t h = target.getHeight();
-    if (inputs.ambientOcclusion != nullptr && inputs.coneVisibility != nullptr)
+    const bool hasCones = inputs.coneVisibility[0] != nullptr;
+    for (const gpu::Image* image : inputs.coneVisibility) {
+        if ((image != nullptr) != hasCones)
+            throw Error("LightingPass::draw: give all four cone visibility images or none");
+        if (image != nullptr)
+            requireImage(*image, gpu::Format::RGBA32Float, w, h, "cone visibility");
+    }
+    if (inputs.ambientOcclusion != nullptr && hasCones)
         throw Error("LightingPass::draw: give ambient occlusion or cone visibilities, not both");
     if (inputs.ambientOcclusion != nullptr)
         requireImage(*inputs.ambientOcclusion, gpu::Format::R32Float, w, h, "ambient occlusion");
     if (inputs.indirectIrradiance != nullptr)
         requireImage(*inputs.indirectIrradiance, gpu::Format::RGBA32Float, w, h,
                      "indirect irradiance");
-    if (inputs.coneVisibility != nullptr &&
-        inputs.coneVisibility->getSize() < std::size_t(w) * h * kLobes * sizeof(float))
-        throw Error("LightingPass::draw: the cone visibility buffer needs 16 floats for each of " +
-                    std::to_string(std::size_t(w) * h) + " pixels, it has " +
-                    std::to_string(inputs.coneVisibility->getSize()) + " bytes");
 
     if (inputs.outHdr != nullptr)
         requireImage(*inputs.outHdr, gpu::Format::RGBA32Float, w, h, "HDR output");
@@ -330,7 +332,7 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
 
     const SkyVisibility visibility = inputs.ambientOcclusion != nullptr
                                          ? SkyVisibility::AmbientOcclusion
-                                     : inputs.coneVisibility != nullptr ? SkyVisibility::Cones
+                                     : hasCones ? SkyVisibility::Cones
                                                                         : SkyVisibility::None;
     LightingConstants constants;
     constants.inverseRelativeViewProjection = glm::inverse(m.projection * rotation);
@@ -352,8 +354,9 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
     const gpu::Image& atlas = inputs.shadows != nullptr ? inputs.shadows->getAtlas() : s.noShadows;
     const gpu::Image& ao =
         inputs.ambientOcclusion != nullptr ? *inputs.ambientOcclusion : s.noOcclusion;
-    const gpu::Buffer& cones =
-        inputs.coneVisibility != nullptr ? *inputs.coneVisibility : s.noCones;
+    const auto cone = [&](std::size_t g) -> const gpu::Image& {
+        return hasCones ? *inputs.coneVisibility[g] : s.noCones;
+    };
     const gpu::Image& indirect =
         inputs.indirectIrradiance != nullptr ? *inputs.indirectIrradiance : s.noIndirect;
     const gpu::GroupCount groups{gpu::computeGroupCount(w, kGroupSize),
@@ -369,10 +372,12 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
              gpu::Binding::storageImage(2, s.gbuffer[2]),
              gpu::Binding::storageImage(3, s.gbuffer[3]), gpu::Binding::storageImage(4, atlas),
              gpu::Binding::storageBuffer(5, s.lights), gpu::Binding::storageBuffer(6, s.sky),
-             gpu::Binding::storageImage(7, ao), gpu::Binding::storageBuffer(8, cones),
+             gpu::Binding::storageImage(7, ao), gpu::Binding::storageImage(8, cone(0)),
              gpu::Binding::storageImage(9, indirect),
              gpu::Binding::storageImage(10, ownOutputs ? s.hdr : *inputs.outHdr),
-             gpu::Binding::storageImage(11, ownOutputs ? s.direct : *inputs.outDirect)},
+             gpu::Binding::storageImage(11, ownOutputs ? s.direct : *inputs.outDirect),
+             gpu::Binding::storageImage(12, cone(1)), gpu::Binding::storageImage(13, cone(2)),
+             gpu::Binding::storageImage(14, cone(3))},
             gpu::PushConstants(constants), groups, kLightingLabel);
         if (ownOutputs)
             cmd.dispatch(

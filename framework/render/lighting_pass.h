@@ -55,6 +55,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include <array>
 #include <memory>
 #include <optional>
 #include <string_view>
@@ -110,10 +111,10 @@ struct LightingInputs {
     const ShadowPass* shadows = nullptr; //!< null: no shadows; lights it has not rendered: none
     //! R32Float image of the G-buffer's size: V_k = ao for every k. Null: no occlusion.
     const gpu::Image* ambientOcclusion = nullptr;
-    //! 16 floats per pixel (pixel (x, y) at floats 16 (y width + x) .. + 15, cone k at + k, in
-    //! the order of scene::getConeDirections()): V_k. Null: no occlusion. Not with
-    //! ambientOcclusion.
-    const gpu::Buffer* coneVisibility = nullptr;
+    //! Four RGBA32Float images of the G-buffer's size, cone k (in the order of
+    //! scene::getConeDirections()) in channel k % 4 of image k / 4: V_k. All null: no occlusion.
+    //! Not with ambientOcclusion.
+    std::array<const gpu::Image*, 4> coneVisibility{};
     //! RGBA32Float image of the G-buffer's size: incident indirect irradiance (rgb). Null: none.
     const gpu::Image* indirectIrradiance = nullptr;
     //! Where to write the frame: RGBA32Float images of the G-buffer's size, e.g. created by the

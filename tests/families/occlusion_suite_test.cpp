@@ -7,9 +7,10 @@
 // pixel's ambient is finite and in [0, 1], bent normals are finite (unit where there is a
 // surface), apertures are finite and in [0, pi/2], and more radius never brightens the image.
 
-#include "gpu/context.h"
 #include "families/occlusion/occlusion.h"
+#include "gpu/context.h"
 #include "plugin/screen_space.h"
+#include "render/image_transfer.h"
 #include "scene/camera.h"
 
 #include <glm/geometric.hpp>
@@ -243,6 +244,55 @@ TEST_P(OcclusionSuite, AnUnoccludedPlaneIsUnoccluded)
             if (out.bentNormal.size() == out.ambient.size()) {
                 ASSERT_NEAR(glm::dot(out.bentNormal.pixels[i], glm::vec3(0, 0, 1)), 1.0f, 1e-3f) << i;
             }
+        }
+    }
+}
+
+TEST_P(OcclusionSuite, ResultsLeftOnTheGpuReadBackToWhatAnImmediateReadBackGives)
+{
+    // A technique that keeps its result on the GPU (outputsOnGpu) must give, with the read-back
+    // deferred, GPU images of the G-buffer's size holding exactly its CPU outputs, and readBack()
+    // must return bitwise what compute() with the read-back gives. Others must refuse readBack().
+    const SyntheticGBuffer g = makeCases()[0].make();
+    auto t = make(0.5);
+    auto& technique = dynamic_cast<plugin::OcclusionTechnique&>(*t);
+    if (!technique.outputsOnGpu()) {
+        plugin::OcclusionOutput out;
+        EXPECT_THROW(technique.readBack(out), Error);
+        return;
+    }
+    plugin::OcclusionOutput immediate, deferred;
+    run(technique, g, &context(), immediate);
+    plugin::OcclusionInput in;
+    in.linearDepth = &g.depth;
+    in.normal = &g.normal;
+    in.projection = g.projection;
+    in.view = g.view;
+    in.gpu = &context();
+    in.readBack = false;
+    technique.compute(in, deferred);
+    EXPECT_TRUE(deferred.ambient.pixels.empty()) << "nothing read back yet";
+    const plugin::OcclusionGpuOutput images = deferred.gpu;
+    ASSERT_TRUE(images.ambient != nullptr || images.coneVisibility[0] != nullptr);
+    technique.readBack(deferred);
+    EXPECT_EQ(deferred.ambient.pixels, immediate.ambient.pixels);
+    EXPECT_EQ(deferred.coneAperture.pixels, immediate.coneAperture.pixels);
+    EXPECT_TRUE(deferred.bentNormal.pixels == immediate.bentNormal.pixels);
+    ASSERT_EQ(deferred.coneVisibility.size(), immediate.coneVisibility.size());
+    for (std::size_t k = 0; k < deferred.coneVisibility.size(); ++k)
+        EXPECT_EQ(deferred.coneVisibility[k].pixels, immediate.coneVisibility[k].pixels) << k;
+    if (images.ambient != nullptr) {
+        const Image<float> onGpu = render::downloadScalar(*images.ambient, 0);
+        ASSERT_EQ(onGpu.width, g.depth.width);
+        ASSERT_EQ(onGpu.height, g.depth.height);
+        EXPECT_EQ(onGpu.pixels, immediate.ambient.pixels);
+    }
+    if (images.coneVisibility[0] != nullptr) {
+        ASSERT_EQ(immediate.coneVisibility.size(), 16u);
+        for (std::size_t k = 0; k < 16; ++k) {
+            ASSERT_NE(images.coneVisibility[k / 4], nullptr);
+            const Image<float> onGpu = render::downloadScalar(*images.coneVisibility[k / 4], int(k % 4));
+            EXPECT_EQ(onGpu.pixels, immediate.coneVisibility[k].pixels) << "cone " << k;
         }
     }
 }

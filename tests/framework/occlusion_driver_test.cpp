@@ -56,6 +56,40 @@ private:
     double mRadius;
 };
 
+// bentcone_ssdo as a technique that keeps nothing on the GPU: its result reaches the lit frame
+// through the CPU slots and the compose pass's upload, as a CPU technique's does.
+class BentConeThroughTheCpu final : public plugin::OcclusionTechnique {
+public:
+    static plugin::TechniqueInfo describe()
+    {
+        return {.summary = "test double: bentcone_ssdo read back and uploaded again"};
+    }
+    static const plugin::TechniqueEntry& inner()
+    {
+        for (const auto* e : plugin::builtinRegistry().techniques("occlusion"))
+            if (e->info.name == "bentcone_ssdo")
+                return *e;
+        throw Error("bentcone_ssdo is not registered");
+    }
+    static config::ParamSchema declareParams() { return inner().schema; }
+    explicit BentConeThroughTheCpu(const config::ParamSet& p)
+        : mInner(inner().create(p)), mTechnique(dynamic_cast<plugin::OcclusionTechnique&>(*mInner))
+    {
+    }
+    config::ParamSet effectiveParams() const override { return mInner->effectiveParams(); }
+    plugin::OcclusionDefinition definition() const override { return mTechnique.definition(); }
+    bool acceptsGpuInputs() const override { return true; }
+    void compute(const plugin::OcclusionInput& in, plugin::OcclusionOutput& out) override
+    {
+        mTechnique.compute(in, out); // in.readBack is true: the CPU images are filled
+        out.gpu = {};
+    }
+
+private:
+    std::unique_ptr<plugin::Technique> mInner;
+    plugin::OcclusionTechnique& mTechnique;
+};
+
 // Runs the experiment quietly into `directory` and returns its rows.
 std::vector<experiment::Row> runAndLoad(const experiment::Experiment& e,
                                         const plugin::Registry& registry,
@@ -295,6 +329,64 @@ TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
                   "shadow_maps:skipped(no light and no shadow caster moved since frame 0)"),
               std::string::npos)
         << rows[1].at("passes");
+}
+
+TEST(OcclusionDriver, TheLitFrameBindsTheTechniquesImagesWithoutARoundTripThroughTheCpu)
+{
+    // bentcone_ssdo leaves its 16 cone visibilities on the GPU and the lighting pass binds them;
+    // the read-back to the CPU runs for the metrics and images only, so it counts as a
+    // measurement. The same technique sent through the CPU and uploaded again gives the same
+    // lit frame, bitwise.
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<BentConeThroughTheCpu>(registry, "occlusion", "bentcone_via_cpu");
+    registry.addTechnique(BentConeThroughTheCpu::inner());
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_slots";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "lamp.yaml")
+        << "scene: lamp\nbase: cornell_box\nframes: 1\n"
+           "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n";
+    auto run = [&](const std::string& technique) {
+        const auto e = experiment::parseExperiment(R"(base:
+  scene: lamp.yaml
+  resolution: [32, 24]
+  metrics: [error]
+  frame: {lighting: true, shadow_map_size: 32}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.05, target_rel_stderr: 0.1, max_samples: 32}
+  techniques: {occlusion: {technique: )" + technique + R"(}}
+)",
+                                                   (dir / (technique + ".yaml")).string(),
+                                                   registry);
+        return runAndLoad(e, registry, (dir / technique).string());
+    };
+    const auto onGpu = run("bentcone_ssdo");
+    const auto viaCpu = run("bentcone_via_cpu");
+    ASSERT_EQ(onGpu.size(), 1u);
+    ASSERT_EQ(viaCpu.size(), 1u);
+    ASSERT_EQ(onGpu[0].at("status"), "ok") << onGpu[0].at("error");
+    ASSERT_EQ(viaCpu[0].at("status"), "ok") << viaCpu[0].at("error");
+    const std::string& gpuPasses = onGpu[0].at("passes");
+    EXPECT_NE(gpuPasses.find("occlusion_gpu_slots:run"), std::string::npos) << gpuPasses;
+    EXPECT_NE(gpuPasses.find("occlusion_readback:run"), std::string::npos) << gpuPasses;
+    EXPECT_EQ(gpuPasses.find("occlusion_upload"), std::string::npos) << gpuPasses;
+    EXPECT_NE(gpuPasses.find("occlusion_slots:skipped(no consumer"), std::string::npos)
+        << "nothing reads the CPU slots: " << gpuPasses;
+    const std::string& gpuFrame = onGpu[0].at("frame_passes");
+    EXPECT_EQ(gpuFrame.find("occlusion_readback"), std::string::npos)
+        << "only measurements read it: " << gpuFrame;
+    EXPECT_EQ(gpuFrame.find("gbuffer_readback"), std::string::npos) << gpuFrame;
+    EXPECT_NE(gpuFrame.find("occlusion;"), std::string::npos) << gpuFrame;
+    EXPECT_NE(viaCpu[0].at("passes").find("occlusion_upload:run"), std::string::npos)
+        << viaCpu[0].at("passes");
+    EXPECT_NE(viaCpu[0].at("frame_passes").find("occlusion_upload"), std::string::npos);
+    EXPECT_EQ(onGpu[0].at("frame.visibility"), "cones");
+    EXPECT_EQ(viaCpu[0].at("frame.visibility"), "cones");
+    const Image<glm::vec3> a = experiment::readExrRgb(onGpu[0].at("image.lit_hdr"));
+    const Image<glm::vec3> b = experiment::readExrRgb(viaCpu[0].at("image.lit_hdr"));
+    ASSERT_EQ(a.pixels.size(), b.pixels.size());
+    ASSERT_GT(a.pixels.size(), 0u);
+    EXPECT_EQ(0, std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)));
 }
 
 TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesAWalkerChangesAndTheFrameMatchesTheUnculledOne)

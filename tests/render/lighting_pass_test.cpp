@@ -292,13 +292,19 @@ TEST_F(LightingPassTest, SkyLobesMatchQuadratureAndScaleWithVisibility)
     std::vector<float> v(16, 0.0f);
     for (const int k : {0, 3, 5, 7, 12})
         v[k] = 1.0f;
-    std::vector<float> cones;
-    for (int i = 0; i < kSize * kSize; ++i)
-        cones.insert(cones.end(), v.begin(), v.end());
-    gpu::Buffer coneBuffer = getContext().createBuffer({cones.size() * sizeof(float), "cones"});
-    coneBuffer.uploadSpan<float>(cones);
+    std::vector<Image<float>> cones;
+    for (const float vk : v)
+        cones.emplace_back(kSize, kSize, vk);
+    std::array<gpu::Image, 4> coneImages;
+    std::array<gpu::Image*, 4> coneTargets{};
     LightingInputs withCones;
-    withCones.coneVisibility = &coneBuffer;
+    for (std::size_t g = 0; g < 4; ++g) {
+        coneImages[g] =
+            createImageFrom(getContext(), Image<glm::vec3>(kSize, kSize, glm::vec3(0.0f)), "cones");
+        coneTargets[g] = &coneImages[g];
+        withCones.coneVisibility[g] = &coneImages[g];
+    }
+    uploadConeVisibility(coneTargets, cones);
     drawFrame(s, camera, kSize, kSize, withCones);
     EXPECT_EQ(getLighting().getLastVisibility(), SkyVisibility::Cones);
     expectSky(getLighting().readBackDirect(), v, "cone subset");
@@ -306,8 +312,12 @@ TEST_F(LightingPassTest, SkyLobesMatchQuadratureAndScaleWithVisibility)
     // Both visibility inputs at once are refused.
     LightingInputs both;
     both.ambientOcclusion = &ao;
-    both.coneVisibility = &coneBuffer;
+    both.coneVisibility = withCones.coneVisibility;
     EXPECT_THROW(drawFrame(s, camera, kSize, kSize, both), Error);
+    // So are some of the four cone images without the others.
+    LightingInputs partial;
+    partial.coneVisibility[0] = &coneImages[0];
+    EXPECT_THROW(drawFrame(s, camera, kSize, kSize, partial), Error);
 }
 
 TEST_F(LightingPassTest, ConstantAndGradientSkiesAreProjectedOntoTheLobes)

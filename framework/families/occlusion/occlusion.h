@@ -3,6 +3,7 @@
 // Ground truth: rays from the same G-buffer points against the full scene, computing exactly the
 // quantity the technique declares (cosine-weighted AO, or obscurance with its falloff and radius).
 
+#include "core/error.h"
 #include "core/image.h"
 #include "plugin/technique.h"
 
@@ -11,6 +12,7 @@
 
 #include <array>
 #include <string>
+#include <vector>
 
 namespace rtlab::gpu {
 class Context;
@@ -70,6 +72,21 @@ struct OcclusionInput {
     //! are then null; the others always get the CPU images.
     const gpu::Image* gpuLinearDepth = nullptr;
     const gpu::Image* gpuNormal = nullptr;
+    //! False: a technique whose outputsOnGpu() is true may return from a GPU compute() with only
+    //! OcclusionOutput::gpu filled; OcclusionTechnique::readBack() then fills the CPU images.
+    //! The frame graph does so when a pass that runs reads them (metrics, images), so a lit
+    //! frame without them keeps the result on the GPU.
+    bool readBack = true;
+};
+
+//! A technique's results still on the GPU after a compute() with OcclusionInput::gpu set: images
+//! the technique owns, valid until its next compute(), of the G-buffer's size. The lit frame
+//! binds them (pipeline/compose.h) instead of uploading the CPU images again.
+struct OcclusionGpuOutput {
+    const gpu::Image* ambient = nullptr; //!< R32Float: OcclusionOutput::ambient
+    //! RGBA32Float: cone k of OcclusionOutput::coneVisibility in channel k % 4 of image k / 4;
+    //! all null when the technique gives no cone visibilities.
+    std::array<const gpu::Image*, 4> coneVisibility{};
 };
 
 struct OcclusionOutput {
@@ -81,6 +98,8 @@ struct OcclusionOutput {
     //! Optional: visibility in [0, 1] of each of the 16 fixed cone directions (scene/sky.h,
     //! world space), in that order; empty when the technique does not produce it.
     std::vector<Image<float>> coneVisibility;
+    //! Set by a GPU compute() of a technique whose outputsOnGpu() is true; null otherwise.
+    OcclusionGpuOutput gpu;
 };
 
 class OcclusionTechnique : public Technique {
@@ -96,6 +115,17 @@ public:
     //! needs no CPU copy of the G-buffer). The frame graph then skips the G-buffer read-back unless
     //! another pass reads it.
     virtual bool acceptsGpuInputs() const { return false; }
+    //! Whether compute() with OcclusionInput::gpu set leaves its results on the GPU
+    //! (OcclusionOutput::gpu) and, with OcclusionInput::readBack false, reads them back only in
+    //! readBack(). The family suite checks that the deferred read-back equals the immediate one.
+    virtual bool outputsOnGpu() const { return false; }
+    //! Fills the CPU images of `out` from the last GPU compute() (see outputsOnGpu()); keeps
+    //! out.gpu. Throws rtlab::Error for a technique that keeps nothing on the GPU or before its
+    //! first GPU compute().
+    virtual void readBack(OcclusionOutput& /*out*/)
+    {
+        throw Error("this occlusion technique keeps no result on the GPU to read back");
+    }
 };
 
 } // namespace rtlab::plugin

@@ -264,7 +264,89 @@ private:
                             "x" + std::to_string(h) + " G-buffer");
             return pipeline::PassOutcome{};
         };
-        if (mTechnique->acceptsGpuInputs() && mRun.gbufferOnGpu) {
+        const auto aoSlot = pipeline::Compose::ambientOcclusionSlot(w, h);
+        const auto conesSlot = pipeline::Compose::coneVisibilitySlot(w, h);
+        if (mTechnique->acceptsGpuInputs() && mTechnique->outputsOnGpu() && mRun.gbufferOnGpu) {
+            // G-buffer and result stay on the GPU: the technique binds the view inputs made
+            // there, the lit frame binds the technique's images, and the result comes to the CPU
+            // in a pass of its own, which runs only when a pass that runs reads it (metrics,
+            // images, a CPU reader of the slots).
+            const auto viewGpu = start.viewInputsGpu();
+            const auto depthGpu = start.viewDepthGpu();
+            const auto normalGpu = start.viewNormalGpu();
+            const pipeline::Resource<plugin::OcclusionGpuOutput> onGpu{
+                "technique_gpu",
+                pipeline::ResourceType::gpuImage("the technique's images (r32f ao or 4 x rgba32f "
+                                                 "cone visibilities)",
+                                                 w, h)};
+            graph.addPass(
+                {.name = "occlusion",
+                 .reads = {viewGpu, depthGpu, normalGpu},
+                 .writes = {onGpu},
+                 .timing = pipeline::PassTiming::Repeated},
+                [this, viewGpu, depthGpu, normalGpu, onGpu, w, h](pipeline::PassContext& ctx) {
+                    const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
+                    plugin::OcclusionInput input;
+                    input.projection = v.projection;
+                    input.view = v.view;
+                    input.frameIndex = ctx.frame();
+                    input.gpu = &mContext.getGpu();
+                    input.gpuLinearDepth = &ctx.read(depthGpu);
+                    input.gpuNormal = &ctx.read(normalGpu);
+                    input.readBack = false;
+                    plugin::OcclusionOutput out;
+                    mTechnique->compute(input, out);
+                    for (const auto& [name, value] : mTechnique->counters())
+                        mRow->set("counter." + name, value);
+                    const plugin::OcclusionGpuOutput& images = out.gpu;
+                    std::vector<const gpu::Image*> all(images.coneVisibility.begin(),
+                                                       images.coneVisibility.end());
+                    all.push_back(images.ambient);
+                    if (images.ambient == nullptr && images.coneVisibility[0] == nullptr)
+                        throw Error("technique '" + mTechniqueName +
+                                    "' says its outputs stay on the GPU but left none there");
+                    for (const gpu::Image* image : all)
+                        if (image != nullptr && (int(image->getDesc().width) != w ||
+                                                 int(image->getDesc().height) != h))
+                            throw Error("technique '" + mTechniqueName + "' left a " +
+                                        std::to_string(image->getDesc().width) + "x" +
+                                        std::to_string(image->getDesc().height) +
+                                        " image on the GPU for a " + std::to_string(w) + "x" +
+                                        std::to_string(h) + " G-buffer");
+                    ctx.write(onGpu) = images;
+                    return pipeline::PassOutcome{};
+                });
+            graph.addPass({.name = "occlusion_readback",
+                           .reads = {onGpu},
+                           .writes = techniqueWrites,
+                           .forReaders = true},
+                          [this, ambient, w, h](pipeline::PassContext& ctx) {
+                              plugin::OcclusionOutput& out = ctx.write(ambient);
+                              mTechnique->readBack(out);
+                              if (out.ambient.width != w || out.ambient.height != h)
+                                  throw Error("technique '" + mTechniqueName +
+                                              "' read back an ambient image of " +
+                                              std::to_string(out.ambient.width) + "x" +
+                                              std::to_string(out.ambient.height) + " for a " +
+                                              std::to_string(w) + "x" + std::to_string(h) +
+                                              " G-buffer");
+                              return pipeline::PassOutcome{};
+                          });
+            const auto aoGpuSlot = pipeline::Compose::ambientOcclusionGpuSlot(w, h);
+            const auto conesGpuSlot = pipeline::Compose::coneVisibilityGpuSlot(w, h);
+            graph.addPass({.name = "occlusion_gpu_slots",
+                           .reads = {onGpu},
+                           .writes = {aoGpuSlot, conesGpuSlot}},
+                          [onGpu, aoGpuSlot, conesGpuSlot](pipeline::PassContext& ctx) {
+                              const plugin::OcclusionGpuOutput& images = ctx.read(onGpu);
+                              // Cones when the technique gives them (the lighting pass takes
+                              // one visibility input).
+                              const bool cones = images.coneVisibility[0] != nullptr;
+                              ctx.write(aoGpuSlot) = cones ? nullptr : images.ambient;
+                              ctx.write(conesGpuSlot) = images.coneVisibility;
+                              return pipeline::PassOutcome{};
+                          });
+        } else if (mTechnique->acceptsGpuInputs() && mRun.gbufferOnGpu) {
             // The G-buffer stays on the GPU: the technique binds the view inputs made there, and
             // the frame reads the G-buffer back only if another pass that runs needs it.
             const auto viewGpu = start.viewInputsGpu();
@@ -307,9 +389,8 @@ private:
                     return runTechnique(input, ctx.write(ambient));
                 });
         }
-        // The frame's slots (pipeline/compose.h): the lit frame reads them when it runs.
-        const auto aoSlot = pipeline::Compose::ambientOcclusionSlot(w, h);
-        const auto conesSlot = pipeline::Compose::coneVisibilitySlot(w, h);
+        // The frame's CPU slots (pipeline/compose.h), for CPU readers, and for the lit frame
+        // when the GPU slots were not written above (compose uploads them then).
         graph.addPass(
             {.name = "occlusion_slots", .reads = {ambient}, .writes = {aoSlot, conesSlot}},
             [ambient, aoSlot, conesSlot](pipeline::PassContext& ctx) {

@@ -33,9 +33,11 @@ layout(std430, binding = 6) readonly buffer Sky {
 } sky;
 
 layout(binding = 7, r32f) uniform readonly image2D ambientOcclusion;
-layout(std430, binding = 8) readonly buffer Cones {
-    float coneVisibility[]; // 16 per pixel, row-major
-};
+// The 16 cone visibilities: cone 4 g + c in channel c of image g (binding 8 for g = 0, 12..14).
+layout(binding = 8, rgba32f) uniform readonly image2D coneVisibility0;
+layout(binding = 12, rgba32f) uniform readonly image2D coneVisibility1;
+layout(binding = 13, rgba32f) uniform readonly image2D coneVisibility2;
+layout(binding = 14, rgba32f) uniform readonly image2D coneVisibility3;
 layout(binding = 9, rgba32f) uniform readonly image2D indirectIrradiance;
 layout(binding = 10, rgba32f) uniform writeonly image2D outHdr;
 layout(binding = 11, rgba32f) uniform writeonly image2D outDirect;
@@ -176,9 +178,15 @@ void main()
     if (int(sky.parameters.x) != 0) {
         const uint visibility = frame.sizeLightsVisibility.w;
         const float ao = visibility == 1u ? imageLoad(ambientOcclusion, pixel).r : 1.0;
-        const uint base = (uint(pixel.y) * size.x + uint(pixel.x)) * 16u;
+        vec4 cones[4] = vec4[4](vec4(ao), vec4(ao), vec4(ao), vec4(ao));
+        if (visibility == 2u) {
+            cones[0] = imageLoad(coneVisibility0, pixel);
+            cones[1] = imageLoad(coneVisibility1, pixel);
+            cones[2] = imageLoad(coneVisibility2, pixel);
+            cones[3] = imageLoad(coneVisibility3, pixel);
+        }
         for (int k = 0; k < 16; ++k) {
-            const float v = visibility == 2u ? coneVisibility[base + uint(k)] : ao;
+            const float v = cones[k >> 2][k & 3];
             skyIrradiance +=
                 v * sky.lobeRadiance[k].rgb * lookupLobeIrradiance(dot(n, sky.axes[k].xyz));
         }

@@ -159,6 +159,8 @@ public:
     }
 
     bool acceptsGpuInputs() const override { return true; }
+    bool outputsOnGpu() const override { return true; }
+    void readBack(plugin::OcclusionOutput& out) override { mGpu.readBack(out); }
 
     void compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out) override
     {

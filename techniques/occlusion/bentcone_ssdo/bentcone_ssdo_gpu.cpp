@@ -58,6 +58,7 @@ struct GpuPath::State {
     gpu::Image aperture;
     std::array<gpu::Image, 4> visibility;
     std::vector<float> normalTexels; //!< staging for the vec3 -> RGBA32F conversion
+    bool computed = false;           //!< a compute() has filled the output images
 };
 
 GpuPath::GpuPath() = default;
@@ -169,6 +170,20 @@ void GpuPath::compute(gpu::Context& context, const FrameSetup& frame,
                      "bentcone_ssdo.main");
     });
 
+    out = plugin::OcclusionOutput();
+    for (std::size_t g = 0; g < 4; ++g)
+        out.gpu.coneVisibility[g] = &s.visibility[g];
+    s.computed = true;
+    if (input.readBack)
+        readBack(out);
+}
+
+void GpuPath::readBack(plugin::OcclusionOutput& out) const
+{
+    if (!mState || !mState->computed)
+        throw Error("bentcone_ssdo: nothing computed on the GPU to read back");
+    const State& s = *mState;
+    const int w = s.width, h = s.height;
     const std::vector<float> bentAmbient = s.bentAmbient.downloadVector<float>();
     const std::vector<float> aperture = s.aperture.downloadVector<float>();
     out.ambient = Image<float>(w, h);
@@ -190,6 +205,8 @@ void GpuPath::compute(gpu::Context& context, const FrameSetup& frame,
                 target[i] = texels[i * 4 + std::size_t(c)];
         }
     }
+    for (std::size_t g = 0; g < 4; ++g)
+        out.gpu.coneVisibility[g] = &s.visibility[g];
 }
 
 } // namespace rtlab::bentcone_ssdo

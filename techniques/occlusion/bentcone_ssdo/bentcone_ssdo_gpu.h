@@ -20,9 +20,13 @@ public:
     GpuPath(GpuPath&&) noexcept;
     GpuPath& operator=(GpuPath&&) noexcept;
 
-    //! Runs the estimator on `context`; fills every field of `out` like computeOnCpu.
+    //! Runs the estimator on `context`: out.gpu.coneVisibility holds its 16 cone visibilities
+    //! on the GPU, and with input.readBack every CPU field of `out` is filled like computeOnCpu.
     void compute(gpu::Context& context, const FrameSetup& frame,
                  const plugin::OcclusionInput& input, plugin::OcclusionOutput& out);
+    //! The CPU fields of `out` from the last compute() (out.gpu kept). Throws rtlab::Error
+    //! before the first.
+    void readBack(plugin::OcclusionOutput& out) const;
 
 private:
     struct State;

@@ -217,6 +217,8 @@ void Gtao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
             mGpu = std::make_unique<GtaoGpu>();
         mGpu->compute(*input.gpu, makeGtaoFrameConstants(mSettings, input, width, height),
                       *input.gpuLinearDepth, *input.gpuNormal, out);
+        if (input.readBack)
+            mGpu->readBack(out);
         return;
     }
     if (input.linearDepth == nullptr || input.normal == nullptr)
@@ -240,9 +242,18 @@ void Gtao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
         if (!mGpu)
             mGpu = std::make_unique<GtaoGpu>();
         mGpu->compute(*input.gpu, constants, depth, normal, out);
+        if (input.readBack)
+            mGpu->readBack(out);
     } else {
         computeGtaoCpu(constants, depth, normal, out);
     }
+}
+
+void Gtao::readBack(plugin::OcclusionOutput& out)
+{
+    if (!mGpu)
+        throw Error("gtao: nothing computed on the GPU to read back");
+    mGpu->readBack(out);
 }
 
 } // namespace rtlab::occlusion

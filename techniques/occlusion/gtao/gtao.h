@@ -47,6 +47,8 @@ public:
     //! throws std::invalid_argument when linearDepth or normal is null or their sizes differ.
     void compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out) override;
     bool acceptsGpuInputs() const override { return true; }
+    bool outputsOnGpu() const override { return true; }
+    void readBack(plugin::OcclusionOutput& out) override;
 
     const GtaoSettings& settings() const { return mSettings; }
 

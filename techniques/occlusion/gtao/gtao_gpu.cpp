@@ -89,8 +89,6 @@ void GtaoGpu::dispatch(gpu::Context& context, const GtaoFrameConstants& constant
                        const gpu::Image& depth, const gpu::Image& normal, int width, int height,
                        plugin::OcclusionOutput& out)
 {
-    const std::size_t count = std::size_t(width) * std::size_t(height);
-    mStaging.resize(count * 4);
     context.run([&](gpu::CommandList& cmd) {
         cmd.dispatch(mPipeline,
                      {gpu::Binding::storageImage(0, depth), gpu::Binding::storageImage(1, normal),
@@ -103,6 +101,18 @@ void GtaoGpu::dispatch(gpu::Context& context, const GtaoFrameConstants& constant
                      kDispatchLabel);
     });
 
+    out = plugin::OcclusionOutput();
+    out.gpu.ambient = &mAmbient;
+    mComputed = true;
+}
+
+void GtaoGpu::readBack(plugin::OcclusionOutput& out)
+{
+    if (!mComputed)
+        throw Error("gtao: nothing computed on the GPU to read back");
+    const int width = mWidth, height = mHeight;
+    const std::size_t count = std::size_t(width) * std::size_t(height);
+    mStaging.resize(count * 4);
     out.ambient = Image<float>(width, height);
     mAmbient.download(out.ambient.pixels.data(), count * sizeof(float));
     out.coneAperture = Image<float>(width, height);
@@ -112,6 +122,7 @@ void GtaoGpu::dispatch(gpu::Context& context, const GtaoFrameConstants& constant
     for (std::size_t i = 0; i < count; ++i)
         out.bentNormal.pixels[i] = {mStaging[4 * i + 0], mStaging[4 * i + 1], mStaging[4 * i + 2]};
     out.coneVisibility.clear();
+    out.gpu.ambient = &mAmbient;
 }
 
 } // namespace rtlab::occlusion

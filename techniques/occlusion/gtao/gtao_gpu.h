@@ -16,7 +16,8 @@ namespace rtlab::occlusion {
 //! taken for the old one, so a technique instance should not outlive the Context it ran on.
 class GtaoGpu {
 public:
-    //! Uploads depth and normals, dispatches "gtao.main" and reads the three outputs back.
+    //! Uploads depth and normals and dispatches "gtao.main"; the results stay on the GPU
+    //! (out.gpu.ambient; out's CPU images are cleared) until readBack().
     void compute(gpu::Context& context, const GtaoFrameConstants& constants,
                  const Image<float>& depth, const Image<glm::vec3>& normal,
                  plugin::OcclusionOutput& out);
@@ -25,6 +26,10 @@ public:
     //! images of one size): nothing is uploaded.
     void compute(gpu::Context& context, const GtaoFrameConstants& constants,
                  const gpu::Image& depth, const gpu::Image& normal, plugin::OcclusionOutput& out);
+
+    //! The three outputs of the last compute() to the CPU (out.gpu kept). Throws rtlab::Error
+    //! before the first compute().
+    void readBack(plugin::OcclusionOutput& out);
 
     //! Label of the dispatch in the Context's run log.
     static constexpr const char* kDispatchLabel = "gtao.main";
@@ -47,6 +52,7 @@ private:
     gpu::Image mAmbient;
     gpu::Image mBentNormal;
     gpu::Image mAperture;
+    bool mComputed = false;
     std::vector<float> mStaging; //!< RGBA texels for normal upload and bent normal download
 };
 

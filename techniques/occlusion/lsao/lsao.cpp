@@ -205,7 +205,8 @@ void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
         const Layout layout = buildLayout(w, h, projection, mParams, input.frameIndex);
         if (!mGpu || &mGpu->getContext() != input.gpu)
             mGpu = std::make_unique<GpuRunner>(*input.gpu);
-        mGpu->run(layout, projection, mParams, *input.gpuLinearDepth, *input.gpuNormal, out);
+        mGpu->run(layout, projection, mParams, *input.gpuLinearDepth, *input.gpuNormal, out,
+                  input.readBack);
         return;
     }
     if (input.linearDepth == nullptr || input.normal == nullptr)
@@ -231,7 +232,14 @@ void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
     }
     if (!mGpu || &mGpu->getContext() != input.gpu)
         mGpu = std::make_unique<GpuRunner>(*input.gpu);
-    mGpu->run(layout, projection, mParams, depth, normal, out);
+    mGpu->run(layout, projection, mParams, depth, normal, out, input.readBack);
+}
+
+void Lsao::readBack(plugin::OcclusionOutput& out)
+{
+    if (!mGpu)
+        throw Error("lsao: nothing computed on the GPU to read back");
+    mGpu->readBack(out);
 }
 
 } // namespace rtlab::occlusion::lsao

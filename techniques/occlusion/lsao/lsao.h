@@ -25,6 +25,8 @@ public:
     //! GPU when input.gpu is set (pipelines and images kept across calls), else C++.
     void compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput& out) override;
     bool acceptsGpuInputs() const override { return true; }
+    bool outputsOnGpu() const override { return true; }
+    void readBack(plugin::OcclusionOutput& out) override;
 
     const Params& getParams() const { return mParams; }
 

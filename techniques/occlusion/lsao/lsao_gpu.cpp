@@ -89,7 +89,7 @@ void GpuRunner::prepare(const Layout& layout)
 
 void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projection,
                     const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
-                    plugin::OcclusionOutput& out)
+                    plugin::OcclusionOutput& out, bool readBack)
 {
     prepare(layout);
     const int w = layout.width, h = layout.height;
@@ -103,16 +103,15 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
         mStaging[4 * i + 3] = 0.0f;
     }
     mNormal.upload(mStaging.data(), count * 4 * sizeof(float));
-    run(layout, projection, params, mDepth, mNormal, out);
+    run(layout, projection, params, mDepth, mNormal, out, readBack);
 }
 
 void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projection,
                     const Params& params, const gpu::Image& depth, const gpu::Image& normal,
-                    plugin::OcclusionOutput& out)
+                    plugin::OcclusionOutput& out, bool readBack)
 {
     prepare(layout);
     const int w = layout.width, h = layout.height;
-    const std::size_t count = std::size_t(w) * std::size_t(h);
     mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));
 
     std::vector<Constants> constants;
@@ -143,6 +142,20 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
         }
     });
 
+    out = plugin::OcclusionOutput();
+    out.gpu.ambient = &mAccumB;
+    mRunWidth = w;
+    mRunHeight = h;
+    if (readBack)
+        this->readBack(out);
+}
+
+void GpuRunner::readBack(plugin::OcclusionOutput& out)
+{
+    if (mRunWidth == 0)
+        throw Error("lsao: nothing computed on the GPU to read back");
+    const int w = mRunWidth, h = mRunHeight;
+    const std::size_t count = std::size_t(w) * std::size_t(h);
     const std::vector<float> a = mAccumA.downloadVector<float>();
     const std::vector<float> b = mAccumB.downloadVector<float>();
     out.ambient = Image<float>(w, h, 1.0f);
@@ -154,6 +167,7 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
         out.bentNormal.pixels[i] = glm::vec3(a[4 * i + 0], a[4 * i + 1], a[4 * i + 2]);
         out.coneAperture.pixels[i] = a[4 * i + 3];
     }
+    out.gpu.ambient = &mAccumB;
 }
 
 std::vector<std::uint32_t> GpuRunner::downloadSweep(std::size_t entryCount) const

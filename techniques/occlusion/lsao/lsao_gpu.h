@@ -27,14 +27,18 @@ public:
 
     gpu::Context& getContext() const { return *mContext; }
 
-    //! Both passes of every batch of `layout` in one submission, then reads back the outputs.
+    //! Both passes of every batch of `layout` in one submission, then (with `readBack`) reads
+    //! back the outputs. out.gpu.ambient is the ambient image on the GPU either way.
     void run(const Layout& layout, const plugin::ScreenProjection& projection, const Params& params,
              const Image<float>& depth, const Image<glm::vec3>& normal,
-             plugin::OcclusionOutput& out);
+             plugin::OcclusionOutput& out, bool readBack = true);
     //! The same from depth (R32Float) and normals (RGBA32Float) already on the GPU: nothing is
     //! uploaded but the direction table.
     void run(const Layout& layout, const plugin::ScreenProjection& projection, const Params& params,
-             const gpu::Image& depth, const gpu::Image& normal, plugin::OcclusionOutput& out);
+             const gpu::Image& depth, const gpu::Image& normal, plugin::OcclusionOutput& out,
+             bool readBack = true);
+    //! The outputs of the last run() to the CPU (out.gpu kept). Throws rtlab::Error before it.
+    void readBack(plugin::OcclusionOutput& out);
 
     //! The sweep buffer of the last batch of the last run (for tests).
     std::vector<std::uint32_t> downloadSweep(std::size_t entryCount) const;
@@ -55,6 +59,8 @@ private:
     int mHeight = 0;
     std::size_t mDirectionCapacity = 0;
     std::size_t mSweepCapacity = 0;
+    int mRunWidth = 0; //!< size of the last run(), 0 before the first
+    int mRunHeight = 0;
     std::vector<float> mStaging;
 };
 
