@@ -251,6 +251,19 @@ void Compose::addPasses(FrameGraph& graph)
         ResourceType::gpuImage("r32f cube atlas", mOptions.shadowMapSize, mOptions.shadowMapSize)};
     // The frame's images are the graph's: created on first use, pooled between frames.
     gpu::Context& gpuContext = mStart.getGpu();
+    // The shadow atlas too, kept across frames (faces nothing changed keep their maps): six
+    // faces per point light of the scene (their number is the scene's in every frame).
+    const std::size_t lightCount = std::max<std::size_t>(mStart.getScene().pointLights.size(), 1);
+    const int faceSize = mOptions.shadowMapSize;
+    gpu::Context* atlasContext = &gpuContext;
+    const Resource<gpu::Image> atlas{
+        "shadow_atlas",
+        ResourceType::gpuImage("r32f cube faces, 6 x " + std::to_string(lightCount) + " slices",
+                               faceSize, faceSize),
+        [atlasContext, faceSize, lightCount] {
+            return std::make_shared<gpu::Image>(atlasContext->createImage(
+                render::ShadowPass::makeAtlasDesc(faceSize, lightCount)));
+        }};
     const auto hdr =
         makeGpuImageResource(gpuContext, "lit_hdr", gpu::Format::RGBA32Float, mWidth, mHeight);
     const auto direct =
@@ -275,9 +288,9 @@ void Compose::addPasses(FrameGraph& graph)
     graph.addPass(
         {.name = "shadow_maps",
          .reads = {geometry},
-         .writes = {shadowMaps},
+         .writes = {shadowMaps, atlas},
          .needs = {scene::SceneFeature::PointLights},
-         .persistent = {shadowMaps.name},
+         .persistent = {shadowMaps.name, atlas.name},
          .reuse =
              [this, geometry](const PassContext& ctx) {
                  const scene::RenderScene& g = ctx.read(geometry);
@@ -294,11 +307,13 @@ void Compose::addPasses(FrameGraph& graph)
                  mStats.shadowSkips = "every light: " + why;
                  return why;
              }},
-        [this, geometry, shadowMaps](PassContext& ctx) {
+        [this, geometry, shadowMaps, atlas](PassContext& ctx) {
             const scene::RenderScene& g = ctx.read(geometry);
-            if (!mShadows)
+            if (!mShadows) {
                 mShadows = std::make_unique<render::ShadowPass>(
                     mStart.getGpu(), render::ShadowPassOptions{.faceSize = mOptions.shadowMapSize});
+                mShadows->useAtlas(ctx.write(atlas));
+            }
             const std::size_t lightCount = g.pointLights.size();
             std::vector<ShadowTriangle> triangles = computeShadowTriangles(g);
             const auto [boundsMin, boundsMax] = computeBounds(g.positions);

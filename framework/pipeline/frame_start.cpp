@@ -51,6 +51,18 @@ Resource<gpu::Image> FrameStart::viewNormalGpu() const
                                 mOptions.height);
 }
 
+Resource<gpu::RenderTarget> FrameStart::gbufferTarget() const
+{
+    gpu::Context* ctx = &mGpu;
+    const int w = mOptions.width, h = mOptions.height;
+    return {"gbuffer_target",
+            ResourceType::gpuImage("render target: 4 x rgba32f + r32ui + d32", w, h),
+            [ctx, w, h] {
+                return std::make_shared<gpu::RenderTarget>(
+                    ctx->createRenderTarget(render::GBufferPass::makeTargetDesc(w, h)));
+            }};
+}
+
 void FrameStart::addPasses(FrameGraph& graph)
 {
     const auto sceneRes =
@@ -127,11 +139,12 @@ void FrameStart::addPasses(FrameGraph& graph)
                       ctx.write(gpuScene) = GpuScene{mUploadedHash, ctx.frame()};
                       return PassOutcome{};
                   });
+    const auto targetRes = gbufferTarget();
     graph.addPass({.name = "gbuffer",
                    .reads = {gpuScene},
-                   .writes = {gbufferRes},
+                   .writes = {gbufferRes, targetRes},
                    .timing = PassTiming::Repeated,
-                   .persistent = {gbufferRes.name},
+                   .persistent = {gbufferRes.name, targetRes.name},
                    .reuse =
                        [this, gpuScene](const PassContext& ctx) {
                            const std::string key =
@@ -142,11 +155,12 @@ void FrameStart::addPasses(FrameGraph& graph)
                                             std::to_string(mDrawnFrame) + ": its G-buffer is reused"
                                       : std::string();
                        }},
-                  [this, gpuScene, gbufferRes](PassContext& ctx) {
+                  [this, gpuScene, gbufferRes, targetRes](PassContext& ctx) {
                       const scene::Camera camera = mScene.getCameraAt(ctx.frame());
-                      mGBufferPass->draw(camera, mOptions.width, mOptions.height);
+                      const gpu::RenderTarget& target = ctx.write(targetRes);
+                      mGBufferPass->draw(target, camera);
                       GpuGBuffer& out = ctx.write(gbufferRes);
-                      out.target = &mGBufferPass->getTarget();
+                      out.target = &target;
                       out.width = mOptions.width;
                       out.height = mOptions.height;
                       out.camera = camera;

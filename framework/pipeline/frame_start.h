@@ -9,8 +9,9 @@
 //   character_pose     the characters' capsules at this frame (needs characters)
 //   assemble_geometry  the frame's triangles, lights and sky (scene::RenderScene)
 //   scene_upload       to the GPU (reused while the geometry is unchanged)
-//   gbuffer            rasterised on Vulkan into GPU attachments (timed with the run's repeats;
-//                      not redrawn while camera, geometry, size and jitter are unchanged)
+//   gbuffer            rasterised on Vulkan into GPU attachments the graph creates and keeps
+//                      (gbuffer_target; timed with the run's repeats; not redrawn while camera,
+//                      geometry, size and jitter are unchanged)
 //   gbuffer_readback   the attachments copied to the CPU, only when a pass that runs reads them
 //   view_inputs        view-space normals and the surface mask (CPU), for CPU-side readers
 //   view_inputs_gpu    linear depth and view-space normals on the GPU, for Vulkan techniques
@@ -123,6 +124,9 @@ public:
         return {kGBuffer, ResourceType::gpuImage("gbuffer: 4 x rgba32f + r32ui", mOptions.width,
                                                  mOptions.height)};
     }
+    //! The attachments themselves (render/gbuffer_pass.h), created by the graph when the
+    //! `gbuffer` pass first draws and kept across frames; `gbuffer` points into them.
+    Resource<gpu::RenderTarget> gbufferTarget() const;
     Resource<scene::GBuffer> gbufferCpu() const
     {
         return {kGBufferCpu, ResourceType::cpuImage("gbuffer", mOptions.width, mOptions.height)};

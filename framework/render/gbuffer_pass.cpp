@@ -28,8 +28,13 @@ const std::vector<gpu::Format>& getAttachmentFormats()
     return formats;
 }
 
-gpu::RenderTargetDesc makeTargetDesc(int width, int height)
+} // namespace
+
+gpu::RenderTargetDesc GBufferPass::makeTargetDesc(int width, int height)
 {
+    if (width < 1 || height < 1)
+        throw Error("GBufferPass: invalid size " + std::to_string(width) + "x" +
+                    std::to_string(height));
     const float inf = std::numeric_limits<float>::infinity();
     gpu::RenderTargetDesc desc;
     desc.width = static_cast<std::uint32_t>(width);
@@ -49,6 +54,8 @@ gpu::RenderTargetDesc makeTargetDesc(int width, int height)
     desc.depthClear = 1.0f;
     return desc;
 }
+
+namespace {
 
 gpu::GraphicsPipeline createPipeline(gpu::Context& context, const GBufferPassOptions& options)
 {
@@ -91,7 +98,8 @@ struct GBufferPass::State {
     std::uint32_t indexCount = 0;
     std::size_t vertexCount = 0;
     bool hasScene = false;
-    gpu::RenderTarget target;
+    gpu::RenderTarget target;               //!< own target of draw(camera, width, height)
+    const gpu::RenderTarget* last = nullptr; //!< the target of the last draw
     bool drawn = false;
     scene::Camera camera;
     glm::vec2 jitter{0.0f};
@@ -152,9 +160,30 @@ gpu::RunResult GBufferPass::draw(const scene::Camera& camera, int width, int hei
                     std::to_string(height));
     if (!s.target.isValid() || s.target.getWidth() != static_cast<std::uint32_t>(width) ||
         s.target.getHeight() != static_cast<std::uint32_t>(height)) {
+        if (s.last == &s.target)
+            s.last = nullptr;
         s.target = gpu::RenderTarget(); // free the old attachments first
         s.target = s.context->createRenderTarget(makeTargetDesc(width, height));
     }
+    return draw(s.target, camera, jitterPixels);
+}
+
+gpu::RunResult GBufferPass::draw(const gpu::RenderTarget& target, const scene::Camera& camera,
+                                 glm::vec2 jitterPixels)
+{
+    State& s = *mState;
+    if (!s.hasScene)
+        throw Error("GBufferPass::draw: no scene was set");
+    const gpu::RenderTargetDesc expected =
+        makeTargetDesc(int(std::max(target.getWidth(), 1u)), int(std::max(target.getHeight(), 1u)));
+    const gpu::RenderTargetDesc& given = target.getDesc();
+    bool matches = target.isValid() && given.colors.size() == expected.colors.size() && given.depth;
+    for (std::size_t i = 0; matches && i < given.colors.size(); ++i)
+        matches = given.colors[i].format == expected.colors[i].format;
+    if (!matches)
+        throw Error("GBufferPass::draw: the render target was not made from makeTargetDesc()");
+    const int width = int(target.getWidth());
+    const int height = int(target.getHeight());
 
     const FrameMatrices m = computeFrameMatrices(camera, width, height, jitterPixels);
     glm::mat4 rotation = m.view;
@@ -169,9 +198,10 @@ gpu::RunResult GBufferPass::draw(const scene::Camera& camera, int width, int hei
     drawCall.indexBuffer = &s.indices;
     drawCall.indexCount = s.indexCount;
     gpu::RunResult result = s.context->run([&](gpu::CommandList& cmd) {
-        cmd.drawIndexed(s.pipeline, s.target, drawCall, gpu::PushConstants(constants), kDrawLabel);
+        cmd.drawIndexed(s.pipeline, target, drawCall, gpu::PushConstants(constants), kDrawLabel);
     });
 
+    s.last = &target;
     s.drawn = true;
     s.camera = camera;
     s.jitter = jitterPixels;
@@ -183,10 +213,11 @@ gpu::RunResult GBufferPass::draw(const scene::Camera& camera, int width, int hei
 scene::GBuffer GBufferPass::readBack() const
 {
     const State& s = *mState;
-    if (!s.drawn)
+    if (!s.drawn || s.last == nullptr)
         throw Error("GBufferPass::readBack: nothing was drawn yet");
-    const int w = static_cast<int>(s.target.getWidth());
-    const int h = static_cast<int>(s.target.getHeight());
+    const gpu::RenderTarget& target = *s.last;
+    const int w = static_cast<int>(target.getWidth());
+    const int h = static_cast<int>(target.getHeight());
     const std::size_t n = std::size_t(w) * std::size_t(h);
 
     scene::GBuffer g;
@@ -202,7 +233,7 @@ scene::GBuffer GBufferPass::readBack() const
     g.albedo = Image<glm::vec3>(w, h);
     g.emission = Image<glm::vec3>(w, h);
 
-    std::vector<glm::vec4> texels = s.target.downloadColorVector<glm::vec4>(kPositionDepth);
+    std::vector<glm::vec4> texels = target.downloadColorVector<glm::vec4>(kPositionDepth);
     for (std::size_t i = 0; i < n; ++i) {
         g.position.pixels[i] = glm::vec3(texels[i]);
         g.depth.pixels[i] = texels[i].w;
@@ -210,13 +241,13 @@ scene::GBuffer GBufferPass::readBack() const
     const std::pair<std::size_t, Image<glm::vec3>*> vectors[] = {
         {kNormal, &g.normal}, {kAlbedo, &g.albedo}, {kEmission, &g.emission}};
     for (const auto& [attachment, image] : vectors) {
-        s.target.downloadColor(attachment, texels.data(), texels.size() * sizeof(glm::vec4));
+        target.downloadColor(attachment, texels.data(), texels.size() * sizeof(glm::vec4));
         for (std::size_t i = 0; i < n; ++i)
             image->pixels[i] = glm::vec3(texels[i]);
     }
     g.materialId.width = w;
     g.materialId.height = h;
-    g.materialId.pixels = s.target.downloadColorVector<std::uint32_t>(kMaterial);
+    g.materialId.pixels = target.downloadColorVector<std::uint32_t>(kMaterial);
     return g;
 }
 
@@ -234,7 +265,7 @@ std::optional<double> GBufferPass::getLastGpuMs() const
 
 const gpu::RenderTarget& GBufferPass::getTarget() const
 {
-    return mState->target;
+    return mState->last != nullptr ? *mState->last : mState->target;
 }
 
 scene::GBuffer renderGBuffer(gpu::Context& context, const scene::RenderScene& scene,

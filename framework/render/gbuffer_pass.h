@@ -78,6 +78,14 @@ public:
     //! run's timings. Throws rtlab::Error without a scene or for a size < 1.
     gpu::RunResult draw(const scene::Camera& camera, int width, int height,
                         glm::vec2 jitterPixels = glm::vec2(0.0f));
+    //! Draws a frame into `target`, a render target the caller owns (e.g. the frame graph's,
+    //! pipeline/frame_start.h), made from makeTargetDesc(); it must outlive its use by readBack()
+    //! and getTarget(). Throws rtlab::Error without a scene or for another kind of target.
+    gpu::RunResult draw(const gpu::RenderTarget& target, const scene::Camera& camera,
+                        glm::vec2 jitterPixels = glm::vec2(0.0f));
+    //! The attachments (see getTarget()) of a G-buffer of width x height. Throws rtlab::Error for
+    //! a size < 1.
+    static gpu::RenderTargetDesc makeTargetDesc(int width, int height);
     //! Reads back the frame of the last draw(). Throws rtlab::Error before the first.
     scene::GBuffer readBack() const;
     //! draw() then readBack().

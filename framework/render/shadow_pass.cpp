@@ -174,23 +174,26 @@ struct ShadowPass::State {
     std::vector<ShadowLightState> lights;
     std::optional<double> lastGpuMs;
 
+    const gpu::Image* external = nullptr; //!< the caller's atlas (useAtlas), else `atlas`
+
+    const gpu::Image& getAtlasImage() const { return external != nullptr ? *external : atlas; }
+
     void createAtlas(std::size_t lightCount)
     {
-        const std::uint32_t slices =
-            static_cast<std::uint32_t>(std::max<std::size_t>(lightCount, 1) * kCubeFaceCount);
+        const gpu::ImageDesc desc = makeAtlasDesc(options.faceSize, lightCount);
         const std::uint32_t limit = context->getDeviceInfo().maxImageDimension3D;
-        if (slices > limit)
+        if (desc.depth > limit)
             throw Error("ShadowPass: " + std::to_string(lightCount) +
-                        " lights need a 3D image of depth " + std::to_string(slices) +
+                        " lights need a 3D image of depth " + std::to_string(desc.depth) +
                         ", the device allows " + std::to_string(limit));
+        if (external != nullptr) {
+            if (external->getDesc().depth < desc.depth)
+                throw Error("ShadowPass: the atlas given to useAtlas() holds " +
+                            std::to_string(external->getDesc().depth / kCubeFaceCount) +
+                            " lights, the scene has " + std::to_string(lightCount));
+            return;
+        }
         atlas = gpu::Image(); // free the old one first
-        gpu::ImageDesc desc;
-        desc.dimension = gpu::ImageDimension::Image3D;
-        desc.format = gpu::Format::R32Float;
-        desc.width = desc.height = static_cast<std::uint32_t>(options.faceSize);
-        desc.depth = slices;
-        desc.usage = gpu::ImageUsage::Storage;
-        desc.name = "shadow atlas";
         atlas = context->createImage(desc);
     }
 
@@ -241,6 +244,34 @@ ShadowPass::ShadowPass(gpu::Context& context, ShadowPassOptions options)
     s.pipeline = createPipeline(context, options);
     s.faceTarget = context.createRenderTarget(makeFaceTargetDesc(options.faceSize));
     s.createAtlas(0);
+}
+
+gpu::ImageDesc ShadowPass::makeAtlasDesc(int faceSize, std::size_t lightCount)
+{
+    gpu::ImageDesc desc;
+    desc.dimension = gpu::ImageDimension::Image3D;
+    desc.format = gpu::Format::R32Float;
+    desc.width = desc.height = static_cast<std::uint32_t>(std::max(faceSize, 1));
+    desc.depth =
+        static_cast<std::uint32_t>(std::max<std::size_t>(lightCount, 1) * kCubeFaceCount);
+    desc.usage = gpu::ImageUsage::Storage;
+    desc.name = "shadow atlas";
+    return desc;
+}
+
+void ShadowPass::useAtlas(const gpu::Image& atlas)
+{
+    State& s = *mState;
+    const gpu::ImageDesc& d = atlas.getDesc();
+    if (!atlas.isValid() || d.dimension != gpu::ImageDimension::Image3D ||
+        d.format != gpu::Format::R32Float || int(d.width) != s.options.faceSize ||
+        int(d.height) != s.options.faceSize || d.depth % kCubeFaceCount != 0)
+        throw Error("ShadowPass::useAtlas: the atlas must be a 3D R32Float image of " +
+                    std::to_string(s.options.faceSize) + " x " +
+                    std::to_string(s.options.faceSize) + " x 6 n texels (makeAtlasDesc)");
+    s.external = &atlas;
+    s.atlas = gpu::Image();
+    s.lights.clear(); // every map is drawn again into the new atlas
 }
 
 ShadowPass::~ShadowPass() = default;
@@ -344,7 +375,7 @@ gpu::RunResult ShadowPass::renderFaces(const scene::RenderScene& scene,
         for (const FaceDraw& d : draws) {
             cmd.drawIndexed(s.pipeline, s.faceTarget, drawCall, gpu::PushConstants(d.constants),
                             kDrawLabel);
-            copyAttachmentToImage(cmd, s.faceTarget, 0, s.atlas, d.slice, kCopyLabel);
+            copyAttachmentToImage(cmd, s.faceTarget, 0, s.getAtlasImage(), d.slice, kCopyLabel);
         }
     });
     const std::optional<double> drawMs = result.sumGpuMs(kDrawLabel);
@@ -373,7 +404,7 @@ const ShadowLightState& ShadowPass::getLightState(std::size_t light) const
 
 const gpu::Image& ShadowPass::getAtlas() const
 {
-    return mState->atlas;
+    return mState->getAtlasImage();
 }
 
 Image<float> ShadowPass::readBackFace(std::size_t light, int face) const
@@ -382,7 +413,7 @@ Image<float> ShadowPass::readBackFace(std::size_t light, int face) const
     if (light >= s.lights.size() || face < 0 || face >= kCubeFaceCount)
         throw Error("ShadowPass::readBackFace: no face " + std::to_string(face) + " of light " +
                     std::to_string(light));
-    const std::vector<float> all = s.atlas.downloadVector<float>();
+    const std::vector<float> all = s.getAtlasImage().downloadVector<float>();
     const int n = s.options.faceSize;
     Image<float> result(n, n);
     const std::size_t offset =

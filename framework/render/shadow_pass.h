@@ -142,6 +142,14 @@ public:
     gpu::RunResult renderFaces(const scene::RenderScene& scene,
                                std::span<const std::uint8_t> faceMasks);
 
+    //! The atlas for `lightCount` lights of faceSize x faceSize faces (see the file comment).
+    static gpu::ImageDesc makeAtlasDesc(int faceSize, std::size_t lightCount);
+    //! Renders into `atlas` from now on: an image the caller owns (the frame graph's,
+    //! pipeline/compose.h), made from makeAtlasDesc(getFaceSize(), n) for at most n lights; it
+    //! must outlive this pass's use of it. Every light's maps are drawn again on the next
+    //! render. Throws rtlab::Error for an image of another kind.
+    void useAtlas(const gpu::Image& atlas);
+
     int getFaceSize() const;
     //! Lights of the last render() or renderFaces() (0 before the first).
     std::size_t getLightCount() const;

@@ -318,10 +318,11 @@ TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
             << row.at("frame_passes");
     }
     EXPECT_EQ(rows[0].at("frame.shadow_maps_rendered"), "1");
-    // The graph's five GPU images (view depth and normals, HDR, direct, tonemapped): four made in
-    // frame 0 (the HDR image takes the view normals' RGBA32F image once the occlusion pass, their
-    // last reader, has run), all five reused in frame 1.
-    EXPECT_EQ(rows[0].at("frame.gpu_images_created"), "4");
+    // The graph's GPU resources: the G-buffer's render target and the shadow atlas (made in
+    // frame 0, kept across frames) and five images (view depth and normals, HDR, direct,
+    // tonemapped): four of them made in frame 0 (the HDR image takes the view normals' RGBA32F
+    // image once the occlusion pass, their last reader, has run), all five reused in frame 1.
+    EXPECT_EQ(rows[0].at("frame.gpu_images_created"), "6");
     EXPECT_EQ(rows[0].at("frame.gpu_images_reused"), "1");
     EXPECT_EQ(rows[1].at("frame.gpu_images_created"), "0");
     EXPECT_EQ(rows[1].at("frame.gpu_images_reused"), "5");

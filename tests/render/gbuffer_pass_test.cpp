@@ -404,6 +404,32 @@ TEST_F(GBufferPassTest, RepeatedFramesAreBitwiseIdentical)
     EXPECT_GT(hits, 200); // the frame shows the scene
 }
 
+TEST_F(GBufferPassTest, DrawingIntoATargetTheCallerOwnsGivesTheSameFrame)
+{
+    // The frame graph owns the G-buffer's attachments (pipeline/frame_start.h): a draw into them
+    // must give bit for bit the frame of the pass's own target, and read back from them.
+    SceneBuilder b;
+    const std::uint32_t grey = b.addMaterial({0.5f, 0.5f, 0.5f});
+    b.addQuad({-5, -1, 5}, {5, -1, 5}, {5, -1, -15}, {-5, -1, -15}, grey);
+    b.addSphere({0.3f, 0.0f, -3.0f}, 0.8f, 24, 12, grey);
+    const scene::Camera camera = makeCamera();
+    getPass().setScene(b.getScene());
+    const scene::GBuffer own = getPass().render(camera, 29, 17);
+    const gpu::RenderTarget target =
+        getContext().createRenderTarget(GBufferPass::makeTargetDesc(29, 17));
+    getPass().draw(target, camera);
+    EXPECT_EQ(&getPass().getTarget(), &target);
+    EXPECT_TRUE(isBitwiseEqual(own, getPass().readBack()));
+    // A render target of another kind is refused.
+    gpu::RenderTargetDesc other;
+    other.width = 29;
+    other.height = 17;
+    other.colors.push_back({});
+    const gpu::RenderTarget wrong = getContext().createRenderTarget(other);
+    EXPECT_THROW(getPass().draw(wrong, camera), Error);
+    EXPECT_THROW(GBufferPass::makeTargetDesc(0, 4), Error);
+}
+
 TEST_F(GBufferPassTest, EmptySceneIsAllSky)
 {
     getPass().setScene(scene::RenderScene{});

@@ -602,6 +602,46 @@ TEST_F(ShadowPassTest, RendersOnlyTheChosenLights)
         EXPECT_TRUE(getShadows().getLightState(i).rendered) << i;
 }
 
+TEST_F(ShadowPassTest, AnAtlasTheCallerOwnsHoldsTheSameMapsAsTheOwnOne)
+{
+    // The frame graph owns the atlas (pipeline/compose.h): a pass rendering into it must give
+    // bit for bit the maps of a pass with its own atlas; an atlas too small for the scene's
+    // lights, or of another kind, is refused.
+    SceneBuilder b;
+    const std::uint32_t m = b.addMaterial(kAlbedo);
+    addFloor(b, 2.0f, m);
+    b.addBox({-0.5f, 0.3f, 0.2f}, {0.3f, 0.3f, 0.3f}, 0.4f, m);
+    scene::RenderScene s = b.getScene();
+    s.pointLights.push_back({{0.0f, 1.2f, 0.0f}, glm::vec3(1.0f)});
+    s.pointLights.push_back({{1.0f, 0.8f, -0.6f}, glm::vec3(1.0f)});
+    ShadowPassOptions options;
+    options.compiler = getCompiler().getOptions();
+    options.faceSize = 32;
+    ShadowPass own(getContext(), options);
+    own.render(s);
+    const gpu::Image atlas =
+        getContext().createImage(ShadowPass::makeAtlasDesc(options.faceSize, 2));
+    ShadowPass external(getContext(), options);
+    external.useAtlas(atlas);
+    external.render(s);
+    EXPECT_EQ(&external.getAtlas(), &atlas);
+    for (std::size_t light = 0; light < 2; ++light)
+        for (int face = 0; face < kCubeFaceCount; ++face) {
+            const Image<float> a = own.readBackFace(light, face);
+            const Image<float> c = external.readBackFace(light, face);
+            ASSERT_EQ(a.pixels.size(), c.pixels.size());
+            EXPECT_EQ(std::memcmp(a.pixels.data(), c.pixels.data(), a.pixels.size() * sizeof(float)),
+                      0)
+                << "light " << light << " face " << face;
+        }
+    const gpu::Image small = getContext().createImage(ShadowPass::makeAtlasDesc(options.faceSize, 1));
+    ShadowPass tooSmall(getContext(), options);
+    tooSmall.useAtlas(small);
+    EXPECT_THROW(tooSmall.render(s), Error);
+    const gpu::Image wrongSize = getContext().createImage(ShadowPass::makeAtlasDesc(16, 2));
+    EXPECT_THROW(tooSmall.useAtlas(wrongSize), Error);
+}
+
 TEST(ShadowFaces, ABoxInsideOneFacesPyramidTouchesThatFaceOnly)
 {
     const glm::vec3 light(1.0f, 2.0f, 3.0f);
