@@ -17,7 +17,7 @@ gpu::Image createImageFrom(gpu::Context& context, const Image<float>& image,
     desc.height = static_cast<std::uint32_t>(image.height);
     desc.name = name;
     gpu::Image result = context.createImage(desc);
-    result.uploadSpan<float>(image.pixels);
+    uploadInto(result, image);
     return result;
 }
 
@@ -30,14 +30,7 @@ gpu::Image createImageFrom(gpu::Context& context, const Image<glm::vec3>& image,
     desc.height = static_cast<std::uint32_t>(image.height);
     desc.name = name;
     gpu::Image result = context.createImage(desc);
-    std::vector<float> texels(image.pixels.size() * 4);
-    for (std::size_t i = 0; i < image.pixels.size(); ++i) {
-        texels[4 * i + 0] = image.pixels[i].x;
-        texels[4 * i + 1] = image.pixels[i].y;
-        texels[4 * i + 2] = image.pixels[i].z;
-        texels[4 * i + 3] = 1.0f;
-    }
-    result.uploadSpan<float>(texels);
+    uploadInto(result, image);
     return result;
 }
 

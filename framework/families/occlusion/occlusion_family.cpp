@@ -266,14 +266,27 @@ private:
         };
         const auto aoSlot = pipeline::Compose::ambientOcclusionSlot(w, h);
         const auto conesSlot = pipeline::Compose::coneVisibilitySlot(w, h);
+        const auto viewGpu = start.viewInputsGpu();
+        const auto depthGpu = start.viewDepthGpu();
+        const auto normalGpu = start.viewNormalGpu();
+        // The technique's input from the view inputs on the GPU.
+        auto makeGpuInput = [this, viewGpu, depthGpu,
+                             normalGpu](const pipeline::PassContext& ctx) {
+            const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
+            plugin::OcclusionInput input;
+            input.projection = v.projection;
+            input.view = v.view;
+            input.frameIndex = ctx.frame();
+            input.gpu = &mContext.getGpu();
+            input.gpuLinearDepth = &ctx.read(depthGpu);
+            input.gpuNormal = &ctx.read(normalGpu);
+            return input;
+        };
         if (mTechnique->acceptsGpuInputs() && mTechnique->outputsOnGpu() && mRun.gbufferOnGpu) {
             // G-buffer and result stay on the GPU: the technique binds the view inputs made
             // there, the lit frame binds the technique's images, and the result comes to the CPU
             // in a pass of its own, which runs only when a pass that runs reads it (metrics,
             // images, a CPU reader of the slots).
-            const auto viewGpu = start.viewInputsGpu();
-            const auto depthGpu = start.viewDepthGpu();
-            const auto normalGpu = start.viewNormalGpu();
             const pipeline::Resource<plugin::OcclusionGpuOutput> onGpu{
                 "technique_gpu",
                 pipeline::ResourceType::gpuImage("the technique's images (r32f ao or 4 x rgba32f "
@@ -284,15 +297,8 @@ private:
                  .reads = {viewGpu, depthGpu, normalGpu},
                  .writes = {onGpu},
                  .timing = pipeline::PassTiming::Repeated},
-                [this, viewGpu, depthGpu, normalGpu, onGpu, w, h](pipeline::PassContext& ctx) {
-                    const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
-                    plugin::OcclusionInput input;
-                    input.projection = v.projection;
-                    input.view = v.view;
-                    input.frameIndex = ctx.frame();
-                    input.gpu = &mContext.getGpu();
-                    input.gpuLinearDepth = &ctx.read(depthGpu);
-                    input.gpuNormal = &ctx.read(normalGpu);
+                [this, makeGpuInput, onGpu, w, h](pipeline::PassContext& ctx) {
+                    plugin::OcclusionInput input = makeGpuInput(ctx);
                     input.readBack = false;
                     plugin::OcclusionOutput out;
                     mTechnique->compute(input, out);
@@ -349,24 +355,12 @@ private:
         } else if (mTechnique->acceptsGpuInputs() && mRun.gbufferOnGpu) {
             // The G-buffer stays on the GPU: the technique binds the view inputs made there, and
             // the frame reads the G-buffer back only if another pass that runs needs it.
-            const auto viewGpu = start.viewInputsGpu();
-            const auto depthGpu = start.viewDepthGpu();
-            const auto normalGpu = start.viewNormalGpu();
             graph.addPass({.name = "occlusion",
                            .reads = {viewGpu, depthGpu, normalGpu},
                            .writes = techniqueWrites,
                            .timing = pipeline::PassTiming::Repeated},
-                          [this, viewGpu, depthGpu, normalGpu, ambient,
-                           runTechnique](pipeline::PassContext& ctx) {
-                              const pipeline::GpuViewInputs& v = ctx.read(viewGpu);
-                              plugin::OcclusionInput input;
-                              input.projection = v.projection;
-                              input.view = v.view;
-                              input.frameIndex = ctx.frame();
-                              input.gpu = &mContext.getGpu();
-                              input.gpuLinearDepth = &ctx.read(depthGpu);
-                              input.gpuNormal = &ctx.read(normalGpu);
-                              return runTechnique(input, ctx.write(ambient));
+                          [makeGpuInput, ambient, runTechnique](pipeline::PassContext& ctx) {
+                              return runTechnique(makeGpuInput(ctx), ctx.write(ambient));
                           });
         } else {
             graph.addPass(
