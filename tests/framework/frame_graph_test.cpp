@@ -111,6 +111,42 @@ TEST(FrameGraph, SkipsPassesNobodyReads)
                                                "reference", "ao_metrics"}));
 }
 
+TEST(FrameGraph, AReadBackThatOnlyMeasurementsReadCountsAsOne)
+{
+    // technique -> readback (forReaders) -> metric (measurement), technique -> plain -> metric,
+    // and optionally a CPU consumer that makes the frame: the read-back is a measurement in the
+    // first graph only; a pass not flagged forReaders is never made one, and neither is a
+    // read-back whose output the run asks for.
+    for (const bool cpuConsumer : {false, true}) {
+        FrameGraph graph;
+        graph.addExternal("scene");
+        const auto nothing = [] { return PassOutcome{}; };
+        graph.addPass({.name = "technique", .reads = {"scene"}, .writes = {"on_gpu"}}, nothing);
+        graph.addPass(
+            {.name = "readback", .reads = {"on_gpu"}, .writes = {"on_cpu"}, .forReaders = true},
+            nothing);
+        graph.addPass({.name = "plain", .reads = {"on_gpu"}, .writes = {"derived"}}, nothing);
+        graph.addPass({.name = "metric",
+                       .reads = {"on_cpu", "derived"},
+                       .writes = {"metric"},
+                       .measurement = true},
+                      nothing);
+        std::vector<std::string> outputs = {"metric"};
+        if (cpuConsumer) {
+            graph.addPass({.name = "consumer", .reads = {"on_cpu"}, .writes = {"frame"}}, nothing);
+            outputs.push_back("frame");
+        }
+        const auto records = graph.execute(FeatureSet{}, outputs);
+        EXPECT_TRUE(find(records, "readback").ran);
+        EXPECT_EQ(find(records, "readback").measurement, !cpuConsumer) << cpuConsumer;
+        EXPECT_FALSE(find(records, "plain").measurement) << "not flagged forReaders";
+        EXPECT_FALSE(find(records, "technique").measurement);
+        // Asked for by the run: part of the frame.
+        const auto asked = graph.execute(FeatureSet{}, {"metric", "on_cpu"});
+        EXPECT_FALSE(find(asked, "readback").measurement);
+    }
+}
+
 TEST(FrameGraph, AnUnavailableExternalSkipsItsReadersWithTheExternalsReason)
 {
     Fixture f(/*previousFrame=*/false);
