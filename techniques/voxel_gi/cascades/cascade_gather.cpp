@@ -6,13 +6,17 @@
 #include "families/voxel_gi/pixel_cones.h"
 #include "families/voxel_gi/upsample.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <chrono>
+#include <array>
 #include <cmath>
 
 namespace rtlab::voxelgi {
 
 bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
-                                 glm::dvec3& n, ConeMarchSettings& march) const
+                                 glm::dvec3& n, ConeMarchSettings& march, double* startLevel) const
 {
     glm::dvec3 p;
     if (!readPixelSurface(gbuffer, x, y, p, n))
@@ -25,6 +29,8 @@ bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, gl
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);
+    if (startLevel != nullptr)
+        *startLevel = start;
     return true;
 }
 
@@ -43,14 +49,32 @@ void CascadeVolume::gather(const scene::GBuffer& gbuffer,
     out = combineCones(in);
 }
 
+namespace {
+
+double millisecondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+} // namespace
+
 void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
+    if (mSettings.farStart > 0.0) {
+        gatherConesSplit(gbuffer, out);
+        return;
+    }
+    mCounters.farConesTraced = 0;
+    mCounters.farVoxelsCached = 0;
+    mCounters.farConesMs = 0.0;
+    const auto start = std::chrono::steady_clock::now();
     const auto prepare = [this](const scene::GBuffer& g, int x, int y, glm::dvec3& origin,
                                 glm::dvec3& n, ConeMarchSettings& march) {
         return preparePixel(g, x, y, origin, n, march);
     };
     mCounters.meanStepsPerCone =
         traceGBufferCones(gbuffer, mCones, prepare, GatheredSampler{this, true}, out);
+    mCounters.pixelConesMs = millisecondsSince(start);
 }
 
 void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
@@ -61,6 +85,216 @@ void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<gl
     };
     // Rays: the faces blended along each direction (no per-cone pre-combined buffer).
     traceGBufferRays(gbuffer, rays, prepare, GatheredSampler{this, false}, out);
+}
+
+int CascadeVolume::getFarDependency(int i) const
+{
+    // A far cone of level i first samples at t = farStart * v_i with footprint 2 t tan(a), that
+    // is at level i + log2(2 farStart tan(a)) (selectLevel takes the coarser of the footprint's
+    // level and the point's own); later samples only coarser.
+    const double footprint = std::log2(2.0 * mSettings.farStart * mCones.tanHalfAngle);
+    return std::clamp(i + int(std::floor(footprint)), 0, i);
+}
+
+void CascadeVolume::invalidateFarCones()
+{
+    for (int i = 0; i < getLevelCount(); ++i) {
+        Level& level = mLevels[std::size_t(i)];
+        const std::size_t voxels = level.region.getVoxelCount();
+        bool stale = level.farSlot.size() != voxels;
+        for (int j = getFarDependency(i); j < getLevelCount() && !stale; ++j) {
+            const Level& other = mLevels[std::size_t(j)];
+            stale = std::max(other.voxelStamp, other.lightStamp) > level.farStamp;
+        }
+        if (!stale)
+            continue;
+        level.farSlot.assign(voxels, ~0u);
+        level.far.clear();
+        level.farStamp = mStamp;
+    }
+}
+
+void CascadeVolume::getTrilinear(const VoxelRegion& r, const glm::dvec3& p,
+                                 std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights)
+{
+    // The same lattice and clamping as sampleLevel: voxel centres, clamped to the region.
+    const int R = r.resolution;
+    glm::dvec3 c = (p - r.origin) / r.voxelSize - 0.5;
+    glm::ivec3 i0;
+    glm::dvec3 t;
+    for (int a = 0; a < 3; ++a) {
+        c[a] = std::clamp(c[a], 0.0, double(R - 1));
+        i0[a] = std::min(int(std::floor(c[a])), R - 2);
+        t[a] = c[a] - i0[a];
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = (corner >> 2) & 1;
+        weights[std::size_t(corner)] =
+            (dx ? t.x : 1.0 - t.x) * (dy ? t.y : 1.0 - t.y) * (dz ? t.z : 1.0 - t.z);
+        voxels[std::size_t(corner)] = r.index(i0.x + dx, i0.y + dy, i0.z + dz);
+    }
+}
+
+glm::vec3 CascadeVolume::sampleFar(const Level& level, const glm::dvec3& p, int cone) const
+{
+    std::array<std::size_t, 8> voxels;
+    std::array<double, 8> weights;
+    getTrilinear(level.region, p, voxels, weights);
+    glm::dvec3 sum(0.0);
+    for (int c = 0; c < 8; ++c)
+        if (weights[std::size_t(c)] != 0.0)
+            sum += weights[std::size_t(c)] *
+                   glm::dvec3(level.far[std::size_t(level.farSlot[voxels[std::size_t(c)]]) * kConeCount +
+                                        std::size_t(cone)]);
+    return glm::vec3(sum);
+}
+
+// "Split Cone Trace" (the talk): two cones in the same direction from nearby points sample
+// increasingly similar voxels further out, so the far part of every cone is traced once from
+// each voxel centre of a level, stored in another cascade, and interpolated trilinearly; each
+// pixel traces only the near part up to the split (the talk: about a metre at its 0.4 m finest
+// voxels), then adds the far radiance seen through the near part's transmittance. The start
+// level blends between levels l0 and l0 + 1 (selectLevel): the pixel composites its near part
+// with each level's far cones at that level's split (the second near segment continues the
+// first) and blends the two, so the split moves smoothly with the start level.
+void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+{
+    invalidateFarCones();
+    const int W = gbuffer.width, H = gbuffer.height, n = getLevelCount();
+    struct Start {
+        glm::dvec3 origin{0.0}, normal{0.0};
+        ConeMarchSettings march;
+        double level = -1.0;
+    };
+    std::vector<Start> starts(std::size_t(W) * std::size_t(H));
+    tbb::parallel_for(0, H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            Start& s = starts[std::size_t(y) * std::size_t(W) + std::size_t(x)];
+            if (!preparePixel(gbuffer, x, y, s.origin, s.normal, s.march, &s.level))
+                s.level = -1.0;
+        }
+    });
+    // The voxel centres whose far cones the pixels read and that are not traced yet.
+    std::vector<std::vector<std::uint8_t>> wanted(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i)
+        wanted[std::size_t(i)].assign(mLevels[std::size_t(i)].farSlot.size(), 0);
+    const auto levelsOf = [n, &levels = mLevels](double l, int& l0, int& l1, double& frac) {
+        l0 = int(std::floor(l));
+        frac = l - l0;
+        l1 = frac > 0.0 && l0 + 1 < n && levels[std::size_t(l0) + 1].voxelized ? l0 + 1 : -1;
+    };
+    for (const Start& s : starts) {
+        if (s.level < 0.0)
+            continue;
+        int l0, l1;
+        double frac;
+        levelsOf(s.level, l0, l1, frac);
+        for (const int l : {l0, l1}) {
+            if (l < 0)
+                continue;
+            std::array<std::size_t, 8> voxels;
+            std::array<double, 8> weights;
+            getTrilinear(mLevels[std::size_t(l)].region, s.origin, voxels, weights);
+            for (int c = 0; c < 8; ++c)
+                if (weights[std::size_t(c)] != 0.0 &&
+                    mLevels[std::size_t(l)].farSlot[voxels[std::size_t(c)]] == ~0u)
+                    wanted[std::size_t(l)][voxels[std::size_t(c)]] = 1;
+        }
+    }
+    // Slots appended to each level's far buffer, in voxel order (deterministic).
+    std::vector<std::pair<int, std::uint32_t>> toTrace;
+    for (int i = 0; i < n; ++i) {
+        Level& level = mLevels[std::size_t(i)];
+        std::uint32_t slot = std::uint32_t(level.far.size() / kConeCount);
+        for (std::size_t v = 0; v < wanted[std::size_t(i)].size(); ++v)
+            if (wanted[std::size_t(i)][v]) {
+                toTrace.emplace_back(i, std::uint32_t(v));
+                level.farSlot[v] = slot++;
+            }
+        level.far.resize(std::size_t(slot) * kConeCount, glm::vec3(0.0f));
+    }
+    const GatheredSampler sampler{this, true};
+    const auto farStart = std::chrono::steady_clock::now();
+    tbb::parallel_for(std::size_t(0), toTrace.size(), [&](std::size_t k) {
+        const auto [i, vox] = toTrace[k];
+        Level& level = mLevels[std::size_t(i)];
+        const VoxelRegion& r = level.region;
+        const int R = r.resolution;
+        const glm::dvec3 centre = r.getVoxelCentre(int(vox % std::uint32_t(R)),
+                                                   int((vox / std::uint32_t(R)) % std::uint32_t(R)),
+                                                   int(vox / (std::uint32_t(R) * std::uint32_t(R))));
+        ConeMarchSettings march;
+        march.tanHalfAngle = mCones.tanHalfAngle;
+        march.stepScale = mSettings.stepScale;
+        march.startDistance = mSettings.farStart * r.voxelSize;
+        for (int c = 0; c < kConeCount; ++c) {
+            const ConeResult far = marchCone(sampler, centre, mCones.directions[std::size_t(c)], c, march);
+            level.far[std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c)] =
+                glm::max(far.light[kDirect], glm::vec3(0.0f));
+        }
+    });
+    mCounters.farConesMs = millisecondsSince(farStart);
+    mCounters.farConesTraced = toTrace.size() * std::size_t(kConeCount);
+    mCounters.farVoxelsCached = 0;
+    for (const Level& level : mLevels)
+        mCounters.farVoxelsCached += level.far.size() / kConeCount;
+
+    // The pixels: near parts, composited with the far cones.
+    const auto pixelStart = std::chrono::steady_clock::now();
+    out.assign(starts.size() * kConeCount, glm::vec3(0.0f));
+    std::vector<std::uint64_t> stepsPerRow(std::size_t(H), 0), conesPerRow(std::size_t(H), 0);
+    tbb::parallel_for(0, H, [&](int y) {
+        for (int x = 0; x < W; ++x) {
+            const std::size_t pixel = std::size_t(y) * std::size_t(W) + std::size_t(x);
+            const Start& s = starts[pixel];
+            if (s.level < 0.0)
+                continue;
+            int l0, l1;
+            double frac;
+            levelsOf(s.level, l0, l1, frac);
+            const auto w = computeIrradianceWeights(mCones, s.normal);
+            const double split0 = mSettings.farStart * mLevels[std::size_t(l0)].region.voxelSize;
+            for (int k = 0; k < kConeCount; ++k) {
+                if (w[std::size_t(k)] == 0.0)
+                    continue;
+                const glm::dvec3& dir = mCones.directions[std::size_t(k)];
+                ConeMarchSettings march = s.march;
+                march.tanHalfAngle = mCones.tanHalfAngle;
+                march.maxDistance = split0;
+                const ConeResult a = marchCone(sampler, s.origin, dir, k, march);
+                glm::dvec3 la(a.light[kDirect]);
+                stepsPerRow[std::size_t(y)] += std::uint64_t(a.steps);
+                ++conesPerRow[std::size_t(y)];
+                // Escaped: the cone left the cascade, nothing lies beyond it.
+                if (!a.escaped)
+                    la += a.transmittance * glm::dvec3(sampleFar(mLevels[std::size_t(l0)], s.origin, k));
+                glm::dvec3 result = la;
+                if (l1 >= 0) {
+                    glm::dvec3 lb(a.light[kDirect]);
+                    if (!a.escaped) {
+                        ConeMarchSettings segment = march;
+                        segment.startDistance = split0;
+                        segment.maxDistance = 2.0 * split0;
+                        const ConeResult b = marchCone(sampler, s.origin, dir, k, segment);
+                        stepsPerRow[std::size_t(y)] += std::uint64_t(b.steps);
+                        lb += a.transmittance * glm::dvec3(b.light[kDirect]);
+                        if (!b.escaped)
+                            lb += a.transmittance * b.transmittance *
+                                  glm::dvec3(sampleFar(mLevels[std::size_t(l1)], s.origin, k));
+                    }
+                    result = la + frac * (lb - la);
+                }
+                out[pixel * kConeCount + std::size_t(k)] = glm::max(glm::vec3(result), glm::vec3(0.0f));
+            }
+        }
+    });
+    std::uint64_t steps = 0, traced = 0;
+    for (int y = 0; y < H; ++y) {
+        steps += stepsPerRow[std::size_t(y)];
+        traced += conesPerRow[std::size_t(y)];
+    }
+    mCounters.meanStepsPerCone = traced ? double(steps) / double(traced) : 0.0;
+    mCounters.pixelConesMs = millisecondsSince(pixelStart);
 }
 
 } // namespace rtlab::voxelgi

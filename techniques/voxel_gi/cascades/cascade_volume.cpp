@@ -560,6 +560,7 @@ std::size_t CascadeVolume::getPayloadBytes() const
         for (const auto& f : l.light)
             bytes += f.size() * sizeof(glm::vec3);
         bytes += l.combined.size() * sizeof(glm::vec4);
+        bytes += l.far.size() * sizeof(glm::vec3) + l.farSlot.size() * sizeof(std::uint32_t);
     }
     return bytes;
 }

@@ -37,6 +37,10 @@ struct CascadeSettings {
     double startOffset = 1.0; //!< voxels
     double stepScale = 0.5;
     bool precombine = true;
+    //! Split near/far cones ("Split Cone Trace"): the pixel traces its cones up to farStart
+    //! voxels of its start level and takes the rest from far cones traced once per voxel centre
+    //! of that level and interpolated trilinearly. 0: every cone traced whole per pixel.
+    double farStart = 0.0;
 };
 
 class CascadeVolume {
@@ -59,6 +63,13 @@ public:
         glm::dvec3 changedMin{1e300}, changedMax{-1e300};
         //! Solid voxels and the nearest surface voxel, whose light they mirror.
         std::vector<std::pair<std::uint32_t, std::uint32_t>> inward;
+        //! The far cones of the voxel centres (settings.farStart > 0), traced when a pixel first
+        //! needs them: farSlot[voxel] is ~0u or the slot s of its 16 cones' gathered radiance
+        //! beyond farStart voxels, far[s * 16 + cone]. Valid while no level they sample changed
+        //! since farStamp.
+        std::vector<std::uint32_t> farSlot;
+        std::vector<glm::vec3> far;
+        std::uint64_t farStamp = 0;
     };
 
     explicit CascadeVolume(CascadeSettings settings);
@@ -90,6 +101,9 @@ public:
     //! every sample at the finest level holding it), E = pi * mean radiance; the directions are
     //! a stratified grid turned per pixel, so the result is deterministic.
     void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
+    //! The lowest level the far cones of level `i` sample (their footprint at farStart, or the
+    //! point's own level, whichever is coarser; never finer than this).
+    int getFarDependency(int i) const;
     //! Indirect irradiance at every pixel of `gbuffer`: gatherCones combined per pixel
     //! (upsample.h combineCones), cones weighted by `coneVisibility` when given.
     void gather(const scene::GBuffer& gbuffer, const std::vector<Image<float>>* coneVisibility,
@@ -130,6 +144,10 @@ public:
         int levelsLit = 0;
         std::size_t surfaceVoxelsLit = 0;
         double meanStepsPerCone = 0.0;
+        std::size_t farConesTraced = 0; //!< by the last gather (the far cones it had to trace)
+        std::size_t farVoxelsCached = 0; //!< voxel centres whose far cones are held after it
+        double farConesMs = 0.0;   //!< wall time of the last gather's far cones
+        double pixelConesMs = 0.0; //!< ... of its pixel cones (whole, or the near parts)
     };
     const Counters& getCounters() const { return mCounters; }
 
@@ -137,7 +155,16 @@ private:
     // Where a pixel's cones start (origin, normal, start distance and step); false when it has no
     // surface or lies outside every level.
     bool preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
-                      glm::dvec3& n, ConeMarchSettings& march) const;
+                      glm::dvec3& n, ConeMarchSettings& march, double* startLevel = nullptr) const;
+    // gatherCones with split near/far cones (settings.farStart > 0).
+    void gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    // Drops the far cones of every level whose sampled levels changed since they were traced.
+    void invalidateFarCones();
+    // Trilinear far radiance of cone `cone` at p in level `level` (its traced voxel centres).
+    glm::vec3 sampleFar(const Level& level, const glm::dvec3& p, int cone) const;
+    // The 8 voxels (of the trilinear neighbourhood of p in `region`) and their weights.
+    static void getTrilinear(const VoxelRegion& region, const glm::dvec3& p,
+                             std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights);
     // The level to sample at p for footprint d, continuous; < 0 when p is outside every level.
     double selectLevel(const glm::dvec3& p, double diameter) const;
     template <bool Gathered>

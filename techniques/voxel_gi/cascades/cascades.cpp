@@ -38,7 +38,11 @@
 //
 // The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; the
 // voxelization and light injection run in C++ (TBB).
-// Not yet: voxelization and light injection on Vulkan, split near/far cones, the extrapolated
+// With `far_start` > 0 the pixel cones are split ("Split Cone Trace"): each pixel traces its
+// cones up to far_start voxels of its start level, and the rest comes from far cones traced once
+// per voxel centre of the level (when a pixel first needs them, kept until a level they sample
+// changes) and interpolated trilinearly (cascade_gather.cpp gatherConesSplit; C++ gather only).
+// Not yet: voxelization and light injection on Vulkan, the far cones on Vulkan, the extrapolated
 // third bounce, the 3D noise offset.
 //
 // Parameters
@@ -58,7 +62,9 @@
 // | solid          | bool  | true              |                                       |        |
 // | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
 // | trace_step     | int   | 4                 | [1, 8]                                | pixels |
+// | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]; device: cpu  | voxels of the pixel's start level |
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
+// The talk's split is "about a meter" at its 0.4 m finest voxels: far_start about 2.5.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
 // 2 bounces in the voxels plus the pixel's gather (bounces: 3 here).
 //
@@ -119,6 +125,10 @@ public:
         schema.addInt("trace_step", 4, 1, 8, "pixels",
                       "trace one pixel per trace_step^2 block and upsample (depth- and "
                       "normal-aware); 4 = the talk's quarter resolution, 1 = every pixel");
+        schema.addFloat("far_start", 0.0, 0.0, 64.0, "voxels",
+                        "split near/far cones: pixels trace up to this many voxels of their "
+                        "start level, far cones from the voxel centres do the rest (0 = off; "
+                        "needs device: cpu)");
         schema.addEnum("device", "vulkan", {"vulkan", "cpu"},
                        "where the pixel gather runs (Vulkan needs precombine; the voxel "
                        "update runs on the CPU)");
@@ -145,6 +155,14 @@ public:
         mSettings.solid = p.getBool("solid");
         mOnGpu = p.getString("device") == "vulkan";
         mTraceStep = int(p.getInt("trace_step"));
+        mSettings.farStart = p.getFloat("far_start");
+        if (mSettings.farStart > 0.0 && mSettings.farStart < mSettings.startOffset)
+            throw Error("cascades: far_start must be 0 (off) or at least start_offset (" +
+                        std::to_string(mSettings.startOffset) + " voxels), found " +
+                        std::to_string(mSettings.farStart));
+        if (mSettings.farStart > 0.0 && mOnGpu)
+            throw Error("cascades: far_start > 0 needs device: cpu (the Vulkan gather traces "
+                        "whole cones)");
     }
 
     config::ParamSet effectiveParams() const override
@@ -164,6 +182,7 @@ public:
         p.set("solid", mSettings.solid);
         p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
         p.set("trace_step", std::int64_t(mTraceStep));
+        p.set("far_start", mSettings.farStart);
         return p;
     }
 
@@ -258,7 +277,11 @@ public:
                 {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
                 {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs()
                                                                          : std::nan("")},
-                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
+                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
+                {"far_cones_traced", double(c.farConesTraced)},
+                {"far_cones_ms", mGatheredOnGpu ? std::nan("") : c.farConesMs},
+                {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
+                {"far_voxels_cached", double(c.farVoxelsCached)}};
     }
 
 private:

@@ -254,6 +254,100 @@ TEST(Cascades, AnEditReVoxelizesOnlyTheChangedRegionAndEqualsAFullVoxelization)
     expectSameVoxels(edited, fresh);
 }
 
+// Three levels of 32^3 around makeOpenRoom (level 0 1.6 wide, level 2 6.4), and a G-buffer on
+// its floor: sky, point light and both bounces reach the pixels.
+CascadeSettings openRoomSettings()
+{
+    CascadeSettings s = furnaceSettings();
+    s.levels = 3;
+    s.voxelSize = 0.05;
+    return s;
+}
+
+scene::GBuffer makeOpenRoomFloor()
+{
+    return makeFloorGBuffer(6, 5, -0.99, -0.8, 0.8, -0.8, 0.8);
+}
+
+TEST(Cascades, SplitConesMatchTheFurnaceClosedForm)
+{
+    // Near parts composited with far cones from the voxel centres: every cone in the furnace
+    // sees the same radiance wherever it starts, so the split keeps the closed form. Tolerance:
+    // the furnace's 3.5 % (the near part and the far cone each stop at 99 % opacity, as the
+    // whole cone does).
+    const double expected = glm::pi<double>() * 0.75;
+    for (const double farStart : {1.0, 2.5, 6.0}) {
+        CascadeSettings s = furnaceSettings();
+        s.farStart = farStart;
+        const Image<glm::vec3> e = runFurnace(s, glm::dvec3(0.0));
+        for (const auto& p : e.pixels)
+            EXPECT_NEAR(p.x, expected, 0.035 * expected) << farStart;
+    }
+}
+
+TEST(Cascades, ASplitBeyondEveryConeIsTheWholeCone)
+{
+    // When the near part reaches as far as any cone goes, the far cones start outside the
+    // cascade and add nothing: bitwise the unsplit gather (on a scene with sky, point light
+    // and both bounces).
+    const scene::RenderScene s = makeOpenRoom(glm::vec3(0.0f));
+    CascadeSettings whole = openRoomSettings();
+    CascadeSettings split = whole;
+    split.farStart = 1e4;
+    const scene::GBuffer g = makeOpenRoomFloor();
+    std::vector<glm::vec3> a, b;
+    for (auto [settings, out] : {std::pair{&whole, &a}, std::pair{&split, &b}}) {
+        CascadeVolume volume(*settings);
+        volume.voxelize(s, "room", glm::dvec3(0.0), 0, false);
+        volume.injectLight(s, "lights", 0, false);
+        volume.gatherCones(g, *out);
+    }
+    ASSERT_EQ(a.size(), b.size());
+    float total = 0.0f;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i], b[i]) << i;
+        total += a[i].x;
+    }
+    EXPECT_GT(total, 0.0f); // the scene is lit: the comparison is not between zeros
+}
+
+TEST(Cascades, FarConesAreTracedOnceUntilALevelTheySampleChanges)
+{
+    const scene::RenderScene s = makeOpenRoom(glm::vec3(0.0f));
+    CascadeSettings settings = openRoomSettings();
+    settings.farStart = 2.5;
+    CascadeVolume volume(settings);
+    volume.voxelize(s, "room", glm::dvec3(0.0), 0, false);
+    volume.injectLight(s, "lights", 0, false);
+    const scene::GBuffer g = makeOpenRoomFloor();
+    std::vector<glm::vec3> first, second, third;
+    volume.gatherCones(g, first);
+    const std::size_t traced = volume.getCounters().farConesTraced;
+    EXPECT_GT(traced, 0u);
+    EXPECT_EQ(traced, volume.getCounters().farVoxelsCached * std::size_t(kConeCount));
+    // Nothing changed: no far cone is traced again, and the result is the same.
+    volume.gatherCones(g, second);
+    EXPECT_EQ(volume.getCounters().farConesTraced, 0u);
+    EXPECT_EQ(first, second);
+    // New lights re-light every level: the far cones are traced again.
+    volume.injectLight(s, "other lights", 1, false);
+    volume.gatherCones(g, third);
+    EXPECT_EQ(volume.getCounters().farConesTraced, traced);
+    EXPECT_EQ(first, third);
+}
+
+TEST(Cascades, TheSplitNeedsTheCppGatherAndAStartBeyondTheOffset)
+{
+    EXPECT_THROW(createTechnique(rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
+                                 {{"far_start", 2.5}}),
+                 Error);
+    EXPECT_THROW(createTechnique(rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
+                                 {{"far_start", 0.5}, {"device", std::string("cpu")}}),
+                 Error);
+    EXPECT_NO_THROW(createTechnique(rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
+                                    {{"far_start", 2.5}, {"device", std::string("cpu")}}));
+}
+
 TEST(Cascades, DeterministicForAnyThreadCount)
 {
     Image<glm::vec3> one, two;
