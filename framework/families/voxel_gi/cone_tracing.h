@@ -18,6 +18,7 @@
 #include <glm/vec3.hpp>
 #include <glm/vec4.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -122,6 +123,24 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
     }
     r.transmittance = 1.0 - occupied;
     return r;
+}
+
+//! The Tomorrow Children's extrapolated extra bounce ("Extra Magic": places that received more
+//! second bounce than first are surmised to get more from a third, and boosted): from the
+//! reflected radiance of the last two bounces, per channel, next = last * min(last / prev, 1).
+//! Where each bounce keeps a fraction g < 1 of the one before (a room of albedo a: g = a) this
+//! is the geometric series' next term, exact in the furnace; where the later bounce is the
+//! larger (g >= 1, the talk's case) the boost is capped at one more bounce as large as the last.
+inline glm::vec3 extrapolateBounce(const glm::vec3& prev, const glm::vec3& last)
+{
+    glm::vec3 next(0.0f);
+    for (int c = 0; c < 3; ++c) {
+        if (!(last[c] > 0.0f))
+            continue;
+        const float gain = prev[c] > 0.0f ? std::min(last[c] / prev[c], 1.0f) : 1.0f;
+        next[c] = last[c] * gain;
+    }
+    return next;
 }
 
 //! Changes exactly when the point lights or the sky change (what light injection depends on

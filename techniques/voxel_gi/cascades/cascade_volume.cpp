@@ -434,7 +434,6 @@ void CascadeVolume::updateCombined(Level& level)
 {
     const std::size_t voxels = level.region.getVoxelCount();
     level.combined.assign(voxels * kConeCount, glm::vec4(0.0f));
-    const int gathered = mSettings.bounces;
     tbb::parallel_for(std::size_t(0), voxels, [&](std::size_t vox) {
         for (int k = 0; k < kConeCount; ++k) {
             const glm::dvec3& d = mCones.directions[std::size_t(k)];
@@ -442,14 +441,23 @@ void CascadeVolume::updateCombined(Level& level)
             for (int axis = 0; axis < 3; ++axis) {
                 const float w = float(d[axis] * d[axis]);
                 const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, d[axis]));
-                glm::vec3 light(0.0f);
-                for (int field = kDirect; field < kDirect + gathered; ++field)
-                    light += level.light[std::size_t(field)][f];
-                c += w * glm::vec4(light, level.alpha[f]);
+                c += w * glm::vec4(getGatheredLight(level, f), level.alpha[f]);
             }
             level.combined[vox * kConeCount + std::size_t(k)] = c;
         }
     });
+}
+
+glm::vec3 CascadeVolume::getGatheredLight(const Level& level, std::size_t f) const
+{
+    glm::vec3 light(0.0f);
+    for (int field = kDirect; field < kDirect + mSettings.bounces; ++field)
+        light += level.light[std::size_t(field)][f];
+    // "Extra Magic" (the talk): one more bounce extrapolated from the last two.
+    if (mSettings.extrapolate && mSettings.bounces >= 2)
+        light += extrapolateBounce(level.light[std::size_t(kDirect + mSettings.bounces - 2)][f],
+                                   level.light[std::size_t(kDirect + mSettings.bounces - 1)][f]);
+    return light;
 }
 
 double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter) const
@@ -511,8 +519,7 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
             const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
             out.alpha += aw * level.alpha[f];
             if (gathered) {
-                for (int field = kDirect; field < kDirect + mSettings.bounces; ++field)
-                    out.light[kDirect] += aw * level.light[std::size_t(field)][f];
+                out.light[kDirect] += aw * getGatheredLight(level, f);
             } else {
                 for (int field = 0; field < kFieldCount; ++field)
                     out.light[std::size_t(field)] += aw * level.light[std::size_t(field)][f];

@@ -41,6 +41,9 @@ struct CascadeSettings {
     //! voxels of its start level and takes the rest from far cones traced once per voxel centre
     //! of that level and interpolated trilinearly. 0: every cone traced whole per pixel.
     double farStart = 0.0;
+    //! Add the talk's extrapolated extra bounce (cone_tracing.h extrapolateBounce) of the last
+    //! two gathered bounces to the light the pixels gather (bounces >= 2): B + 1 reflections.
+    bool extrapolate = false;
 };
 
 class CascadeVolume {
@@ -175,6 +178,8 @@ private:
     void lightLevel(int level, const scene::RenderScene& geometry);
     void propagateInward(Level& level);
     void updateCombined(Level& level);
+    // The reflected light a pixel gathers from face f: bounces 1..B (and the extrapolated one).
+    glm::vec3 getGatheredLight(const Level& level, std::size_t f) const;
 
     CascadeSettings mSettings;
     ConeSet mCones;
