@@ -21,7 +21,7 @@ bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, gl
     glm::dvec3 p;
     if (!readPixelSurface(gbuffer, x, y, p, n))
         return false;
-    const double start = selectLevel(p, 0.0);
+    const double start = selectLevel(p, 0.0, true);
     if (start < 0.0)
         return false;
     // Start a voxel of the pixel's start level out, along the normal and along the cone.

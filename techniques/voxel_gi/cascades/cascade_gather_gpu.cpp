@@ -15,8 +15,10 @@ struct GatherConstants {
     glm::ivec4 size{0};  // width, height, levels, resolution
     glm::vec4 march{0};  // level-0 voxel size, tan(half-angle), start offset, step scale
     glm::ivec4 flags{0}; // visibility given, max steps
+    glm::ivec4 anchorCell{0}; // the anchor in level-0 voxels
+    glm::vec4 noise{0.0f};    // x: level noise (of a level's radius)
 };
-static_assert(sizeof(GatherConstants) == 48, "must match cascade_gather.comp");
+static_assert(sizeof(GatherConstants) == 80, "must match cascade_gather.comp");
 
 struct LevelDesc {
     glm::vec4 origin{0.0f};
@@ -90,6 +92,11 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
     constants.march = {float(settings.voxelSize), float(volume.getCones().tanHalfAngle),
                        float(settings.startOffset), float(settings.stepScale)};
     constants.flags = {0, 1024, 0, 0};
+    // The noise lattice is the world's level-0 voxels: the anchor (a level centre, on a lattice
+    // of whole level-0 voxels) as integer cells, positions relative to it.
+    const glm::dvec3 anchorCells = glm::round(anchor / settings.voxelSize);
+    constants.anchorCell = glm::ivec4(glm::ivec3(anchorCells), 0);
+    constants.noise = {float(settings.levelNoise), 0.0f, 0.0f, 0.0f};
     mLastGpuMs = mDispatch.run(mLevels, mCombined, gpu::PushConstants(constants), out);
 }
 

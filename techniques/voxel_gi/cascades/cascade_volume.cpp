@@ -460,7 +460,37 @@ glm::vec3 CascadeVolume::getGatheredLight(const Level& level, std::size_t f) con
     return light;
 }
 
-double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter) const
+namespace {
+
+// pcg3d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020), to 24 bits so
+// that the float conversion is exact on every device.
+float hashToUnit(glm::uvec3 v)
+{
+    v = v * 1664525u + 1013904223u;
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    v ^= v >> 16u;
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    return float(v.x >> 8u) * (1.0f / 16777216.0f);
+}
+
+} // namespace
+
+float computeValueNoise(const glm::ivec3& cell, const glm::vec3& f)
+{
+    float n = 0.0f;
+    for (int corner = 0; corner < 8; ++corner) {
+        const glm::ivec3 d(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const float w = (d.x ? f.x : 1.0f - f.x) * (d.y ? f.y : 1.0f - f.y) * (d.z ? f.z : 1.0f - f.z);
+        n += w * hashToUnit(glm::uvec3(cell + d));
+    }
+    return n;
+}
+
+double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter, bool noisy) const
 {
     const int n = getLevelCount();
     double containing = -1.0;
@@ -472,8 +502,18 @@ double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter) const
         const double radius = (0.5 * level.region.resolution - 1.0) * level.region.voxelSize;
         const double r = glm::length(p - level.centre) / radius;
         if (r <= 1.0) {
-            // From half the radius on, blend toward the next level ("Cascade selection").
-            containing = i + (i + 1 < n ? std::clamp((r - 0.5) / 0.5, 0.0, 1.0) : 0.0);
+            // From half the radius on, blend toward the next level ("Cascade selection"), with
+            // the talk's "3D noise offset" on the blend (the containment test stays exact).
+            double blend = r;
+            const glm::dvec3 u = p / mSettings.voxelSize;
+            const glm::dvec3 cell = glm::floor(u);
+            // (Cells beyond the int range, 2^30 voxels out, get no noise.)
+            if (noisy && mSettings.levelNoise > 0.0 &&
+                std::max({std::abs(cell.x), std::abs(cell.y), std::abs(cell.z)}) < 1073741824.0) {
+                blend += mSettings.levelNoise *
+                         (2.0 * double(computeValueNoise(glm::ivec3(cell), glm::vec3(u - cell))) - 1.0);
+            }
+            containing = i + (i + 1 < n ? std::clamp((blend - 0.5) / 0.5, 0.0, 1.0) : 0.0);
             break;
         }
     }
@@ -532,7 +572,7 @@ template <bool Gathered>
 bool CascadeVolume::sampleAt(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
                              ConeSample& out) const
 {
-    const double l = selectLevel(p, diameter);
+    const double l = selectLevel(p, diameter, Gathered);
     if (l < 0.0)
         return false;
     out = ConeSample{};

@@ -44,7 +44,16 @@ struct CascadeSettings {
     //! Add the talk's extrapolated extra bounce (cone_tracing.h extrapolateBounce) of the last
     //! two gathered bounces to the light the pixels gather (bounces >= 2): B + 1 reflections.
     bool extrapolate = false;
+    //! The talk's "3D noise offset" on the start-level blend (pixel cones only): the blend's
+    //! radius is offset by levelNoise * (2 n - 1) of the level's radius, n a smooth 3D noise of
+    //! the point (computeValueNoise on the level-0 voxel lattice). 0: no noise.
+    double levelNoise = 0.0;
 };
+
+//! Smooth 3D value noise in [0, 1): the hashes of the 8 corners of lattice cell `cell`
+//! interpolated trilinearly at `frac` in [0, 1]^3 (hash: pcg3d, Jarzynski and Olano, "Hash
+//! Functions for GPU Rendering", JCGT 2020). The same bits as shaders/cascade_gather.comp.
+float computeValueNoise(const glm::ivec3& cell, const glm::vec3& frac);
 
 class CascadeVolume {
 public:
@@ -169,7 +178,8 @@ private:
     static void getTrilinear(const VoxelRegion& region, const glm::dvec3& p,
                              std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights);
     // The level to sample at p for footprint d, continuous; < 0 when p is outside every level.
-    double selectLevel(const glm::dvec3& p, double diameter) const;
+    // With `noisy` (pixel cones), the blend between levels carries settings.levelNoise.
+    double selectLevel(const glm::dvec3& p, double diameter, bool noisy = false) const;
     template <bool Gathered>
     bool sampleAt(const glm::dvec3& p, double diameter, int cone, const glm::dvec3& dir,
                   ConeSample& out) const;

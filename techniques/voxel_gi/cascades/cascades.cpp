@@ -45,8 +45,9 @@
 // With `extrapolate` the pixels also gather the talk's extrapolated extra bounce ("Extra Magic",
 // cone_tracing.h extrapolateBounce) from the voxels' last two bounces: the technique then claims
 // bounces + 1 reflections and is measured against that ground truth.
-// Not yet: voxelization and light injection on Vulkan, the far cones on Vulkan, the 3D noise
-// offset.
+// `level_noise` adds the talk's "3D noise offset" to the start-level blend of the pixel cones (a
+// smooth value noise on the level-0 voxel lattice, the same bits in C++ and on Vulkan).
+// Not yet: voxelization and light injection on Vulkan, the far cones on Vulkan.
 //
 // Parameters
 // | name           | type  | default           | range / choices                       | unit   |
@@ -67,6 +68,7 @@
 // | trace_step     | int   | 4                 | [1, 8]                                | pixels |
 // | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]; device: cpu  | voxels of the pixel's start level |
 // | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
+// | level_noise    | float | 0                 | [0, 0.5]                              | of a level's radius |
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
 // The talk's split is "about a meter" at its 0.4 m finest voxels: far_start about 2.5.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
@@ -136,6 +138,9 @@ public:
         schema.addBool("extrapolate", false,
                        "add the talk's extrapolated extra bounce (bounces + 1 reflections; "
                        "needs bounces >= 2)");
+        schema.addFloat("level_noise", 0.0, 0.0, 0.5, "of a level's radius",
+                        "3D noise offset on the pixel cones' start-level blend (hides the "
+                        "transition between levels)");
         schema.addEnum("device", "vulkan", {"vulkan", "cpu"},
                        "where the pixel gather runs (Vulkan needs precombine; the voxel "
                        "update runs on the CPU)");
@@ -168,6 +173,7 @@ public:
                         std::to_string(mSettings.startOffset) + " voxels), found " +
                         std::to_string(mSettings.farStart));
         mSettings.extrapolate = p.getBool("extrapolate");
+        mSettings.levelNoise = p.getFloat("level_noise");
         if (mSettings.extrapolate && mSettings.bounces < 2)
             throw Error("cascades: extrapolate needs bounces >= 2 (it extrapolates from the last "
                         "two), found bounces " + std::to_string(mSettings.bounces));
@@ -195,6 +201,7 @@ public:
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("far_start", mSettings.farStart);
         p.set("extrapolate", mSettings.extrapolate);
+        p.set("level_noise", mSettings.levelNoise);
         return p;
     }
 

@@ -20,7 +20,9 @@ using namespace rtlab::voxelgi::testing;
 
 namespace {
 
-void compare(const glm::vec3& offset, const CascadeSettings& settings)
+// The C++ and Vulkan cones of the open room seen from a camera, checked against each other.
+std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>> compare(const glm::vec3& offset,
+                                                                  const CascadeSettings& settings)
 {
     const scene::RenderScene s = makeOpenRoom(offset);
     scene::Camera camera;
@@ -40,6 +42,7 @@ void compare(const glm::vec3& offset, const CascadeSettings& settings)
     // A second call uploads no level (nothing changed), only the pixels.
     gather.gatherCones(context, volume, g, gpuCones);
     EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
+    return {cpuCones, gpuCones};
 }
 
 CascadeSettings testSettings()
@@ -61,6 +64,30 @@ TEST(CascadesGpu, VulkanGatherMatchesTheCppGather)
 TEST(CascadesGpu, VulkanGatherMatchesFarFromTheOrigin)
 {
     compare(glm::vec3(1e5f, 0.0f, -1e5f), testSettings());
+}
+
+TEST(CascadesGpu, VulkanGatherMatchesWithTheLevelNoise)
+{
+    // The noise is hashed from world voxel cells on both sides (the GPU from the anchor's cell
+    // and relative positions), so the two agree near the origin and far from it.
+    // Voxels of 0.2 so that the room's pixels lie in level 1's blend band (radius 1.4 to 2.8 m).
+    CascadeSettings s = testSettings();
+    s.voxelSize = 0.2;
+    s.levelNoise = 0.3;
+    for (const glm::vec3 offset : {glm::vec3(0.0f), glm::vec3(1e5f, 0.0f, -1e5f)}) {
+        const auto [cpu, gpu] = compare(offset, s);
+        // The noise changes the answer far more than the two devices differ: the GPU follows it.
+        CascadeSettings plain = s;
+        plain.levelNoise = 0.0;
+        const auto [cpuPlain, gpuPlain] = compare(offset, plain);
+        double byNoise = 0.0, byDevice = 0.0;
+        for (std::size_t i = 0; i < cpu.size(); ++i) {
+            byNoise += glm::length(cpu[i] - cpuPlain[i]);
+            byDevice += glm::length(gpu[i] - cpu[i]);
+        }
+        EXPECT_GT(byNoise, 0.0);
+        EXPECT_LT(byDevice, 0.01 * byNoise);
+    }
 }
 
 } // namespace

@@ -380,6 +380,56 @@ TEST(Cascades, ExtrapolationClaimsOneMoreBounceAndNeedsTwo)
                  Error);
 }
 
+TEST(Cascades, TheValueNoiseIsSmoothBoundedAndSpread)
+{
+    // In [0, 1); continuous across cell faces (the corner hashes are shared); not constant: over
+    // 4096 cells the values spread over most of [0, 1].
+    float lo = 1.0f, hi = 0.0f;
+    for (int z = -8; z < 8; ++z)
+        for (int y = -8; y < 8; ++y)
+            for (int x = -8; x < 8; ++x) {
+                const glm::ivec3 c(x * 977, y, z - 1000000);
+                const float n = computeValueNoise(c, glm::vec3(0.25f, 0.5f, 0.75f));
+                ASSERT_GE(n, 0.0f);
+                ASSERT_LT(n, 1.0f);
+                lo = std::min(lo, n);
+                hi = std::max(hi, n);
+                EXPECT_FLOAT_EQ(computeValueNoise(c, glm::vec3(1.0f, 0.5f, 0.5f)),
+                                computeValueNoise(c + glm::ivec3(1, 0, 0), glm::vec3(0.0f, 0.5f, 0.5f)));
+            }
+    EXPECT_LT(lo, 0.2f);
+    EXPECT_GT(hi, 0.8f);
+}
+
+TEST(Cascades, TheLevelNoiseMovesTheBlendButKeepsTheFurnace)
+{
+    // The noise only moves which level a pixel's samples blend toward: in the furnace every level
+    // holds the same light, so the closed form and its tolerance hold.
+    CascadeSettings s = furnaceSettings();
+    s.levelNoise = 0.5;
+    const double expected = glm::pi<double>() * 0.75;
+    for (const auto& p : runFurnace(s, glm::dvec3(0.0)).pixels)
+        EXPECT_NEAR(p.x, expected, 0.035 * expected);
+    // In the open room it changes the answer (it does something), by less than the blend could.
+    const scene::RenderScene room = makeOpenRoom(glm::vec3(0.0f));
+    std::vector<glm::vec3> plain, noisy;
+    for (auto [noise, out] : {std::pair{0.0, &plain}, std::pair{0.5, &noisy}}) {
+        CascadeSettings settings = openRoomSettings();
+        settings.levelNoise = noise;
+        CascadeVolume volume(settings);
+        volume.voxelize(room, "room", glm::dvec3(0.0), 0, false);
+        volume.injectLight(room, "lights", 0, false);
+        volume.gatherCones(makeOpenRoomFloor(), *out);
+    }
+    double changed = 0.0, total = 0.0;
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+        changed += std::abs(double(noisy[i].x) - double(plain[i].x));
+        total += plain[i].x;
+    }
+    EXPECT_GT(changed, 0.0);
+    EXPECT_LT(changed, 0.5 * total);
+}
+
 TEST(Cascades, DeterministicForAnyThreadCount)
 {
     Image<glm::vec3> one, two;

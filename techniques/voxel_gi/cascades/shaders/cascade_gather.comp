@@ -27,7 +27,40 @@ layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, levels, resolution
     vec4 march;  // level-0 voxel size, tan(half-angle), start offset (voxels), step scale
     ivec4 flags; // y: max steps
+    ivec4 anchorCell; // xyz: the anchor in level-0 voxels
+    vec4 noise;       // x: level noise (of a level's radius)
 } pc;
+
+// pcg3d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020) to 24 bits, and
+// the value noise on the level-0 voxel lattice: CascadeVolume's computeValueNoise.
+float hashToUnit(uvec3 v)
+{
+    v = v * 1664525u + 1013904223u;
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    v ^= v >> 16u;
+    v.x += v.y * v.z;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    return float(v.x >> 8u) * (1.0 / 16777216.0);
+}
+
+float valueNoise(vec3 p)
+{
+    const vec3 u = p / pc.march.x;
+    const vec3 c = floor(u);
+    const vec3 f = u - c;
+    const ivec3 cell = pc.anchorCell.xyz + ivec3(c);
+    float n = 0.0;
+    for (int corner = 0; corner < 8; ++corner) {
+        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const float w = (d.x == 1 ? f.x : 1.0 - f.x) * (d.y == 1 ? f.y : 1.0 - f.y) *
+                        (d.z == 1 ? f.z : 1.0 - f.z);
+        n += w * hashToUnit(uvec3(cell + d));
+    }
+    return n;
+}
 
 float selectLevel(vec3 p, float diameter)
 {
@@ -39,7 +72,9 @@ float selectLevel(vec3 p, float diameter)
             continue;
         const float r = length(p - levels[i].centre.xyz) / radius;
         if (r <= 1.0) {
-            containing = float(i) + (i + 1 < n ? clamp((r - 0.5) / 0.5, 0.0, 1.0) : 0.0);
+            // The talk's "3D noise offset" on the blend; the containment test stays exact.
+            const float blend = pc.noise.x > 0.0 ? r + pc.noise.x * (2.0 * valueNoise(p) - 1.0) : r;
+            containing = float(i) + (i + 1 < n ? clamp((blend - 0.5) / 0.5, 0.0, 1.0) : 0.0);
             break;
         }
     }
