@@ -202,8 +202,7 @@ void checkName(const YamlFile& file, const YAML::Node& node, const std::string& 
         return;
     std::string msg = "unknown " + what + " '" + name + "'";
     const auto close = closestNames(name, valid);
-    if (!close.empty())
-        msg += "; did you mean " + joinList(close, "or") + "?";
+    msg += close.empty() ? std::string(".") : "; did you mean " + joinList(close, "or") + "?";
     msg += " Valid: " + (valid.empty() ? std::string("none") : joinList(valid)) + ".";
     file.fail(node, msg);
 }

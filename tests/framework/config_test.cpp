@@ -177,6 +177,18 @@ TEST(ConfigValidation, UnknownFamilySuggestsClosest)
     EXPECT_NE(err.find("Valid: isosurface, occlusion, voxel_gi"), std::string::npos) << err;
 }
 
+TEST(ConfigValidation, AnUnknownNameWithNothingCloseEndsItsSentence)
+{
+    const std::string err = errorOf(R"(base:
+  scene: sphere
+  techniques:
+    lighting: {technique: fake_mesher}
+)");
+    EXPECT_NE(err.find("unknown technique family 'lighting'. Valid: isosurface, occlusion, voxel_gi."),
+              std::string::npos)
+        << err;
+}
+
 TEST(ConfigValidation, NotYaml)
 {
     const std::string err = errorOf("base: [unclosed\n  scene: {\n");

@@ -10,7 +10,8 @@
 namespace rtlab::voxelgi {
 
 void PixelConeDispatch::create(gpu::Context& context, const std::filesystem::path& shader,
-                               const std::string& label, std::size_t pushConstantSize, const ConeSet& cones)
+                               const std::string& label, std::size_t pushConstantSize, const ConeSet& cones,
+                               std::uint32_t extraBuffers)
 {
     *this = PixelConeDispatch();
     mContext = &context;
@@ -19,7 +20,7 @@ void PixelConeDispatch::create(gpu::Context& context, const std::filesystem::pat
     gpu::ComputePipelineDesc desc;
     desc.name = label;
     desc.spirv = compiler.compileFile(shader).spirv;
-    for (std::uint32_t b = 0; b < 6; ++b)
+    for (std::uint32_t b = 0; b < 6 + extraBuffers; ++b)
         desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
     desc.pushConstantSize = std::uint32_t(pushConstantSize);
     mPipeline = context.createPipeline(desc);
@@ -62,14 +63,17 @@ std::size_t PixelConeDispatch::uploadPixels(const scene::GBuffer& gbuffer, const
 }
 
 std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& second,
-                                             const gpu::PushConstants& constants, std::vector<glm::vec3>& out)
+                                             const gpu::PushConstants& constants, std::vector<glm::vec3>& out,
+                                             const std::vector<gpu::Buffer*>& extra)
 {
+    std::vector<gpu::Binding> bindings = {
+        gpu::Binding::storageBuffer(0, first),      gpu::Binding::storageBuffer(1, second),
+        gpu::Binding::storageBuffer(2, mPositions), gpu::Binding::storageBuffer(3, mNormals),
+        gpu::Binding::storageBuffer(4, mOutput),    gpu::Binding::storageBuffer(5, mCones)};
+    for (std::size_t i = 0; i < extra.size(); ++i)
+        bindings.push_back(gpu::Binding::storageBuffer(std::uint32_t(6 + i), *extra[i]));
     const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
-        cmd.dispatch(mPipeline,
-                     {gpu::Binding::storageBuffer(0, first), gpu::Binding::storageBuffer(1, second),
-                      gpu::Binding::storageBuffer(2, mPositions), gpu::Binding::storageBuffer(3, mNormals),
-                      gpu::Binding::storageBuffer(4, mOutput), gpu::Binding::storageBuffer(5, mCones)},
-                     constants,
+        cmd.dispatch(mPipeline, bindings, constants,
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(mWidth), 8),
                                      gpu::computeGroupCount(std::uint64_t(mHeight), 8), 1},
                      mLabel.c_str());

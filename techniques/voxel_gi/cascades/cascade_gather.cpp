@@ -9,8 +9,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <chrono>
 #include <array>
+#include <chrono>
 #include <cmath>
 
 namespace rtlab::voxelgi {
@@ -157,50 +157,35 @@ glm::vec3 CascadeVolume::sampleFar(const Level& level, const glm::dvec3& p, int 
 // level blends between levels l0 and l0 + 1 (selectLevel): the pixel composites its near part
 // with each level's far cones at that level's split (the second near segment continues the
 // first) and blends the two, so the split moves smoothly with the start level.
-void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer)
 {
     invalidateFarCones();
     const int W = gbuffer.width, H = gbuffer.height, n = getLevelCount();
-    struct Start {
-        glm::dvec3 origin{0.0}, normal{0.0};
-        ConeMarchSettings march;
-        double level = -1.0;
-    };
-    std::vector<Start> starts(std::size_t(W) * std::size_t(H));
-    tbb::parallel_for(0, H, [&](int y) {
-        for (int x = 0; x < W; ++x) {
-            Start& s = starts[std::size_t(y) * std::size_t(W) + std::size_t(x)];
-            if (!preparePixel(gbuffer, x, y, s.origin, s.normal, s.march, &s.level))
-                s.level = -1.0;
-        }
-    });
-    // The voxel centres whose far cones the pixels read and that are not traced yet.
+    // The voxel centres whose far cones the pixels read (the trilinear neighbourhoods of their
+    // cone origins at their start levels) and that are not traced yet.
     std::vector<std::vector<std::uint8_t>> wanted(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i)
         wanted[std::size_t(i)].assign(mLevels[std::size_t(i)].farSlot.size(), 0);
-    const auto levelsOf = [n, &levels = mLevels](double l, int& l0, int& l1, double& frac) {
-        l0 = int(std::floor(l));
-        frac = l - l0;
-        l1 = frac > 0.0 && l0 + 1 < n && levels[std::size_t(l0) + 1].voxelized ? l0 + 1 : -1;
-    };
-    for (const Start& s : starts) {
-        if (s.level < 0.0)
-            continue;
-        int l0, l1;
-        double frac;
-        levelsOf(s.level, l0, l1, frac);
-        for (const int l : {l0, l1}) {
-            if (l < 0)
+    for (int y = 0; y < H; ++y)
+        for (int x = 0; x < W; ++x) {
+            glm::dvec3 origin, normal;
+            ConeMarchSettings march;
+            double start = -1.0;
+            if (!preparePixel(gbuffer, x, y, origin, normal, march, &start))
                 continue;
-            std::array<std::size_t, 8> voxels;
-            std::array<double, 8> weights;
-            getTrilinear(mLevels[std::size_t(l)].region, s.origin, voxels, weights);
-            for (int c = 0; c < 8; ++c)
-                if (weights[std::size_t(c)] != 0.0 &&
-                    mLevels[std::size_t(l)].farSlot[voxels[std::size_t(c)]] == ~0u)
-                    wanted[std::size_t(l)][voxels[std::size_t(c)]] = 1;
+            const auto [l0, l1, frac] = getStartLevels(start);
+            for (const int l : {l0, l1}) {
+                if (l < 0)
+                    continue;
+                std::array<std::size_t, 8> voxels;
+                std::array<double, 8> weights;
+                getTrilinear(mLevels[std::size_t(l)].region, origin, voxels, weights);
+                for (int c = 0; c < 8; ++c)
+                    if (weights[std::size_t(c)] != 0.0 &&
+                        mLevels[std::size_t(l)].farSlot[voxels[std::size_t(c)]] == ~0u)
+                        wanted[std::size_t(l)][voxels[std::size_t(c)]] = 1;
+            }
         }
-    }
     // Slots appended to each level's far buffer, in voxel order (deterministic).
     std::vector<std::pair<int, std::uint32_t>> toTrace;
     for (int i = 0; i < n; ++i) {
@@ -238,20 +223,40 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
     mCounters.farVoxelsCached = 0;
     for (const Level& level : mLevels)
         mCounters.farVoxelsCached += level.far.size() / kConeCount;
+}
 
+CascadeVolume::StartLevels CascadeVolume::getStartLevels(double start) const
+{
+    StartLevels s;
+    s.l0 = int(std::floor(start));
+    s.frac = start - s.l0;
+    s.l1 = s.frac > 0.0 && s.l0 + 1 < getLevelCount() && mLevels[std::size_t(s.l0) + 1].voxelized
+               ? s.l0 + 1
+               : -1;
+    return s;
+}
+
+void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+{
+    prepareFarCones(gbuffer);
+    const int W = gbuffer.width, H = gbuffer.height;
+    const GatheredSampler sampler{this, true};
+    struct Start {
+        glm::dvec3 origin{0.0}, normal{0.0};
+        ConeMarchSettings march;
+        double level = -1.0;
+    };
     // The pixels: near parts, composited with the far cones.
     const auto pixelStart = std::chrono::steady_clock::now();
-    out.assign(starts.size() * kConeCount, glm::vec3(0.0f));
+    out.assign(std::size_t(W) * std::size_t(H) * kConeCount, glm::vec3(0.0f));
     std::vector<std::uint64_t> stepsPerRow(std::size_t(H), 0), conesPerRow(std::size_t(H), 0);
     tbb::parallel_for(0, H, [&](int y) {
         for (int x = 0; x < W; ++x) {
             const std::size_t pixel = std::size_t(y) * std::size_t(W) + std::size_t(x);
-            const Start& s = starts[pixel];
-            if (s.level < 0.0)
+            Start s;
+            if (!preparePixel(gbuffer, x, y, s.origin, s.normal, s.march, &s.level))
                 continue;
-            int l0, l1;
-            double frac;
-            levelsOf(s.level, l0, l1, frac);
+            const auto [l0, l1, frac] = getStartLevels(s.level);
             const auto w = computeIrradianceWeights(mCones, s.normal);
             const double split0 = mSettings.farStart * mLevels[std::size_t(l0)].region.voxelSize;
             for (int k = 0; k < kConeCount; ++k) {

@@ -44,7 +44,7 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
     if (!mDispatch.isReadyFor(context)) {
         *this = CascadeGatherGpu();
         mDispatch.create(context, getShaderDir() / "cascade_gather.comp", kDispatchLabel,
-                         sizeof(GatherConstants), volume.getCones());
+                         sizeof(GatherConstants), volume.getCones(), 2);
     }
     mLastUploadBytes = 0;
     const int n = volume.getLevelCount();
@@ -96,8 +96,59 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
     // of whole level-0 voxels) as integer cells, positions relative to it.
     const glm::dvec3 anchorCells = glm::round(anchor / settings.voxelSize);
     constants.anchorCell = glm::ivec4(glm::ivec3(anchorCells), 0);
-    constants.noise = {float(settings.levelNoise), 0.0f, 0.0f, 0.0f};
-    mLastGpuMs = mDispatch.run(mLevels, mCombined, gpu::PushConstants(constants), out);
+    constants.noise = {float(settings.levelNoise), float(settings.farStart), 0.0f, 0.0f};
+    uploadFarCones(volume);
+    mLastGpuMs = mDispatch.run(mLevels, mCombined, gpu::PushConstants(constants), out,
+                               {&mFarSlots, &mFarCones});
+}
+
+void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)
+{
+    const CascadeSettings& settings = volume.getSettings();
+    const int n = volume.getLevelCount();
+    const std::size_t levelVoxels = std::size_t(settings.resolution) * std::size_t(settings.resolution) *
+                                    std::size_t(settings.resolution);
+    if (settings.farStart <= 0.0) {
+        // The shader does not read them; the bindings still need buffers.
+        if (!mFarSlots.isValid()) {
+            mFarSlots = mDispatch.makeBuffer(16, "cascades.far_slots");
+            mFarCones = mDispatch.makeBuffer(16, "cascades.far_cones");
+        }
+        return;
+    }
+    // Everything again when any level's far cones changed (new slots or invalidated).
+    std::vector<std::pair<std::uint64_t, std::size_t>> state(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const auto& level = volume.getLevel(i);
+        if (level.voxelized && level.farSlot.size() != levelVoxels)
+            throw Error("cascades: the Vulkan gather with split cones needs "
+                        "CascadeVolume::prepareFarCones first");
+        state[std::size_t(i)] = {level.farStamp, level.far.size()};
+    }
+    if (state == mUploadedFar && mFarSlots.isValid())
+        return;
+    std::vector<std::uint32_t> slots(levelVoxels * std::size_t(n), ~0u);
+    std::vector<glm::vec4> cones;
+    for (int i = 0; i < n; ++i) {
+        const auto& level = volume.getLevel(i);
+        const std::uint32_t base = std::uint32_t(cones.size() / kConeCount);
+        for (std::size_t v = 0; v < level.farSlot.size(); ++v)
+            if (level.farSlot[v] != ~0u)
+                slots[std::size_t(i) * levelVoxels + v] = base + level.farSlot[v];
+        for (const glm::vec3& c : level.far)
+            cones.emplace_back(c, 0.0f);
+    }
+    const std::size_t slotBytes = slots.size() * sizeof(std::uint32_t);
+    const std::size_t coneBytes = std::max<std::size_t>(cones.size(), 1) * sizeof(glm::vec4);
+    if (!mFarSlots.isValid() || mFarSlots.getSize() < slotBytes)
+        mFarSlots = mDispatch.makeBuffer(slotBytes, "cascades.far_slots");
+    if (!mFarCones.isValid() || mFarCones.getSize() < coneBytes)
+        mFarCones = mDispatch.makeBuffer(coneBytes, "cascades.far_cones");
+    mFarSlots.uploadSpan<std::uint32_t>(slots);
+    if (!cones.empty())
+        mFarCones.uploadSpan<glm::vec4>(cones);
+    mLastUploadBytes += slotBytes + cones.size() * sizeof(glm::vec4);
+    mUploadedFar = std::move(state);
 }
 
 } // namespace rtlab::voxelgi

@@ -19,7 +19,8 @@ public:
     static constexpr const char* kDispatchLabel = "cascades.gather";
 
     //! CascadeVolume::gatherCones on the GPU: the radiance of each of the 16 cones at every
-    //! pixel, [pixel * 16 + cone]. Needs pre-combined buffers (CascadeSettings::precombine).
+    //! pixel, [pixel * 16 + cone]. Needs pre-combined buffers (CascadeSettings::precombine); with
+    //! split cones (farStart > 0), volume.prepareFarCones(gbuffer) called first.
     void gatherCones(gpu::Context& context, const CascadeVolume& volume,
                      const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
     //! GPU time of the last dispatch, when the device has timestamps.
@@ -30,8 +31,13 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
+    // The far cones of split cone tracing (or placeholders when off), when they changed.
+    void uploadFarCones(const CascadeVolume& volume);
+
     PixelConeDispatch mDispatch;
     gpu::Buffer mLevels, mCombined;
+    gpu::Buffer mFarSlots, mFarCones; //!< split cones: slot per level voxel, radiance per slot
+    std::vector<std::pair<std::uint64_t, std::size_t>> mUploadedFar; //!< per level: stamp, slots
     std::size_t mCombinedLevelVoxels = 0;
     int mCombinedLevelCount = 0;
     std::vector<std::uint64_t> mUploadedStamps;

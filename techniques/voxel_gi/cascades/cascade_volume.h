@@ -113,6 +113,10 @@ public:
     //! every sample at the finest level holding it), E = pi * mean radiance; the directions are
     //! a stratified grid turned per pixel, so the result is deterministic.
     void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
+    //! With settings.farStart > 0: drops the far cones of levels whose sampled levels changed and
+    //! traces those the pixels of `gbuffer` need that are not traced yet (gatherCones calls it;
+    //! the Vulkan gather needs it called first).
+    void prepareFarCones(const scene::GBuffer& gbuffer);
     //! The lowest level the far cones of level `i` sample (their footprint at farStart, or the
     //! point's own level, whichever is coarser; never finer than this).
     int getFarDependency(int i) const;
@@ -168,6 +172,13 @@ private:
     // surface or lies outside every level.
     bool preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
                       glm::dvec3& n, ConeMarchSettings& march, double* startLevel = nullptr) const;
+    // The pixel's start levels: l0 = floor(start), l1 = l0 + 1 when it is voxelized and the
+    // start blends toward it (frac > 0), else -1.
+    struct StartLevels {
+        int l0 = 0, l1 = -1;
+        double frac = 0.0;
+    };
+    StartLevels getStartLevels(double start) const;
     // gatherCones with split near/far cones (settings.farStart > 0).
     void gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
     // Drops the far cones of every level whose sampled levels changed since they were traced.

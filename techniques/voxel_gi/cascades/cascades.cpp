@@ -41,13 +41,14 @@
 // With `far_start` > 0 the pixel cones are split ("Split Cone Trace"): each pixel traces its
 // cones up to far_start voxels of its start level, and the rest comes from far cones traced once
 // per voxel centre of the level (when a pixel first needs them, kept until a level they sample
-// changes) and interpolated trilinearly (cascade_gather.cpp gatherConesSplit; C++ gather only).
+// changes) and interpolated trilinearly (cascade_gather.cpp gatherConesSplit). The far cones
+// are traced in C++; the near parts and the composite run in the pixel gather (Vulkan or C++).
 // With `extrapolate` the pixels also gather the talk's extrapolated extra bounce ("Extra Magic",
 // cone_tracing.h extrapolateBounce) from the voxels' last two bounces: the technique then claims
 // bounces + 1 reflections and is measured against that ground truth.
 // `level_noise` adds the talk's "3D noise offset" to the start-level blend of the pixel cones (a
 // smooth value noise on the level-0 voxel lattice, the same bits in C++ and on Vulkan).
-// Not yet: voxelization and light injection on Vulkan, the far cones on Vulkan.
+// Not yet: voxelization, light injection and the far cones on Vulkan.
 //
 // Parameters
 // | name           | type  | default           | range / choices                       | unit   |
@@ -66,7 +67,7 @@
 // | solid          | bool  | true              |                                       |        |
 // | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
 // | trace_step     | int   | 4                 | [1, 8]                                | pixels |
-// | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]; device: cpu  | voxels of the pixel's start level |
+// | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]               | voxels of the pixel's start level |
 // | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
 // | level_noise    | float | 0                 | [0, 0.5]                              | of a level's radius |
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
@@ -133,8 +134,7 @@ public:
                       "normal-aware); 4 = the talk's quarter resolution, 1 = every pixel");
         schema.addFloat("far_start", 0.0, 0.0, 64.0, "voxels",
                         "split near/far cones: pixels trace up to this many voxels of their "
-                        "start level, far cones from the voxel centres do the rest (0 = off; "
-                        "needs device: cpu)");
+                        "start level, far cones from the voxel centres do the rest (0 = off)");
         schema.addBool("extrapolate", false,
                        "add the talk's extrapolated extra bounce (bounces + 1 reflections; "
                        "needs bounces >= 2)");
@@ -177,9 +177,6 @@ public:
         if (mSettings.extrapolate && mSettings.bounces < 2)
             throw Error("cascades: extrapolate needs bounces >= 2 (it extrapolates from the last "
                         "two), found bounces " + std::to_string(mSettings.bounces));
-        if (mSettings.farStart > 0.0 && mOnGpu)
-            throw Error("cascades: far_start > 0 needs device: cpu (the Vulkan gather traces "
-                        "whole cones)");
     }
 
     config::ParamSet effectiveParams() const override
@@ -258,8 +255,11 @@ public:
         irradiance = voxelgi::gatherConesReduced(
             *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
             input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                if (mGatheredOnGpu)
+                if (mGatheredOnGpu) {
+                    if (mSettings.farStart > 0.0)
+                        mVolume->prepareFarCones(reduced); // the far cones, in C++
                     mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
+                }
                 else
                     mVolume->gatherCones(reduced, cones);
             });
@@ -302,7 +302,7 @@ public:
                                                                          : std::nan("")},
                 {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
                 {"far_cones_traced", double(c.farConesTraced)},
-                {"far_cones_ms", mGatheredOnGpu ? std::nan("") : c.farConesMs},
+                {"far_cones_ms", c.farConesMs},
                 {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
                 {"far_voxels_cached", double(c.farVoxelsCached)}};
     }

@@ -34,7 +34,7 @@ std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>> compare(const glm::vec
     volume.voxelize(s, "k", glm::dvec3(camera.position), 0, false);
     volume.injectLight(s, "l", 0, false);
     std::vector<glm::vec3> cpuCones, gpuCones;
-    volume.gatherCones(g, cpuCones);
+    volume.gatherCones(g, cpuCones); // with split cones, this traces the far cones the GPU reads
     gpu::Context context;
     CascadeGatherGpu gather;
     gather.gatherCones(context, volume, g, gpuCones);
@@ -66,28 +66,44 @@ TEST(CascadesGpu, VulkanGatherMatchesFarFromTheOrigin)
     compare(glm::vec3(1e5f, 0.0f, -1e5f), testSettings());
 }
 
+// The GPU matches the C++ gather with `option` set, near the origin and at 1e5, and follows the
+// option: it changes the answer (against `plain`) far more than the two devices differ.
+void expectTheGpuFollows(const CascadeSettings& option, const CascadeSettings& plain)
+{
+    for (const glm::vec3 offset : {glm::vec3(0.0f), glm::vec3(1e5f, 0.0f, -1e5f)}) {
+        const auto [cpu, gpu] = compare(offset, option);
+        const auto [cpuPlain, gpuPlain] = compare(offset, plain);
+        double byOption = 0.0, byDevice = 0.0;
+        for (std::size_t i = 0; i < cpu.size(); ++i) {
+            byOption += glm::length(cpu[i] - cpuPlain[i]);
+            byDevice += glm::length(gpu[i] - cpu[i]);
+        }
+        EXPECT_GT(byOption, 0.0);
+        EXPECT_LT(byDevice, 0.01 * byOption);
+    }
+}
+
 TEST(CascadesGpu, VulkanGatherMatchesWithTheLevelNoise)
 {
     // The noise is hashed from world voxel cells on both sides (the GPU from the anchor's cell
-    // and relative positions), so the two agree near the origin and far from it.
-    // Voxels of 0.2 so that the room's pixels lie in level 1's blend band (radius 1.4 to 2.8 m).
-    CascadeSettings s = testSettings();
-    s.voxelSize = 0.2;
-    s.levelNoise = 0.3;
-    for (const glm::vec3 offset : {glm::vec3(0.0f), glm::vec3(1e5f, 0.0f, -1e5f)}) {
-        const auto [cpu, gpu] = compare(offset, s);
-        // The noise changes the answer far more than the two devices differ: the GPU follows it.
-        CascadeSettings plain = s;
-        plain.levelNoise = 0.0;
-        const auto [cpuPlain, gpuPlain] = compare(offset, plain);
-        double byNoise = 0.0, byDevice = 0.0;
-        for (std::size_t i = 0; i < cpu.size(); ++i) {
-            byNoise += glm::length(cpu[i] - cpuPlain[i]);
-            byDevice += glm::length(gpu[i] - cpu[i]);
-        }
-        EXPECT_GT(byNoise, 0.0);
-        EXPECT_LT(byDevice, 0.01 * byNoise);
-    }
+    // and relative positions). Voxels of 0.2 so that the room's pixels lie in level 1's blend
+    // band (radius 1.4 to 2.8 m).
+    CascadeSettings plain = testSettings();
+    plain.voxelSize = 0.2;
+    CascadeSettings noisy = plain;
+    noisy.levelNoise = 0.3;
+    expectTheGpuFollows(noisy, plain);
+}
+
+TEST(CascadesGpu, VulkanGatherMatchesWithSplitCones)
+{
+    // The far cones traced in C++ (prepareFarCones), the near parts and the composite on Vulkan;
+    // voxels of 0.2 so that pixels blend between two start levels too.
+    CascadeSettings plain = testSettings();
+    plain.voxelSize = 0.2;
+    CascadeSettings split = plain;
+    split.farStart = 2.5;
+    expectTheGpuFollows(split, plain);
 }
 
 } // namespace

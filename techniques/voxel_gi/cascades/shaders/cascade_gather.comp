@@ -22,13 +22,17 @@ layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
 layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
 layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
+// Split near/far cones (noise.y > 0): [level][voxel] the slot of the voxel centre's far cones
+// (~0u: not traced), and [slot][cone] their radiance (CascadeVolume::prepareFarCones).
+layout(std430, binding = 6) readonly buffer FarSlotBuffer { uint farSlots[]; };
+layout(std430, binding = 7) readonly buffer FarConeBuffer { vec4 farCones[]; };
 
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, levels, resolution
     vec4 march;  // level-0 voxel size, tan(half-angle), start offset (voxels), step scale
     ivec4 flags; // y: max steps
     ivec4 anchorCell; // xyz: the anchor in level-0 voxels
-    vec4 noise;       // x: level noise (of a level's radius)
+    vec4 noise;       // x: level noise (of a level's radius), y: far start (level voxels; 0: off)
 } pc;
 
 // pcg3d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020) to 24 bits, and
@@ -106,6 +110,69 @@ vec4 sampleLevel(int level, vec3 p, int cone)
     return acc;
 }
 
+// The far cones' radiance at p for cone `cone`, trilinear over level `level`'s voxel centres
+// (the lattice and clamping of sampleLevel).
+vec3 sampleFar(int level, vec3 p, int cone)
+{
+    const int R = pc.size.w;
+    vec3 c = (p - levels[level].origin.xyz) / levels[level].origin.w - 0.5;
+    c = clamp(c, vec3(0.0), vec3(float(R - 1)));
+    const ivec3 i0 = min(ivec3(floor(c)), ivec3(R - 2));
+    const vec3 t = c - vec3(i0);
+    const uint base = uint(level) * uint(R) * uint(R) * uint(R);
+    vec3 acc = vec3(0.0);
+    for (int corner = 0; corner < 8; ++corner) {
+        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
+        const float w = w3.x * w3.y * w3.z;
+        if (w == 0.0)
+            continue;
+        const ivec3 v = i0 + d;
+        const uint slot = farSlots[base + uint(v.x + R * (v.y + R * v.z))];
+        if (slot != 0xffffffffu)
+            acc += w * farCones[slot * 16u + uint(cone)].rgb;
+    }
+    return acc;
+}
+
+// One cone marched front to back from t0 until tMax: rgb the radiance, a the transmittance;
+// `escaped` when it left the cascade (voxelgi::marchCone).
+vec4 marchCone(vec3 origin, vec3 dir, int k, float t0, float tMax, out bool escaped)
+{
+    float occupied = 0.0;
+    vec3 light = vec3(0.0);
+    float t = t0;
+    escaped = false;
+    for (int step = 0; step < pc.flags.y; ++step) {
+        if (t >= tMax)
+            break;
+        const float diameter = 2.0 * t * pc.march.y;
+        const vec3 q = origin + t * dir;
+        const float l = selectLevel(q, diameter);
+        if (l < 0.0) {
+            escaped = true; // left the cascade: no indirect light from beyond
+            break;
+        }
+        const int l0 = int(floor(l));
+        const float frac = l - float(l0);
+        vec4 s = (1.0 - frac) * sampleLevel(l0, q, k);
+        if (frac > 0.0 && l0 + 1 < pc.size.z)
+            s += frac * sampleLevel(l0 + 1, q, k);
+        const float voxelSize = pc.march.x * exp2(l);
+        const float dt = pc.march.w * voxelSize;
+        const float a = clamp(s.a, 0.0, 1.0);
+        if (a > 0.0) {
+            const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
+            light += ((1.0 - occupied) * corrected / a) * s.rgb;
+            occupied += (1.0 - occupied) * corrected;
+            if (occupied >= 0.99)
+                break;
+        }
+        t += dt;
+    }
+    return vec4(light, 1.0 - occupied);
+}
+
 void main()
 {
     const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
@@ -129,35 +196,38 @@ void main()
     // The radiance of each cone above the surface; the pixel's irradiance weights, the
     // occlusion family's visibilities and the capsules are applied in the combine step
     // (families/voxel_gi/upsample.h), at full resolution.
+    // Split near/far cones: the start levels l0 and l1 = l0 + 1 when the start blends toward a
+    // voxelized l1 (CascadeVolume::getStartLevels and gatherConesSplit).
+    const float farStart = pc.noise.y;
+    const int l0 = int(floor(start));
+    const float frac = start - float(l0);
+    const bool two = frac > 0.0 && l0 + 1 < pc.size.z && levels[l0 + 1].centre.w > 0.0;
+    const float split0 = farStart * levels[l0].origin.w;
     for (int k = 0; k < 16; ++k) {
         if (dot(cones[k].xyz, n) <= 0.0)
             continue;
         const vec3 dir = cones[k].xyz;
-        float occupied = 0.0;
-        vec3 light = vec3(0.0);
-        float t = startDistance;
-        for (int step = 0; step < pc.flags.y; ++step) {
-            const float diameter = 2.0 * t * pc.march.y;
-            const vec3 q = origin + t * dir;
-            const float l = selectLevel(q, diameter);
-            if (l < 0.0)
-                break; // left the cascade: no indirect light from beyond
-            const int l0 = int(floor(l));
-            const float frac = l - float(l0);
-            vec4 s = (1.0 - frac) * sampleLevel(l0, q, k);
-            if (frac > 0.0 && l0 + 1 < pc.size.z)
-                s += frac * sampleLevel(l0 + 1, q, k);
-            const float voxelSize = pc.march.x * exp2(l);
-            const float dt = pc.march.w * voxelSize;
-            const float a = clamp(s.a, 0.0, 1.0);
-            if (a > 0.0) {
-                const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
-                light += ((1.0 - occupied) * corrected / a) * s.rgb;
-                occupied += (1.0 - occupied) * corrected;
-                if (occupied >= 0.99)
-                    break;
+        bool escaped;
+        vec3 light;
+        if (farStart <= 0.0) {
+            light = marchCone(origin, dir, k, startDistance, 1e30, escaped).rgb;
+        } else {
+            const vec4 a = marchCone(origin, dir, k, startDistance, split0, escaped);
+            vec3 la = a.rgb;
+            if (!escaped)
+                la += a.a * sampleFar(l0, origin, k);
+            light = la;
+            if (two) {
+                vec3 lb = a.rgb;
+                if (!escaped) {
+                    bool escapedB;
+                    const vec4 b = marchCone(origin, dir, k, split0, 2.0 * split0, escapedB);
+                    lb += a.a * b.rgb;
+                    if (!escapedB)
+                        lb += a.a * b.a * sampleFar(l0 + 1, origin, k);
+                }
+                light = la + frac * (lb - la);
             }
-            t += dt;
         }
         coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
     }
