@@ -114,27 +114,6 @@ void CascadeVolume::invalidateFarCones()
     }
 }
 
-void CascadeVolume::getTrilinear(const VoxelRegion& r, const glm::dvec3& p,
-                                 std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights)
-{
-    // The same lattice and clamping as sampleLevel: voxel centres, clamped to the region.
-    const int R = r.resolution;
-    glm::dvec3 c = (p - r.origin) / r.voxelSize - 0.5;
-    glm::ivec3 i0;
-    glm::dvec3 t;
-    for (int a = 0; a < 3; ++a) {
-        c[a] = std::clamp(c[a], 0.0, double(R - 1));
-        i0[a] = std::min(int(std::floor(c[a])), R - 2);
-        t[a] = c[a] - i0[a];
-    }
-    for (int corner = 0; corner < 8; ++corner) {
-        const int dx = corner & 1, dy = (corner >> 1) & 1, dz = (corner >> 2) & 1;
-        weights[std::size_t(corner)] =
-            (dx ? t.x : 1.0 - t.x) * (dy ? t.y : 1.0 - t.y) * (dz ? t.z : 1.0 - t.z);
-        voxels[std::size_t(corner)] = r.index(i0.x + dx, i0.y + dy, i0.z + dz);
-    }
-}
-
 glm::vec3 CascadeVolume::sampleFar(const Level& level, const glm::dvec3& p, int cone) const
 {
     std::array<std::size_t, 8> voxels;

@@ -524,11 +524,10 @@ double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter, bool noi
     return std::min(double(n - 1), std::max(containing, footprint));
 }
 
-void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int cone,
-                                const glm::dvec3& dir, bool gathered, float weight,
-                                ConeSample& out) const
+void CascadeVolume::getTrilinear(const VoxelRegion& r, const glm::dvec3& p,
+                                 std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights)
 {
-    const VoxelRegion& r = level.region;
+    // The lattice of the voxel centres, clamped to the region (sampleLevel, sampleFar).
     const int R = r.resolution;
     glm::dvec3 c = (p - r.origin) / r.voxelSize - 0.5;
     glm::ivec3 i0;
@@ -538,14 +537,28 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
         i0[a] = std::min(int(std::floor(c[a])), R - 2);
         t[a] = c[a] - i0[a];
     }
-    const bool combined = gathered && cone >= 0 && !level.combined.empty();
     for (int corner = 0; corner < 8; ++corner) {
         const int dx = corner & 1, dy = (corner >> 1) & 1, dz = (corner >> 2) & 1;
-        const double w = (dx ? t.x : 1.0 - t.x) * (dy ? t.y : 1.0 - t.y) * (dz ? t.z : 1.0 - t.z);
+        weights[std::size_t(corner)] =
+            (dx ? t.x : 1.0 - t.x) * (dy ? t.y : 1.0 - t.y) * (dz ? t.z : 1.0 - t.z);
+        voxels[std::size_t(corner)] = r.index(i0.x + dx, i0.y + dy, i0.z + dz);
+    }
+}
+
+void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int cone,
+                                const glm::dvec3& dir, bool gathered, float weight,
+                                ConeSample& out) const
+{
+    std::array<std::size_t, 8> voxels;
+    std::array<double, 8> weights;
+    getTrilinear(level.region, p, voxels, weights);
+    const bool combined = gathered && cone >= 0 && !level.combined.empty();
+    for (int corner = 0; corner < 8; ++corner) {
+        const double w = weights[std::size_t(corner)];
         if (w == 0.0)
             continue;
         const float fw = float(w) * weight;
-        const std::size_t vox = r.index(i0.x + dx, i0.y + dy, i0.z + dz);
+        const std::size_t vox = voxels[std::size_t(corner)];
         if (combined) {
             const glm::vec4& v = level.combined[vox * kConeCount + std::size_t(cone)];
             out.alpha += fw * v.a;
