@@ -259,9 +259,9 @@ public:
                     if (mSettings.farStart > 0.0)
                         mVolume->prepareFarCones(reduced); // the far cones, in C++
                     mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
-                }
-                else
+                } else {
                     mVolume->gatherCones(reduced, cones);
+                }
             });
     }
 
