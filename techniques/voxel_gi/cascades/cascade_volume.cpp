@@ -505,13 +505,13 @@ double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter, bool noi
             // From half the radius on, blend toward the next level ("Cascade selection"), with
             // the talk's "3D noise offset" on the blend (the containment test stays exact).
             double blend = r;
-            const glm::dvec3 u = p / mSettings.voxelSize;
-            const glm::dvec3 cell = glm::floor(u);
-            // (Cells beyond the int range, 2^30 voxels out, get no noise.)
-            if (noisy && mSettings.levelNoise > 0.0 &&
-                std::max({std::abs(cell.x), std::abs(cell.y), std::abs(cell.z)}) < 1073741824.0) {
-                blend += mSettings.levelNoise *
-                         (2.0 * double(computeValueNoise(glm::ivec3(cell), glm::vec3(u - cell))) - 1.0);
+            if (noisy && mSettings.levelNoise > 0.0) {
+                const glm::dvec3 u = p / mSettings.voxelSize;
+                const glm::dvec3 cell = glm::floor(u);
+                // (Cells beyond the int range, 2^30 voxels out, get no noise.)
+                if (std::max({std::abs(cell.x), std::abs(cell.y), std::abs(cell.z)}) < 1073741824.0)
+                    blend += mSettings.levelNoise *
+                             (2.0 * double(computeValueNoise(glm::ivec3(cell), glm::vec3(u - cell))) - 1.0);
             }
             containing = i + (i + 1 < n ? std::clamp((blend - 0.5) / 0.5, 0.0, 1.0) : 0.0);
             break;
