@@ -20,12 +20,31 @@ struct GatherConstants {
 };
 static_assert(sizeof(GatherConstants) == 80, "must match cascade_gather.comp");
 
-struct LevelDesc {
-    glm::vec4 origin{0.0f};
-    glm::vec4 centre{0.0f, 0.0f, 0.0f, -1.0f};
-};
-
 } // namespace
+
+glm::dvec3 getGpuAnchor(const CascadeVolume& volume)
+{
+    for (int i = volume.getLevelCount() - 1; i >= 0; --i)
+        if (volume.getLevel(i).voxelized)
+            return volume.getLevel(i).centre;
+    return glm::dvec3(0.0);
+}
+
+std::vector<GpuCascadeLevel> describeGpuLevels(const CascadeVolume& volume, const glm::dvec3& anchor,
+                                               bool needCombined)
+{
+    std::vector<GpuCascadeLevel> levels(static_cast<std::size_t>(volume.getLevelCount()));
+    for (int i = 0; i < volume.getLevelCount(); ++i) {
+        const auto& level = volume.getLevel(i);
+        if (!level.voxelized || (needCombined && level.combined.size() != level.region.getVoxelCount() * kConeCount))
+            continue;
+        const VoxelRegion& r = level.region;
+        levels[std::size_t(i)].origin = glm::vec4(glm::vec3(r.origin - anchor), float(r.voxelSize));
+        levels[std::size_t(i)].centre = glm::vec4(glm::vec3(level.centre - anchor),
+                                                  float((0.5 * r.resolution - 1.0) * r.voxelSize));
+    }
+    return levels;
+}
 
 std::filesystem::path CascadeGatherGpu::getShaderDir()
 {
@@ -58,21 +77,12 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
         mUploadedStamps.assign(std::size_t(n), 0);
     }
     // Everything relative to the coarsest voxelized level's centre (float precision far away).
-    glm::dvec3 anchor(0.0);
-    for (int i = n - 1; i >= 0; --i)
-        if (volume.getLevel(i).voxelized) {
-            anchor = volume.getLevel(i).centre;
-            break;
-        }
-    std::vector<LevelDesc> levels(static_cast<std::size_t>(n));
+    const glm::dvec3 anchor = getGpuAnchor(volume);
+    const std::vector<GpuCascadeLevel> levels = describeGpuLevels(volume, anchor, true);
     for (int i = 0; i < n; ++i) {
         const auto& level = volume.getLevel(i);
-        if (!level.voxelized || level.combined.size() != levelVoxels * kConeCount)
+        if (levels[std::size_t(i)].centre.w < 0.0f)
             continue;
-        const VoxelRegion& r = level.region;
-        levels[std::size_t(i)].origin = glm::vec4(glm::vec3(r.origin - anchor), float(r.voxelSize));
-        levels[std::size_t(i)].centre = glm::vec4(glm::vec3(level.centre - anchor),
-                                                  float((0.5 * r.resolution - 1.0) * r.voxelSize));
         const std::uint64_t stamp = std::max(level.voxelStamp, level.lightStamp);
         if (mUploadedStamps[std::size_t(i)] != stamp) {
             mCombined.upload(level.combined.data(), levelBytes, levelBytes * std::size_t(i));
@@ -80,9 +90,9 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
             mLastUploadBytes += levelBytes;
         }
     }
-    if (!mLevels.isValid() || mLevels.getSize() < levels.size() * sizeof(LevelDesc))
-        mLevels = mDispatch.makeBuffer(levels.size() * sizeof(LevelDesc), "cascades.levels");
-    mLevels.uploadSpan<LevelDesc>(levels);
+    if (!mLevels.isValid() || mLevels.getSize() < levels.size() * sizeof(GpuCascadeLevel))
+        mLevels = mDispatch.makeBuffer(levels.size() * sizeof(GpuCascadeLevel), "cascades.levels");
+    mLevels.uploadSpan<GpuCascadeLevel>(levels);
 
     const int w = gbuffer.width, h = gbuffer.height;
     mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);

@@ -14,6 +14,19 @@
 
 namespace rtlab::voxelgi {
 
+//! A level as the Vulkan passes see it (shaders/cascade_common.glsl `Level`).
+struct GpuCascadeLevel {
+    glm::vec4 origin{0.0f};                     //!< min corner relative to the anchor, voxel size
+    glm::vec4 centre{0.0f, 0.0f, 0.0f, -1.0f}; //!< centre, radius of its selection sphere (< 0: empty)
+};
+//! What positions on the GPU are relative to: the coarsest voxelized level's centre (float
+//! precision far from the origin).
+glm::dvec3 getGpuAnchor(const CascadeVolume& volume);
+//! The levels relative to `anchor`; those not voxelized, and with `needCombined` those without
+//! pre-combined buffers, are empty.
+std::vector<GpuCascadeLevel> describeGpuLevels(const CascadeVolume& volume, const glm::dvec3& anchor,
+                                               bool needCombined);
+
 class CascadeGatherGpu {
 public:
     static constexpr const char* kDispatchLabel = "cascades.gather";

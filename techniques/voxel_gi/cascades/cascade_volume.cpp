@@ -215,6 +215,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         level.alpha.assign(faces, 0.0f);
         for (auto& field : level.light)
             field.assign(faces, glm::vec3(0.0f));
+        level.lightRevision = ++mRevision;
         for (std::size_t f = 0; f < faces; ++f) {
             level.alpha[f] = level.grid.faces[f].a;
             level.light[kEmission][f] = level.alpha[f] * level.grid.emission[f];
@@ -319,7 +320,8 @@ bool CascadeVolume::isStale(int i) const
 }
 
 std::string CascadeVolume::injectLight(const scene::RenderScene& geometry,
-                                       const std::string& lightsKey, int frame, bool force)
+                                       const std::string& lightsKey, int frame, bool force,
+                                       const IrradianceGather& gather)
 {
     mCounters.levelsLit = 0;
     mCounters.surfaceVoxelsLit = 0;
@@ -343,7 +345,7 @@ std::string CascadeVolume::injectLight(const scene::RenderScene& geometry,
         for (int j = i; j < getLevelCount() && !inputsChanged; ++j)
             inputsChanged = mLevels[std::size_t(j)].voxelStamp > level.litStamp ||
                             (j > i && mLevels[std::size_t(j)].lightStamp > level.litStamp);
-        lightLevel(i, geometry);
+        lightLevel(i, geometry, gather);
         level.litCount = inputsChanged ? 1 : level.litCount + 1;
         level.litStamp = ++mStamp;
         level.lightStamp = level.litStamp;
@@ -355,7 +357,15 @@ std::string CascadeVolume::injectLight(const scene::RenderScene& geometry,
     return what;
 }
 
-void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry)
+InjectionSettings CascadeVolume::getInjectionSettings() const
+{
+    InjectionSettings settings;
+    settings.startOffset = mSettings.startOffset;
+    settings.march.stepScale = mSettings.stepScale;
+    return settings;
+}
+
+void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry, const IrradianceGather& gather)
 {
     Level& level = mLevels[std::size_t(i)];
     const FieldSampler sampler{this};
@@ -364,9 +374,7 @@ void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry)
     lights.hasSky = geometry.sky.emits();
     if (lights.hasSky)
         lights.skyPerCone = computeSkyPerCone(geometry.sky, mCones);
-    InjectionSettings settings;
-    settings.startOffset = mSettings.startOffset;
-    settings.march.stepScale = mSettings.stepScale;
+    const InjectionSettings settings = getInjectionSettings();
 
     const auto& surface = level.grid.surfaceVoxels;
     const int R = level.region.resolution;
@@ -374,19 +382,33 @@ void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry)
     // from the new direct buffer, then the second; the one-pass schedule traces once and writes
     // every buffer from the previous ones ("One Pass Strategy").
     const int passes = mSettings.onePass ? 1 : mSettings.bounces;
+    std::vector<FaceIrradiance> irradiance;
     for (int pass = 0; pass < passes; ++pass) {
+        // Every surface voxel's 16 cones and shadow cones, from the buffers as they are now.
+        irradiance.resize(surface.size());
+        if (gather) {
+            gather(i, lights, irradiance);
+            if (irradiance.size() != surface.size())
+                throw Error("cascades: the injection gave " + std::to_string(irradiance.size()) +
+                            " voxels' irradiance for " + std::to_string(surface.size()) + " surface voxels");
+        } else {
+            tbb::parallel_for(std::size_t(0), surface.size(), [&](std::size_t s) {
+                const std::uint32_t vox = surface[s];
+                const int x = int(vox % std::uint32_t(R));
+                const int y = int((vox / std::uint32_t(R)) % std::uint32_t(R));
+                const int z = int(vox / (std::uint32_t(R) * std::uint32_t(R)));
+                InjectionVoxel v;
+                v.centre = level.region.getVoxelCentre(x, y, z);
+                v.normal = level.grid.normal[vox];
+                v.voxelSize = level.region.voxelSize;
+                v.faces = &level.grid.faces[std::size_t(vox) * kFaceCount];
+                irradiance[s] = gatherVoxelIrradiance(sampler, v, mCones, lights, settings);
+            });
+        }
         std::array<std::vector<glm::vec3>, kFieldCount> next = level.light;
         tbb::parallel_for(std::size_t(0), surface.size(), [&](std::size_t s) {
             const std::uint32_t vox = surface[s];
-            const int x = int(vox % std::uint32_t(R));
-            const int y = int((vox / std::uint32_t(R)) % std::uint32_t(R));
-            const int z = int(vox / (std::uint32_t(R) * std::uint32_t(R)));
-            InjectionVoxel v;
-            v.centre = level.region.getVoxelCentre(x, y, z);
-            v.normal = level.grid.normal[vox];
-            v.voxelSize = level.region.voxelSize;
-            v.faces = &level.grid.faces[std::size_t(vox) * kFaceCount];
-            const FaceIrradiance e = gatherVoxelIrradiance(sampler, v, mCones, lights, settings);
+            const FaceIrradiance& e = irradiance[s];
             for (int face = 0; face < kFaceCount; ++face) {
                 const std::size_t f = std::size_t(vox) * kFaceCount + std::size_t(face);
                 const glm::vec4& g = level.grid.faces[f];
@@ -400,6 +422,7 @@ void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry)
         });
         level.light = std::move(next);
         propagateInward(level);
+        level.lightRevision = ++mRevision;
     }
     if (mSettings.precombine)
         updateCombined(level);

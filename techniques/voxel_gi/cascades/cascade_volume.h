@@ -19,6 +19,7 @@
 #include <glm/vec4.hpp>
 
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -67,6 +68,9 @@ public:
         bool voxelized = false;
         std::uint64_t voxelStamp = 0; //!< when it was last voxelized (CascadeVolume's counter)
         std::uint64_t lightStamp = 0; //!< when its light buffers last changed
+        //! Changes whenever the light buffers change, between the passes of one update too (what
+        //! a copy of them on the GPU is checked against).
+        std::uint64_t lightRevision = 0;
         std::uint64_t litStamp = 0;   //!< what it was lit against: every stamp up to this one
         int litCount = 0;             //!< one-pass updates since its inputs last changed
         glm::dvec3 centre{0.0};
@@ -101,10 +105,19 @@ public:
     //! a description of what it did ("" when nothing).
     std::string voxelize(const scene::RenderScene& geometry, const std::string& geometryKey,
                          const glm::dvec3& camera, int frame, bool force);
+    //! The irradiance per face of the surface voxels of a level (in the order of its
+    //! grid.surfaceVoxels) from the volume's current light buffers: what gatherVoxelIrradiance
+    //! gives over sampleFields with getInjectionSettings(), computed elsewhere (on Vulkan:
+    //! cascade_inject_gpu.h).
+    using IrradianceGather =
+        std::function<void(int level, const InjectionLights& lights, std::vector<FaceIrradiance>& out)>;
     //! Updates the light buffers of the due levels that are stale. `lightsKey` changes with the
-    //! lights and sky. Returns what it did ("" when nothing).
+    //! lights and sky. The surface voxels' cones are traced in C++ unless `gather` is given.
+    //! Returns what it did ("" when nothing).
     std::string injectLight(const scene::RenderScene& geometry, const std::string& lightsKey,
-                            int frame, bool force);
+                            int frame, bool force, const IrradianceGather& gather = {});
+    //! The march and offsets light injection uses.
+    InjectionSettings getInjectionSettings() const;
     //! The radiance each of the 16 cones gathers at every pixel of `gbuffer`, [pixel * 16 +
     //! cone]; 0 for cones below the surface and for pixels without a surface or outside the
     //! cascade.
@@ -196,7 +209,7 @@ private:
                   ConeSample& out) const;
     void sampleLevel(const Level& level, const glm::dvec3& p, int cone, const glm::dvec3& dir,
                      bool gathered, float weight, ConeSample& out) const;
-    void lightLevel(int level, const scene::RenderScene& geometry);
+    void lightLevel(int level, const scene::RenderScene& geometry, const IrradianceGather& gather);
     void propagateInward(Level& level);
     void updateCombined(Level& level);
     // The reflected light a pixel gathers from face f: bounces 1..B (and the extrapolated one).
@@ -217,6 +230,7 @@ private:
     std::vector<TriangleKey> mTriangles; //!< of the last geometry seen, sorted by hash
     std::string mTrianglesKey;
     std::uint64_t mStamp = 0;
+    std::uint64_t mRevision = 0; //!< Level::lightRevision's counter
     std::string mLightsKey;
     int mFirstFrame = -1;
     Counters mCounters;

@@ -36,8 +36,11 @@
 //    bentcone_ssdo (when that occlusion technique runs in the same frame) and by the characters'
 //    capsules tested against the cone ("Characters": not voxelized; families/voxel_gi/upsample.h).
 //
-// The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; the
-// voxelization and light injection run in C++ (TBB).
+// The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; so
+// do the cones of light injection (shaders/cascade_inject.comp, `inject_device: vulkan`: the 16
+// cones and the shadow cones of every surface voxel; the light buffers stay in C++, go up per
+// level when they changed, and the C++ side reflects, propagates inward and pre-combines the
+// irradiance that comes back). The voxelization runs in C++ (TBB).
 // With `far_start` > 0 the pixel cones are split ("Split Cone Trace"): each pixel traces its
 // cones up to far_start voxels of its start level, and the rest comes from far cones traced once
 // per voxel centre of the level (when a pixel first needs them, kept until a level they sample
@@ -48,7 +51,7 @@
 // bounces + 1 reflections and is measured against that ground truth.
 // `level_noise` adds the talk's "3D noise offset" to the start-level blend of the pixel cones (a
 // smooth value noise on the level-0 voxel lattice, the same bits in C++ and on Vulkan).
-// Not yet: voxelization, light injection and the far cones on Vulkan.
+// Not yet: voxelization and the far cones on Vulkan.
 //
 // Parameters
 // | name           | type  | default           | range / choices                       | unit   |
@@ -66,6 +69,7 @@
 // | precombine     | bool  | true              |                                       |        |
 // | solid          | bool  | true              |                                       |        |
 // | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
+// | inject_device  | enum  | cpu               | cpu, vulkan (light injection's cones) |        |
 // | trace_step     | int   | 4                 | [1, 8]                                | pixels |
 // | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]               | voxels of the pixel's start level |
 // | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
@@ -80,6 +84,7 @@
 //     voxel_gi: {technique: cascades, params: {levels: 6, resolution: 32, schedule: one_pass}}
 
 #include "cascade_gather_gpu.h"
+#include "cascade_inject_gpu.h"
 #include "cascade_volume.h"
 
 #include "core/error.h"
@@ -142,8 +147,10 @@ public:
                         "3D noise offset on the pixel cones' start-level blend (hides the "
                         "transition between levels)");
         schema.addEnum("device", "vulkan", {"vulkan", "cpu"},
-                       "where the pixel gather runs (Vulkan needs precombine; the voxel "
-                       "update runs on the CPU)");
+                       "where the pixel gather runs (Vulkan needs precombine)");
+        schema.addEnum("inject_device", "cpu", {"cpu", "vulkan"},
+                       "where light injection traces the surface voxels' cones (the light "
+                       "buffers stay on the CPU; voxelization runs on the CPU)");
         return schema;
     }
 
@@ -166,6 +173,7 @@ public:
         mSettings.precombine = p.getBool("precombine");
         mSettings.solid = p.getBool("solid");
         mOnGpu = p.getString("device") == "vulkan";
+        mInjectOnGpu = p.getString("inject_device") == "vulkan";
         mTraceStep = int(p.getInt("trace_step"));
         mSettings.farStart = p.getFloat("far_start");
         if (mSettings.farStart > 0.0 && mSettings.farStart < mSettings.startOffset)
@@ -195,6 +203,7 @@ public:
         p.set("precombine", mSettings.precombine);
         p.set("solid", mSettings.solid);
         p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
+        p.set("inject_device", std::string(mInjectOnGpu ? "vulkan" : "cpu"));
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("far_start", mSettings.farStart);
         p.set("extrapolate", mSettings.extrapolate);
@@ -237,8 +246,17 @@ public:
 
     plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
     {
+        // The surface voxels' cones on Vulkan when asked and a device is there.
+        mInjectedOnGpu = mInjectOnGpu && frame.gpu != nullptr;
+        mInjectGpu.resetCounters();
+        voxelgi::CascadeVolume::IrradianceGather onGpu;
+        if (mInjectedOnGpu)
+            onGpu = [&](int level, const voxelgi::InjectionLights& lights,
+                        std::vector<voxelgi::FaceIrradiance>& out) {
+                mInjectGpu.gatherIrradiance(*frame.gpu, *mVolume, level, lights, out);
+            };
         const std::string what = mVolume->injectLight(*frame.geometry, voxelgi::computeLightsKey(*frame.geometry),
-                                                      frame.frameIndex, frame.force);
+                                                      frame.frameIndex, frame.force, onGpu);
         if (what.empty())
             return plugin::VoxelGiStep::skipped(
                 "the due level's voxels, lights and coarser levels are unchanged since it was lit");
@@ -304,7 +322,13 @@ public:
                 {"far_cones_traced", double(c.farConesTraced)},
                 {"far_cones_ms", c.farConesMs},
                 {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
-                {"far_voxels_cached", double(c.farVoxelsCached)}};
+                {"far_voxels_cached", double(c.farVoxelsCached)},
+                {"inject_on_gpu", mInjectedOnGpu ? 1.0 : 0.0},
+                {"inject_gpu_ms", mInjectedOnGpu && mInjectGpu.getCounters().timed &&
+                                          mInjectGpu.getCounters().dispatches > 0
+                                      ? mInjectGpu.getCounters().gpuMs
+                                      : std::nan("")},
+                {"inject_upload_bytes", mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0}};
     }
 
 private:
@@ -312,7 +336,10 @@ private:
     double mVoxelSizeParam = 0.0;
     std::optional<voxelgi::CascadeVolume> mVolume;
     voxelgi::CascadeGatherGpu mGpu;
+    voxelgi::CascadeInjectGpu mInjectGpu;
     bool mOnGpu = true;
+    bool mInjectOnGpu = false;
+    bool mInjectedOnGpu = false;
     bool mGatheredOnGpu = false;
     int mTraceStep = 4;
 };

@@ -10,13 +10,8 @@
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
-struct Level {
-    vec4 origin; // xyz: min corner relative to the anchor, w: voxel size
-    vec4 centre; // xyz: centre relative to the anchor, w: radius of the sphere that selects it (< 0: empty)
-};
+#include "cascade_common.glsl"
 
-layout(std430, binding = 0) readonly buffer LevelBuffer { Level levels[]; };
-// [level][voxel][cone]: rgb = light premultiplied by the occupancy, a = occupancy.
 layout(std430, binding = 1) readonly buffer CombinedBuffer { vec4 combined[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
@@ -35,72 +30,22 @@ layout(push_constant) uniform Constants {
     vec4 noise;       // x: level noise (of a level's radius), y: far start (level voxels; 0: off)
 } pc;
 
-// pcg3d (Jarzynski and Olano, "Hash Functions for GPU Rendering", JCGT 2020) to 24 bits, and
-// the value noise on the level-0 voxel lattice: CascadeVolume's computeValueNoise.
-float hashToUnit(uvec3 v)
-{
-    v = v * 1664525u + 1013904223u;
-    v.x += v.y * v.z;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    v ^= v >> 16u;
-    v.x += v.y * v.z;
-    v.y += v.z * v.x;
-    v.z += v.x * v.y;
-    return float(v.x >> 8u) * (1.0 / 16777216.0);
-}
-
-float valueNoise(vec3 p)
-{
-    const vec3 u = p / pc.march.x;
-    const vec3 c = floor(u);
-    const vec3 f = u - c;
-    const ivec3 cell = pc.anchorCell.xyz + ivec3(c);
-    float n = 0.0;
-    for (int corner = 0; corner < 8; ++corner) {
-        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-        const float w = (d.x == 1 ? f.x : 1.0 - f.x) * (d.y == 1 ? f.y : 1.0 - f.y) *
-                        (d.z == 1 ? f.z : 1.0 - f.z);
-        n += w * hashToUnit(uvec3(cell + d));
-    }
-    return n;
-}
-
 float selectLevel(vec3 p, float diameter)
 {
-    const int n = pc.size.z;
-    float containing = -1.0;
-    for (int i = 0; i < n; ++i) {
-        const float radius = levels[i].centre.w;
-        if (radius <= 0.0)
-            continue;
-        const float r = length(p - levels[i].centre.xyz) / radius;
-        if (r <= 1.0) {
-            // The talk's "3D noise offset" on the blend; the containment test stays exact.
-            const float blend = pc.noise.x > 0.0 ? r + pc.noise.x * (2.0 * valueNoise(p) - 1.0) : r;
-            containing = float(i) + (i + 1 < n ? clamp((blend - 0.5) / 0.5, 0.0, 1.0) : 0.0);
-            break;
-        }
-    }
-    if (containing < 0.0)
-        return -1.0;
-    const float footprint = diameter > pc.march.x ? log2(diameter / pc.march.x) : 0.0;
-    return min(float(n - 1), max(containing, footprint));
+    return selectLevel(p, diameter, pc.size.z, pc.march.x, pc.noise.x, pc.anchorCell.xyz);
 }
 
 vec4 sampleLevel(int level, vec3 p, int cone)
 {
     const int R = pc.size.w;
-    vec3 c = (p - levels[level].origin.xyz) / levels[level].origin.w - 0.5;
-    c = clamp(c, vec3(0.0), vec3(float(R - 1)));
-    const ivec3 i0 = min(ivec3(floor(c)), ivec3(R - 2));
-    const vec3 t = c - vec3(i0);
+    ivec3 i0;
+    vec3 t;
+    getTrilinear(level, p, R, i0, t);
     const uint base = uint(level) * uint(R) * uint(R) * uint(R);
     vec4 acc = vec4(0.0);
     for (int corner = 0; corner < 8; ++corner) {
-        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-        const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
-        const float w = w3.x * w3.y * w3.z;
+        ivec3 d;
+        const float w = getCornerWeight(corner, t, d);
         if (w == 0.0)
             continue;
         const ivec3 v = i0 + d;
@@ -115,16 +60,14 @@ vec4 sampleLevel(int level, vec3 p, int cone)
 vec3 sampleFar(int level, vec3 p, int cone)
 {
     const int R = pc.size.w;
-    vec3 c = (p - levels[level].origin.xyz) / levels[level].origin.w - 0.5;
-    c = clamp(c, vec3(0.0), vec3(float(R - 1)));
-    const ivec3 i0 = min(ivec3(floor(c)), ivec3(R - 2));
-    const vec3 t = c - vec3(i0);
+    ivec3 i0;
+    vec3 t;
+    getTrilinear(level, p, R, i0, t);
     const uint base = uint(level) * uint(R) * uint(R) * uint(R);
     vec3 acc = vec3(0.0);
     for (int corner = 0; corner < 8; ++corner) {
-        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
-        const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
-        const float w = w3.x * w3.y * w3.z;
+        ivec3 d;
+        const float w = getCornerWeight(corner, t, d);
         if (w == 0.0)
             continue;
         const ivec3 v = i0 + d;
