@@ -7,7 +7,10 @@
 
 #include <glm/vec4.hpp>
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace rtlab::voxelgi {
@@ -37,6 +40,16 @@ gpu::Buffer& CascadeInjectGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, c
 void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolume& volume, int li,
                                         const InjectionLights& lights, std::vector<FaceIrradiance>& out)
 {
+    const auto start = std::chrono::steady_clock::now();
+    struct AddCallTime {
+        Counters& counters;
+        std::chrono::steady_clock::time_point start;
+        ~AddCallTime()
+        {
+            counters.callMs +=
+                std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        }
+    } addCallTime{mCounters, start};
     if (mContext != &context || !mPipeline.isValid()) {
         *this = CascadeInjectGpu();
         mContext = &context;
@@ -73,11 +86,11 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
         if (!level.voxelized || mUploadedRevision[std::size_t(i)] == level.lightRevision)
             continue;
         packed.resize(levelFaces * kFieldsPerFace);
-        for (std::size_t f = 0; f < levelFaces; ++f) {
+        tbb::parallel_for(std::size_t(0), levelFaces, [&](std::size_t f) {
             packed[f * 3 + 0] = glm::vec4(level.light[kEmission][f], level.alpha[f]);
             packed[f * 3 + 1] = glm::vec4(level.light[kDirect][f], 0.0f);
             packed[f * 3 + 2] = glm::vec4(level.light[kBounce1][f], 0.0f);
-        }
+        });
         mFields.upload(packed.data(), levelBytes, levelBytes * std::size_t(i));
         mUploadedRevision[std::size_t(i)] = level.lightRevision;
         mCounters.uploadBytes += levelBytes;
@@ -136,6 +149,7 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
                      kDispatchLabel);
     });
     ++mCounters.dispatches;
+    mCounters.submitMs += result.cpuSubmitMs;
     if (const auto ms = result.sumGpuMs(kDispatchLabel))
         mCounters.gpuMs += *ms;
     else

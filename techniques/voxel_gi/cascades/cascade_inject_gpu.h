@@ -24,11 +24,14 @@ public:
     //! centre).
     void gatherIrradiance(gpu::Context& context, const CascadeVolume& volume, int level,
                           const InjectionLights& lights, std::vector<FaceIrradiance>& out);
-    //! Sums over the calls since resetCounters: GPU time (when the device has timestamps; NaN
-    //! otherwise), bytes uploaded, dispatches.
+    //! Sums over the calls since resetCounters: GPU time (when the device has timestamps), wall
+    //! time from submit to completion, wall time of the whole call (packing, uploads, read-back),
+    //! bytes uploaded, dispatches.
     struct Counters {
         double gpuMs = 0.0;
         bool timed = true;
+        double submitMs = 0.0;
+        double callMs = 0.0;
         std::size_t uploadBytes = 0;
         int dispatches = 0;
     };

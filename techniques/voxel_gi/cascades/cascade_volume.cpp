@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <chrono>
 #include <cmath>
 #include <string>
 
@@ -325,6 +326,7 @@ std::string CascadeVolume::injectLight(const scene::RenderScene& geometry,
 {
     mCounters.levelsLit = 0;
     mCounters.surfaceVoxelsLit = 0;
+    mCounters.injectConesMs = 0.0;
     if (lightsKey != mLightsKey) {
         mLightsKey = lightsKey;
         for (Level& level : mLevels) {
@@ -386,6 +388,7 @@ void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry, const 
     for (int pass = 0; pass < passes; ++pass) {
         // Every surface voxel's 16 cones and shadow cones, from the buffers as they are now.
         irradiance.resize(surface.size());
+        const auto start = std::chrono::steady_clock::now();
         if (gather) {
             gather(i, lights, irradiance);
             if (irradiance.size() != surface.size())
@@ -405,6 +408,8 @@ void CascadeVolume::lightLevel(int i, const scene::RenderScene& geometry, const 
                 irradiance[s] = gatherVoxelIrradiance(sampler, v, mCones, lights, settings);
             });
         }
+        mCounters.injectConesMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         std::array<std::vector<glm::vec3>, kFieldCount> next = level.light;
         tbb::parallel_for(std::size_t(0), surface.size(), [&](std::size_t s) {
             const std::uint32_t vox = surface[s];

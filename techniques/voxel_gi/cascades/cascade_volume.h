@@ -177,6 +177,9 @@ public:
         std::size_t farVoxelsCached = 0; //!< voxel centres whose far cones are held after it
         double farConesMs = 0.0;   //!< wall time of the last gather's far cones
         double pixelConesMs = 0.0; //!< ... of its pixel cones (whole, or the near parts)
+        //! Wall time of the last injectLight's surface-voxel cones (C++, or the IrradianceGather
+        //! given, uploads and read-back included), every pass.
+        double injectConesMs = 0.0;
     };
     const Counters& getCounters() const { return mCounters; }
 

@@ -324,11 +324,14 @@ public:
                 {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
                 {"far_voxels_cached", double(c.farVoxelsCached)},
                 {"inject_on_gpu", mInjectedOnGpu ? 1.0 : 0.0},
+                {"inject_cones_ms", c.injectConesMs},
                 {"inject_gpu_ms", mInjectedOnGpu && mInjectGpu.getCounters().timed &&
                                           mInjectGpu.getCounters().dispatches > 0
                                       ? mInjectGpu.getCounters().gpuMs
                                       : std::nan("")},
-                {"inject_upload_bytes", mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0}};
+                {"inject_upload_bytes", mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0},
+                {"inject_dispatch_ms", mInjectedOnGpu ? mInjectGpu.getCounters().submitMs : std::nan("")},
+                {"inject_device_call_ms", mInjectedOnGpu ? mInjectGpu.getCounters().callMs : std::nan("")}};
     }
 
 private:
