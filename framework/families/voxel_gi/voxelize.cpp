@@ -73,11 +73,10 @@ struct Accumulators {
 
 } // namespace
 
-VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& region,
-                            const VoxelizeOptions& options, VoxelizeStats* stats)
+void checkVoxelizeArguments(const VoxelRegion& region, const VoxelizeOptions& options, int maxResolution)
 {
-    if (region.resolution < 1 || region.resolution > 1024)
-        throw Error("voxelize: resolution must be in [1, 1024], found " +
+    if (region.resolution < 1 || region.resolution > maxResolution)
+        throw Error("voxelize: resolution must be in [1, " + std::to_string(maxResolution) + "], found " +
                     std::to_string(region.resolution));
     if (!(region.voxelSize > 0.0) || !std::isfinite(region.voxelSize))
         throw Error("voxelize: voxel size must be positive and finite, found " +
@@ -88,13 +87,26 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
     if (options.supersampling < 1 || options.supersampling > 16)
         throw Error("voxelize: supersampling must be in [1, 16], found " +
                     std::to_string(options.supersampling));
+}
 
+void getVoxelizeBox(const VoxelRegion& region, const VoxelizeOptions& options, glm::ivec3& begin,
+                    glm::ivec3& end)
+{
+    const int R = region.resolution;
+    begin = glm::clamp(options.boxBegin, glm::ivec3(0), glm::ivec3(R));
+    end = options.boxEnd;
+    for (int a = 0; a < 3; ++a)
+        end[a] = std::clamp(end[a] < 0 ? R : end[a], begin[a], R);
+}
+
+VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& region,
+                            const VoxelizeOptions& options, VoxelizeStats* stats)
+{
+    checkVoxelizeArguments(region, options);
     const int R = region.resolution;
     const int S = options.supersampling;
-    glm::ivec3 boxBegin = glm::clamp(options.boxBegin, glm::ivec3(0), glm::ivec3(R));
-    glm::ivec3 boxEnd = options.boxEnd;
-    for (int a = 0; a < 3; ++a)
-        boxEnd[a] = std::clamp(boxEnd[a] < 0 ? R : boxEnd[a], boxBegin[a], R);
+    glm::ivec3 boxBegin, boxEnd;
+    getVoxelizeBox(region, options, boxBegin, boxEnd);
     const int N = R * S;
     const double h = region.voxelSize / S;
     const std::size_t voxelCount = region.getVoxelCount();
@@ -184,6 +196,7 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                 const int jr0 = std::max(row * S, int(std::ceil(minV / h - 0.5)));
                 const int jr1 = std::min(row * S + S - 1, int(std::floor(maxV / h - 0.5)));
                 const bool entering = tri.normal[a] < 0.0; // a ray along +a meets its front
+                const bool flat = tri.p[0][a] == tri.p[1][a] && tri.p[1][a] == tri.p[2][a];
                 const bool tlA = isTopLeft(C - B), tlB = isTopLeft(A - C), tlC = isTopLeft(B - A);
                 for (int j = jr0; j <= jr1; ++j)
                     for (int i = i0; i <= i1; ++i) {
@@ -195,10 +208,14 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                             continue;
                         if ((w0 == 0.0 && !tlA) || (w1 == 0.0 && !tlB) || (w2 == 0.0 && !tlC))
                             continue;
+                        // A triangle perpendicular to the axis lies at its corners' depth
+                        // exactly (coplanar faces then tie and are ordered by index).
                         const double sum = w0 + w1 + w2;
-                        const double depth = (w0 * tri.p[order[0]][a] + w1 * tri.p[order[1]][a] +
-                                              w2 * tri.p[order[2]][a]) /
-                                             sum;
+                        const double depth =
+                            flat ? tri.p[0][a]
+                                 : (w0 * tri.p[order[0]][a] + w1 * tri.p[order[1]][a] +
+                                    w2 * tri.p[order[2]][a]) /
+                                       sum;
                         rays[std::size_t(j - row * S) * std::size_t(N) + std::size_t(i)]
                             .push_back({depth, t, entering});
                         ++fragments;

@@ -96,6 +96,14 @@ struct VoxelizeStats {
     std::size_t solidVoxels = 0;
 };
 
+//! Throws rtlab::Error for a region with a resolution outside [1, maxResolution], a non-positive
+//! or non-finite voxel size or a non-finite origin, or supersampling outside [1, 16].
+void checkVoxelizeArguments(const VoxelRegion& region, const VoxelizeOptions& options,
+                            int maxResolution = 1024);
+//! The voxel box [begin, end) that options.boxBegin/boxEnd select in `region`.
+void getVoxelizeBox(const VoxelRegion& region, const VoxelizeOptions& options, glm::ivec3& begin,
+                    glm::ivec3& end);
+
 //! Voxelizes every triangle of `scene` that meets `region` (its box). Throws rtlab::Error for a
 //! region with resolution < 1 or a non-positive or non-finite voxel size, or a bad option.
 VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& region,
