@@ -23,8 +23,9 @@ struct ColumnConstants {
     glm::ivec4 boxBegin{0};
     glm::ivec4 boxEnd{0};
     glm::vec4 scale{0.0f};  // voxel size, ray spacing
+    glm::ivec4 ray{0};      // x: the ray within the column
 };
-static_assert(sizeof(ColumnConstants) == 64, "must match voxelize_columns.comp");
+static_assert(sizeof(ColumnConstants) == 80, "must match voxelize_columns.comp");
 
 struct ResolveConstants {
     glm::ivec4 size{0}; // R, S
@@ -144,8 +145,19 @@ VoxelGrid VoxelizerGpu::voxelize(gpu::Context& context, const scene::RenderScene
                 for (int cu = s.x; cu <= s.y; ++cu)
                     ++binStart[std::size_t(a) * columns + std::size_t(cu) + std::size_t(R) * std::size_t(cv) + 1];
         }
-    for (std::size_t i = 1; i < binStart.size(); ++i)
+    std::uint32_t largestBin = 0;
+    for (std::size_t i = 1; i < binStart.size(); ++i) {
+        largestBin = std::max(largestBin, binStart[i]);
         binStart[i] += binStart[i - 1];
+    }
+    if (largestBin > kMaxTrianglesPerColumn) {
+        // One invocation loops over its column's triangles; past this many, lavapipe's cap on
+        // loop iterations could cut it short: the exact C++ path.
+        ++mCounters.fallbacks;
+        mCounters.callMs +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        return voxelizeTriangles(scene, region, options, stats);
+    }
     std::vector<std::uint32_t> bins(binStart.back());
     {
         std::vector<std::uint32_t> fill(binStart.begin(), binStart.end() - 1);
@@ -197,13 +209,18 @@ VoxelGrid VoxelizerGpu::voxelize(gpu::Context& context, const scene::RenderScene
         cmd.fillBuffer(mFaceSums, 0u, "voxelize.clear");
         cmd.fillBuffer(mNormalSums, 0u, "voxelize.clear");
         cmd.fillBuffer(mStats, 0u, "voxelize.clear");
-        cmd.dispatch(mColumns,
-                     {gpu::Binding::storageBuffer(0, mTriangles), gpu::Binding::storageBuffer(1, mMaterials),
-                      gpu::Binding::storageBuffer(2, mBinStart), gpu::Binding::storageBuffer(3, mBins),
-                      gpu::Binding::storageBuffer(4, mCounts), gpu::Binding::storageBuffer(5, mFaceSums),
-                      gpu::Binding::storageBuffer(6, mNormalSums), gpu::Binding::storageBuffer(7, mStats)},
-                     gpu::PushConstants(columnConstants),
-                     gpu::GroupCount{gpu::computeGroupCount(3 * std::uint64_t(columns), 64), 1, 1}, kColumnsLabel);
+        // One dispatch per ray of the columns, in the C++ path's order (rows of rays, then rays).
+        for (int ray = 0; ray < S * S; ++ray) {
+            columnConstants.ray.x = ray;
+            cmd.dispatch(mColumns,
+                         {gpu::Binding::storageBuffer(0, mTriangles), gpu::Binding::storageBuffer(1, mMaterials),
+                          gpu::Binding::storageBuffer(2, mBinStart), gpu::Binding::storageBuffer(3, mBins),
+                          gpu::Binding::storageBuffer(4, mCounts), gpu::Binding::storageBuffer(5, mFaceSums),
+                          gpu::Binding::storageBuffer(6, mNormalSums), gpu::Binding::storageBuffer(7, mStats)},
+                         gpu::PushConstants(columnConstants),
+                         gpu::GroupCount{gpu::computeGroupCount(3 * std::uint64_t(columns), 64), 1, 1},
+                         kColumnsLabel);
+        }
         cmd.dispatch(mResolve,
                      {gpu::Binding::storageBuffer(0, mCounts), gpu::Binding::storageBuffer(1, mFaceSums),
                       gpu::Binding::storageBuffer(2, mNormalSums), gpu::Binding::storageBuffer(3, mFaces),

@@ -21,11 +21,16 @@ public:
     static constexpr const char* kResolveLabel = "voxelize.resolve";
     static constexpr int kMaxResolution = 128;
     static constexpr int kMaxFragmentsPerRay = 64; //!< must match voxelize_columns.comp
+    //! Columns (of one axis) holding more triangles than this are voxelized by the C++ path: an
+    //! invocation loops over its column's triangles, and lavapipe ends any invocation after
+    //! 65,535 loop iterations in all.
+    static constexpr std::uint32_t kMaxTrianglesPerColumn = 40000;
 
     //! voxelizeTriangles on Vulkan, for regions up to kMaxResolution voxels per axis (throws
     //! rtlab::Error beyond, and for the arguments voxelizeTriangles refuses). When some ray meets
-    //! more than kMaxFragmentsPerRay surfaces the region is voxelized by the C++ path instead
-    //! (counted in Counters::fallbacks).
+    //! more than kMaxFragmentsPerRay surfaces, or a column holds more than
+    //! kMaxTrianglesPerColumn triangles, the region is voxelized by the C++ path instead (counted
+    //! in Counters::fallbacks).
     VoxelGrid voxelize(gpu::Context& context, const scene::RenderScene& scene, const VoxelRegion& region,
                        const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
 

@@ -123,8 +123,11 @@ void CascadeVolume::trackGeometryChange(const scene::RenderScene& geometry,
 
 std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                                     const std::string& geometryKey, const glm::dvec3& camera,
-                                    int frame, bool force)
+                                    int frame, bool force, const Voxelizer& voxelizer)
 {
+    const auto voxelizeRegion = [&](const VoxelRegion& region, const VoxelizeOptions& options) {
+        return voxelizer ? voxelizer(geometry, region, options) : voxelizeTriangles(geometry, region, options);
+    };
     if (mFirstFrame < 0)
         mFirstFrame = frame;
     trackGeometryChange(geometry, geometryKey);
@@ -178,8 +181,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                                         .solid = mSettings.solid};
                 options.boxBegin = dugBegin;
                 options.boxEnd = dugEnd;
-                pasteVoxelBox(voxelizeTriangles(geometry, region, options), dugBegin, dugEnd,
-                            level.grid);
+                pasteVoxelBox(voxelizeRegion(region, options), dugBegin, dugEnd, level.grid);
                 finalizeVoxelGrid(level.grid);
             }
             why += boxVoxels > 0 ? ": re-voxelized the changed region (" + std::to_string(boxVoxels) +
@@ -197,7 +199,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                                         .solid = mSettings.solid};
                 options.boxBegin[a] = shift[a] > 0 ? R - shift[a] : 0;
                 options.boxEnd[a] = shift[a] > 0 ? R : -shift[a];
-                const VoxelGrid slab = voxelizeTriangles(geometry, region, options);
+                const VoxelGrid slab = voxelizeRegion(region, options);
                 pasteVoxelBox(slab, options.boxBegin, options.boxEnd, level.grid);
                 slabVoxels += std::size_t(std::abs(shift[a])) * std::size_t(R) * std::size_t(R);
             }
@@ -205,9 +207,8 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
             why += ", voxelized the new slabs (" + std::to_string(slabVoxels) + " of " +
                    std::to_string(region.getVoxelCount()) + " voxels)";
         } else {
-            level.grid = voxelizeTriangles(geometry, region,
-                                           {.supersampling = mSettings.supersampling,
-                                            .solid = mSettings.solid});
+            level.grid = voxelizeRegion(region, {.supersampling = mSettings.supersampling,
+                                                 .solid = mSettings.solid});
         }
         level.geometryKey = geometryKey;
         level.voxelized = true;

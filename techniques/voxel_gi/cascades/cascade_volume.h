@@ -101,10 +101,14 @@ public:
     //! Levels due at `frame` (every level on the first update or with oneLevelPerFrame off).
     std::vector<int> getDueLevels(int frame) const;
 
-    //! Re-voxelizes the due levels whose region or geometry changed (all when `force`). Returns
-    //! a description of what it did ("" when nothing).
+    //! What voxelizes a region (voxelize.h voxelizeTriangles, or on Vulkan voxelize_gpu.h).
+    using Voxelizer = std::function<VoxelGrid(const scene::RenderScene& geometry, const VoxelRegion& region,
+                                              const VoxelizeOptions& options)>;
+    //! Re-voxelizes the due levels whose region or geometry changed (all when `force`), with
+    //! `voxelizer` when given, else voxelizeTriangles. Returns a description of what it did (""
+    //! when nothing).
     std::string voxelize(const scene::RenderScene& geometry, const std::string& geometryKey,
-                         const glm::dvec3& camera, int frame, bool force);
+                         const glm::dvec3& camera, int frame, bool force, const Voxelizer& voxelizer = {});
     //! The irradiance per face of the surface voxels of a level (in the order of its
     //! grid.surfaceVoxels) from the volume's current light buffers: what gatherVoxelIrradiance
     //! gives over sampleFields with getInjectionSettings(), computed elsewhere (on Vulkan:

@@ -40,7 +40,10 @@
 // do the cones of light injection (shaders/cascade_inject.comp, `inject_device: vulkan`: the 16
 // cones and the shadow cones of every surface voxel; the light buffers stay in C++, go up per
 // level when they changed, and the C++ side reflects, propagates inward and pre-combines the
-// irradiance that comes back). The voxelization runs in C++ (TBB).
+// irradiance that comes back). The voxelization runs in C++ (TBB) or on Vulkan
+// (framework/families/voxel_gi/voxelize_gpu.h, `voxelize_device: vulkan`: the columns' rays and
+// the per-voxel resolve; the binning of triangles to columns and the solid fill's last step in
+// C++).
 // With `far_start` > 0 the pixel cones are split ("Split Cone Trace"): each pixel traces its
 // cones up to far_start voxels of its start level, and the rest comes from far cones traced once
 // per voxel centre of the level (when a pixel first needs them, kept until a level they sample
@@ -51,7 +54,7 @@
 // bounces + 1 reflections and is measured against that ground truth.
 // `level_noise` adds the talk's "3D noise offset" to the start-level blend of the pixel cones (a
 // smooth value noise on the level-0 voxel lattice, the same bits in C++ and on Vulkan).
-// Not yet: voxelization and the far cones on Vulkan.
+// Not yet: the far cones on Vulkan, and the light buffers kept on the GPU between updates.
 //
 // Parameters
 // | name           | type  | default           | range / choices                       | unit   |
@@ -70,6 +73,7 @@
 // | solid          | bool  | true              |                                       |        |
 // | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
 // | inject_device  | enum  | cpu               | cpu, vulkan (light injection's cones) |        |
+// | voxelize_device| enum  | cpu               | cpu, vulkan (resolution <= 128)       |        |
 // | trace_step     | int   | 4                 | [1, 8]                                | pixels |
 // | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]               | voxels of the pixel's start level |
 // | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
@@ -91,6 +95,7 @@
 #include "core/hash.h"
 #include "families/voxel_gi/upsample.h"
 #include "families/voxel_gi/voxel_gi.h"
+#include "families/voxel_gi/voxelize_gpu.h"
 
 #include <glm/geometric.hpp>
 
@@ -150,7 +155,9 @@ public:
                        "where the pixel gather runs (Vulkan needs precombine)");
         schema.addEnum("inject_device", "cpu", {"cpu", "vulkan"},
                        "where light injection traces the surface voxels' cones (the light "
-                       "buffers stay on the CPU; voxelization runs on the CPU)");
+                       "buffers stay on the CPU)");
+        schema.addEnum("voxelize_device", "cpu", {"cpu", "vulkan"},
+                       "where the levels are voxelized (Vulkan: resolution up to 128)");
         return schema;
     }
 
@@ -174,6 +181,7 @@ public:
         mSettings.solid = p.getBool("solid");
         mOnGpu = p.getString("device") == "vulkan";
         mInjectOnGpu = p.getString("inject_device") == "vulkan";
+        mVoxelizeOnGpu = p.getString("voxelize_device") == "vulkan";
         mTraceStep = int(p.getInt("trace_step"));
         mSettings.farStart = p.getFloat("far_start");
         if (mSettings.farStart > 0.0 && mSettings.farStart < mSettings.startOffset)
@@ -204,6 +212,7 @@ public:
         p.set("solid", mSettings.solid);
         p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
         p.set("inject_device", std::string(mInjectOnGpu ? "vulkan" : "cpu"));
+        p.set("voxelize_device", std::string(mVoxelizeOnGpu ? "vulkan" : "cpu"));
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("far_start", mSettings.farStart);
         p.set("extrapolate", mSettings.extrapolate);
@@ -237,8 +246,16 @@ public:
             }
             mVolume.emplace(s);
         }
-        const std::string what = mVolume->voxelize(*frame.geometry, frame.geometryKey,
-                                                   frame.cameraPosition, frame.frameIndex, frame.force);
+        mVoxelizedOnGpu = mVoxelizeOnGpu && frame.gpu != nullptr;
+        mVoxelizer.resetCounters();
+        voxelgi::CascadeVolume::Voxelizer onGpu;
+        if (mVoxelizedOnGpu)
+            onGpu = [&](const scene::RenderScene& geometry, const voxelgi::VoxelRegion& region,
+                        const voxelgi::VoxelizeOptions& options) {
+                return mVoxelizer.voxelize(*frame.gpu, geometry, region, options);
+            };
+        const std::string what = mVolume->voxelize(*frame.geometry, frame.geometryKey, frame.cameraPosition,
+                                                   frame.frameIndex, frame.force, onGpu);
         if (what.empty())
             return plugin::VoxelGiStep::skipped("no due level moved and the geometry is unchanged");
         return plugin::VoxelGiStep::done(what);
@@ -331,7 +348,11 @@ public:
                                       : std::nan("")},
                 {"inject_upload_bytes", mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0},
                 {"inject_dispatch_ms", mInjectedOnGpu ? mInjectGpu.getCounters().submitMs : std::nan("")},
-                {"inject_device_call_ms", mInjectedOnGpu ? mInjectGpu.getCounters().callMs : std::nan("")}};
+                {"inject_device_call_ms", mInjectedOnGpu ? mInjectGpu.getCounters().callMs : std::nan("")},
+                {"voxelize_on_gpu", mVoxelizedOnGpu ? 1.0 : 0.0},
+                {"voxelize_dispatch_ms", mVoxelizedOnGpu ? mVoxelizer.getCounters().submitMs : std::nan("")},
+                {"voxelize_device_call_ms", mVoxelizedOnGpu ? mVoxelizer.getCounters().callMs : std::nan("")},
+                {"voxelize_fallbacks", mVoxelizedOnGpu ? double(mVoxelizer.getCounters().fallbacks) : 0.0}};
     }
 
 private:
@@ -340,6 +361,9 @@ private:
     std::optional<voxelgi::CascadeVolume> mVolume;
     voxelgi::CascadeGatherGpu mGpu;
     voxelgi::CascadeInjectGpu mInjectGpu;
+    voxelgi::VoxelizerGpu mVoxelizer;
+    bool mVoxelizeOnGpu = false;
+    bool mVoxelizedOnGpu = false;
     bool mOnGpu = true;
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;

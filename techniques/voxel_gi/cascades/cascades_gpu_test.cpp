@@ -7,6 +7,7 @@
 
 #include "families/voxel_gi/voxel_gi_gpu_parity.h"
 #include "families/voxel_gi/voxel_gi_test_scenes.h"
+#include "families/voxel_gi/voxelize_gpu.h"
 #include "gpu/context.h"
 #include "reference/reference.h"
 
@@ -259,6 +260,68 @@ TEST(CascadesGpu, VulkanInjectionGivesTheCppLightBuffers)
         gpu.gatherCones(g, fromGpu);
         expectGpuConesMatchCpu(fromCpu, fromGpu, g, cpu.getCones().halfAngle);
     }
+}
+
+} // namespace
+
+namespace {
+
+// The same voxels up to float rounding: the scenes below are axis-aligned boxes, which the
+// Vulkan voxelizer gives exactly as C++ does but for float sums (voxelize_gpu_test.cpp).
+void expectSameVoxelsUpToRounding(const CascadeVolume& a, const CascadeVolume& b)
+{
+    for (int level = 0; level < a.getLevelCount(); ++level) {
+        const VoxelGrid& x = a.getLevel(level).grid;
+        const VoxelGrid& y = b.getLevel(level).grid;
+        ASSERT_TRUE(x.region == y.region) << level;
+        EXPECT_EQ(x.flags, y.flags) << level;
+        EXPECT_EQ(x.surfaceVoxels, y.surfaceVoxels) << level;
+        double worst = 0.0;
+        for (std::size_t i = 0; i < x.faces.size(); ++i) {
+            EXPECT_EQ(x.faces[i].a, y.faces[i].a);
+            worst = std::max({worst, double(glm::length(glm::vec3(x.faces[i]) - glm::vec3(y.faces[i]))),
+                              double(glm::length(x.emission[i] - y.emission[i]))});
+        }
+        EXPECT_LE(worst, 1e-5) << level;
+    }
+}
+
+// The levels voxelized on Vulkan through their updates (first voxelization, a scroll that
+// voxelizes only the new slabs, an edit that re-voxelizes only the changed region) hold the
+// voxels the C++ path gives.
+TEST(CascadesGpu, VulkanVoxelizationScrollsAndEditsLikeTheCppOne)
+{
+    const auto make = [](float x) {
+        scene::RenderScene s;
+        const auto m = addMaterial(s, {0.6f, 0.5f, 0.4f}, {0.1f, 0.0f, 0.0f});
+        addRoom(s, glm::vec3(-0.4f), glm::vec3(0.4f), 0.1f, m);
+        addBox(s, glm::vec3(x, -0.4f, -0.2f), glm::vec3(x + 0.13f, -0.27f, -0.05f), m);
+        return s;
+    };
+    const scene::RenderScene before = make(-0.2f), after = make(-0.14f);
+    CascadeSettings settings = testSettings();
+    settings.resolution = 16;
+    settings.voxelSize = 1.0 / 16.0;
+    gpu::Context context;
+    VoxelizerGpu voxelizer;
+    const CascadeVolume::Voxelizer onGpu = [&](const scene::RenderScene& g, const VoxelRegion& r,
+                                               const VoxelizeOptions& o) {
+        return voxelizer.voxelize(context, g, r, o);
+    };
+    CascadeVolume cpu(settings), gpu(settings);
+    const glm::dvec3 a(0.0), b(3.0 / 16.0 + 0.01, 0.0, -1.0 / 16.0);
+    cpu.voxelize(before, "before", a, 0, false);
+    gpu.voxelize(before, "before", a, 0, false, onGpu);
+    expectSameVoxelsUpToRounding(cpu, gpu);
+    EXPECT_NE(gpu.voxelize(before, "before", b, 1, false, onGpu).find("voxelized the new slabs"), std::string::npos);
+    cpu.voxelize(before, "before", b, 1, false);
+    expectSameVoxelsUpToRounding(cpu, gpu);
+    EXPECT_NE(gpu.voxelize(after, "after", b, 2, false, onGpu).find("re-voxelized the changed region"),
+              std::string::npos);
+    cpu.voxelize(after, "after", b, 2, false);
+    expectSameVoxelsUpToRounding(cpu, gpu);
+    EXPECT_GE(voxelizer.getCounters().calls, 4);
+    EXPECT_EQ(voxelizer.getCounters().fallbacks, 0);
 }
 
 } // namespace
