@@ -27,10 +27,19 @@ public:
                 std::size_t pushConstantSize, const ConeSet& cones, std::uint32_t extraBuffers = 0);
     //! Uploads the pixels' positions relative to `anchor` and their normals; returns the bytes.
     std::size_t uploadPixels(const scene::GBuffer& gbuffer, const glm::dvec3& anchor);
-    //! Runs the pipeline over the uploaded pixels with the structure's two buffers and reads the
-    //! cone radiances back into `out`; returns the dispatch's GPU time when the device has one.
+    //! Uploads points to trace cones from instead of pixels (a structure's own points, such as
+    //! voxel centres; their own buffers, laid out as rows of 256 "pixels", w = 0 past the last):
+    //! positions (w = 1) and a second vec4 per point whose meaning is the shader's; returns the
+    //! bytes.
+    std::size_t uploadPoints(const std::vector<glm::vec4>& positions, const std::vector<glm::vec4>& second);
+    //! The layout of the uploaded points: "pixels" per row, rows.
+    glm::ivec2 getPointsSize() const { return {mPoints.width, mPoints.height}; }
+    //! Runs the pipeline over the uploaded pixels (or, with `points`, the uploaded points) with
+    //! the structure's two buffers and reads the cone radiances back into `out` (one row of 16
+    //! per pixel or point); returns the dispatch's GPU time when the device has one.
     std::optional<double> run(gpu::Buffer& first, gpu::Buffer& second, const gpu::PushConstants& constants,
-                              std::vector<glm::vec3>& out, const std::vector<gpu::Buffer*>& extra = {});
+                              std::vector<glm::vec3>& out, const std::vector<gpu::Buffer*>& extra = {},
+                              bool points = false);
     //! A storage buffer of at least `bytes` (16 at least) named `name`.
     gpu::Buffer makeBuffer(std::size_t bytes, const char* name);
 
@@ -38,9 +47,16 @@ private:
     gpu::Context* mContext = nullptr;
     gpu::ComputePipeline mPipeline;
     std::string mLabel;
-    gpu::Buffer mPositions, mNormals, mOutput, mCones;
-    int mWidth = 0, mHeight = 0;
-    std::size_t mPixels = 0;
+    gpu::Buffer mCones;
+    // What the cones start from: the pixels, or points.
+    struct Starts {
+        gpu::Buffer positions, normals, output;
+        int width = 0, height = 0;
+        std::size_t count = 0;    //!< entries read back
+        std::size_t capacity = 0; //!< entries the buffers hold
+    };
+    Starts mPixels, mPoints;
+    void reserve(Starts& starts, std::size_t entries, const char* what);
 };
 
 } // namespace rtlab::voxelgi

@@ -3,6 +3,7 @@
 
 #include "cascade_volume.h"
 
+#include "core/error.h"
 #include "families/voxel_gi/pixel_cones.h"
 #include "families/voxel_gi/upsample.h"
 
@@ -136,7 +137,14 @@ glm::vec3 CascadeVolume::sampleFar(const Level& level, const glm::dvec3& p, int 
 // level blends between levels l0 and l0 + 1 (selectLevel): the pixel composites its near part
 // with each level's far cones at that level's split (the second near segment continues the
 // first) and blends the two, so the split moves smoothly with the start level.
-void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer)
+glm::dvec3 CascadeVolume::getVoxelCentre(int level, std::uint32_t vox) const
+{
+    const VoxelRegion& r = mLevels[std::size_t(level)].region;
+    const std::uint32_t R = std::uint32_t(r.resolution);
+    return r.getVoxelCentre(int(vox % R), int((vox / R) % R), int(vox / (R * R)));
+}
+
+void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarConeTracer& tracer)
 {
     invalidateFarCones();
     const int W = gbuffer.width, H = gbuffer.height, n = getLevelCount();
@@ -179,14 +187,25 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer)
     }
     const GatheredSampler sampler{this, true};
     const auto farStart = std::chrono::steady_clock::now();
-    tbb::parallel_for(std::size_t(0), toTrace.size(), [&](std::size_t k) {
+    if (tracer && !toTrace.empty()) {
+        std::vector<glm::vec3> traced;
+        tracer(toTrace, traced);
+        if (traced.size() != toTrace.size() * kConeCount)
+            throw Error("cascades: the far-cone tracer gave " + std::to_string(traced.size()) +
+                        " cones for " + std::to_string(toTrace.size() * kConeCount));
+        for (std::size_t k = 0; k < toTrace.size(); ++k) {
+            const auto [i, vox] = toTrace[k];
+            Level& level = mLevels[std::size_t(i)];
+            for (int c = 0; c < kConeCount; ++c)
+                level.far[std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c)] =
+                    traced[k * kConeCount + std::size_t(c)];
+        }
+    }
+    tbb::parallel_for(std::size_t(0), tracer ? std::size_t(0) : toTrace.size(), [&](std::size_t k) {
         const auto [i, vox] = toTrace[k];
         Level& level = mLevels[std::size_t(i)];
         const VoxelRegion& r = level.region;
-        const int R = r.resolution;
-        const glm::dvec3 centre = r.getVoxelCentre(int(vox % std::uint32_t(R)),
-                                                   int((vox / std::uint32_t(R)) % std::uint32_t(R)),
-                                                   int(vox / (std::uint32_t(R) * std::uint32_t(R))));
+        const glm::dvec3 centre = getVoxelCentre(i, vox);
         ConeMarchSettings march;
         march.tanHalfAngle = mCones.tanHalfAngle;
         march.stepScale = mSettings.stepScale;

@@ -53,8 +53,7 @@ std::filesystem::path CascadeGatherGpu::getShaderDir()
     return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
 }
 
-void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& volume,
-                                   const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume& volume)
 {
     const CascadeSettings& settings = volume.getSettings();
     if (!settings.precombine)
@@ -65,7 +64,6 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
         mDispatch.create(context, getShaderDir() / "cascade_gather.comp", kDispatchLabel,
                          sizeof(GatherConstants), volume.getCones(), 2);
     }
-    mLastUploadBytes = 0;
     const int n = volume.getLevelCount();
     const int R = settings.resolution;
     const std::size_t levelVoxels = std::size_t(R) * std::size_t(R) * std::size_t(R);
@@ -93,23 +91,62 @@ void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& v
     if (!mLevels.isValid() || mLevels.getSize() < levels.size() * sizeof(GpuCascadeLevel))
         mLevels = mDispatch.makeBuffer(levels.size() * sizeof(GpuCascadeLevel), "cascades.levels");
     mLevels.uploadSpan<GpuCascadeLevel>(levels);
+    return anchor;
+}
 
-    const int w = gbuffer.width, h = gbuffer.height;
-    mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
+namespace {
 
+GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anchor, glm::ivec2 size, bool far)
+{
+    const CascadeSettings& settings = volume.getSettings();
     GatherConstants constants;
-    constants.size = {w, h, n, R};
+    constants.size = {size.x, size.y, volume.getLevelCount(), settings.resolution};
     constants.march = {float(settings.voxelSize), float(volume.getCones().tanHalfAngle),
                        float(settings.startOffset), float(settings.stepScale)};
-    constants.flags = {0, 1024, 0, 0};
+    constants.flags = {0, 1024, far ? 1 : 0, 0};
     // The noise lattice is the world's level-0 voxels: the anchor (a level centre, on a lattice
     // of whole level-0 voxels) as integer cells, positions relative to it.
     const glm::dvec3 anchorCells = glm::round(anchor / settings.voxelSize);
     constants.anchorCell = glm::ivec4(glm::ivec3(anchorCells), 0);
     constants.noise = {float(settings.levelNoise), float(settings.farStart), 0.0f, 0.0f};
+    return constants;
+}
+
+} // namespace
+
+void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& volume,
+                                   const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+{
+    mLastUploadBytes = 0;
+    const glm::dvec3 anchor = prepare(context, volume);
+    mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
     uploadFarCones(volume);
-    mLastGpuMs = mDispatch.run(mLevels, mCombined, gpu::PushConstants(constants), out,
-                               {&mFarSlots, &mFarCones});
+    mLastGpuMs = mDispatch.run(mLevels, mCombined,
+                               gpu::PushConstants(makeConstants(volume, anchor, {gbuffer.width, gbuffer.height}, false)),
+                               out, {&mFarSlots, &mFarCones});
+}
+
+void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume& volume,
+                                     const std::vector<std::pair<int, std::uint32_t>>& centres,
+                                     std::vector<glm::vec3>& out)
+{
+    mLastUploadBytes = 0;
+    const glm::dvec3 anchor = prepare(context, volume);
+    std::vector<glm::vec4> positions(centres.size()), sizes(centres.size());
+    for (std::size_t k = 0; k < centres.size(); ++k) {
+        const auto [level, voxel] = centres[k];
+        positions[k] = glm::vec4(glm::vec3(volume.getVoxelCentre(level, voxel) - anchor), 1.0f);
+        sizes[k] = glm::vec4(0.0f, 0.0f, 0.0f, float(volume.getLevel(level).region.voxelSize));
+    }
+    mLastUploadBytes += mDispatch.uploadPoints(positions, sizes);
+    // The far-cone buffers are not read in this mode; the bindings need buffers.
+    if (!mFarSlots.isValid()) {
+        mFarSlots = mDispatch.makeBuffer(16, "cascades.far_slots");
+        mFarCones = mDispatch.makeBuffer(16, "cascades.far_cones");
+    }
+    mLastGpuMs = mDispatch.run(mLevels, mCombined,
+                               gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true)),
+                               out, {&mFarSlots, &mFarCones}, true);
 }
 
 void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)

@@ -36,6 +36,10 @@ public:
     //! split cones (farStart > 0), volume.prepareFarCones(gbuffer) called first.
     void gatherCones(gpu::Context& context, const CascadeVolume& volume,
                      const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! CascadeVolume::FarConeTracer on Vulkan: the 16 far cones of each voxel centre, through
+    //! the same pre-combined buffers (uploaded when they changed), [centre * 16 + cone].
+    void traceFarCones(gpu::Context& context, const CascadeVolume& volume,
+                       const std::vector<std::pair<int, std::uint32_t>>& centres, std::vector<glm::vec3>& out);
     //! GPU time of the last dispatch, when the device has timestamps.
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     //! Bytes uploaded by the last call (levels that changed, pixels).
@@ -44,6 +48,9 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
+    // The pipeline for `context`, the levels' descriptors and the pre-combined buffers of the
+    // levels that changed; returns the anchor positions are relative to.
+    glm::dvec3 prepare(gpu::Context& context, const CascadeVolume& volume);
     // The far cones of split cone tracing (or placeholders when off), when they changed.
     void uploadFarCones(const CascadeVolume& volume);
 

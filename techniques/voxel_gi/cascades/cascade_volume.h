@@ -130,10 +130,16 @@ public:
     //! every sample at the finest level holding it), E = pi * mean radiance; the directions are
     //! a stratified grid turned per pixel, so the result is deterministic.
     void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
+    //! Far cones to trace: (level, voxel) of each centre; out gets the 16 cones' radiance of
+    //! each, [centre * 16 + cone] (on Vulkan: CascadeGatherGpu::traceFarCones).
+    using FarConeTracer = std::function<void(const std::vector<std::pair<int, std::uint32_t>>& centres,
+                                             std::vector<glm::vec3>& out)>;
     //! With settings.farStart > 0: drops the far cones of levels whose sampled levels changed and
-    //! traces those the pixels of `gbuffer` need that are not traced yet (gatherCones calls it;
-    //! the Vulkan gather needs it called first).
-    void prepareFarCones(const scene::GBuffer& gbuffer);
+    //! traces those the pixels of `gbuffer` need that are not traced yet, in C++ or with
+    //! `tracer` (gatherCones calls it; the Vulkan gather needs it called first).
+    void prepareFarCones(const scene::GBuffer& gbuffer, const FarConeTracer& tracer = {});
+    //! The world position of voxel `voxel`'s centre in level `level`.
+    glm::dvec3 getVoxelCentre(int level, std::uint32_t voxel) const;
     //! The lowest level the far cones of level `i` sample (their footprint at farStart, or the
     //! point's own level, whichever is coarser; never finer than this).
     int getFarDependency(int i) const;

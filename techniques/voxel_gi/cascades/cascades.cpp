@@ -48,13 +48,14 @@
 // cones up to far_start voxels of its start level, and the rest comes from far cones traced once
 // per voxel centre of the level (when a pixel first needs them, kept until a level they sample
 // changes) and interpolated trilinearly (cascade_gather.cpp gatherConesSplit). The far cones
-// are traced in C++; the near parts and the composite run in the pixel gather (Vulkan or C++).
+// are traced by the pixel gather's device (Vulkan: the gather shader's far-cone mode, or C++), as
+// are the near parts and the composite.
 // With `extrapolate` the pixels also gather the talk's extrapolated extra bounce ("Extra Magic",
 // cone_tracing.h extrapolateBounce) from the voxels' last two bounces: the technique then claims
 // bounces + 1 reflections and is measured against that ground truth.
 // `level_noise` adds the talk's "3D noise offset" to the start-level blend of the pixel cones (a
 // smooth value noise on the level-0 voxel lattice, the same bits in C++ and on Vulkan).
-// Not yet: the far cones on Vulkan, and the light buffers kept on the GPU between updates.
+// Not yet: the volumetric G-buffer and the light buffers kept on the GPU between updates.
 //
 // Parameters
 // | name           | type  | default           | range / choices                       | unit   |
@@ -291,8 +292,12 @@ public:
             *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
             input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
                 if (mGatheredOnGpu) {
-                    if (mSettings.farStart > 0.0)
-                        mVolume->prepareFarCones(reduced); // the far cones, in C++
+                    if (mSettings.farStart > 0.0) // the far cones, on Vulkan too
+                        mVolume->prepareFarCones(
+                            reduced, [&](const std::vector<std::pair<int, std::uint32_t>>& centres,
+                                         std::vector<glm::vec3>& far) {
+                                mGpu.traceFarCones(*input.gpu, *mVolume, centres, far);
+                            });
                     mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
                 } else {
                     mVolume->gatherCones(reduced, cones);

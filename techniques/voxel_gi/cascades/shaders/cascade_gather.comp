@@ -14,6 +14,7 @@ layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(std430, binding = 1) readonly buffer CombinedBuffer { vec4 combined[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
+// The pixels' normals; for far cones (flags.z = 1) w is the voxel size of the centre's level.
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
 layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
 layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
@@ -25,7 +26,7 @@ layout(std430, binding = 7) readonly buffer FarConeBuffer { vec4 farCones[]; };
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, levels, resolution
     vec4 march;  // level-0 voxel size, tan(half-angle), start offset (voxels), step scale
-    ivec4 flags; // y: max steps
+    ivec4 flags; // y: max steps, z: 1 = far cones of voxel centres instead of pixels
     ivec4 anchorCell; // xyz: the anchor in level-0 voxels
     vec4 noise;       // x: level noise (of a level's radius), y: far start (level voxels; 0: off)
 } pc;
@@ -124,6 +125,20 @@ void main()
     const int index = pixel.y * pc.size.x + pixel.x;
     for (int k = 0; k < 16; ++k)
         coneRadiance[index * 16 + k] = vec4(0.0);
+    if (pc.flags.z == 1) {
+        // Far cones ("Split Cone Trace"): all 16 cones from a voxel centre, from far start voxels
+        // of its level on (CascadeVolume::prepareFarCones).
+        const vec4 centre = positions[index];
+        if (centre.w == 0.0)
+            return;
+        const float t0 = pc.noise.y * normals[index].w;
+        for (int k = 0; k < 16; ++k) {
+            bool escaped;
+            const vec3 light = marchCone(centre.xyz, cones[k].xyz, k, t0, 1e30, escaped).rgb;
+            coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+        }
+        return;
+    }
     const vec4 position = positions[index];
     const vec3 n = normals[index].xyz;
     if (position.w == 0.0 || dot(n, n) < 0.5)
