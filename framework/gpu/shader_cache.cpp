@@ -36,11 +36,16 @@ fs::path getDefaultShaderCacheDir()
     return fs::temp_directory_path() / "rtlab" / "spirv";
 }
 
-fs::path getBuiltinShaderDir()
+fs::path findShaderDir(const fs::path& relative, const fs::path& builtIn)
 {
     if (fs::path root = readPathFromEnv("RTLAB_SOURCE_DIR"); !root.empty())
-        return root / "framework" / "gpu" / "shaders";
-    return fs::path(RTLAB_GPU_SHADER_DIR);
+        return root / relative;
+    return builtIn;
+}
+
+fs::path getBuiltinShaderDir()
+{
+    return findShaderDir("framework/gpu/shaders", RTLAB_GPU_SHADER_DIR);
 }
 
 namespace detail {

@@ -89,6 +89,11 @@ std::filesystem::path getDefaultShaderCacheDir();
 //! Part of every cache key.
 std::string getShaderCompilerVersion();
 
+//! A folder of shaders in the source tree: $RTLAB_SOURCE_DIR/`relative` when that variable is set
+//! (shaders edited in another checkout, or a moved tree), otherwise `builtIn`, the folder the
+//! code was compiled from (a compile definition such as RTLAB_TECHNIQUE_DIR "/shaders").
+std::filesystem::path findShaderDir(const std::filesystem::path& relative, const std::filesystem::path& builtIn);
+
 //! Directory of the shaders that ship with the framework (framework/gpu/shaders):
 //! $RTLAB_SOURCE_DIR/framework/gpu/shaders when that variable is set, otherwise the path
 //! of the source tree the library was built from.

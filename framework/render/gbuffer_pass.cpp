@@ -1,8 +1,8 @@
 #include "render/gbuffer_pass.h"
+#include "gpu/shader_compiler.h"
 
 #include <algorithm>
 #include <cstddef>
-#include <cstdlib>
 #include <limits>
 #include <string>
 #include <vector>
@@ -85,9 +85,8 @@ gpu::GraphicsPipeline createPipeline(gpu::Context& context, const GBufferPassOpt
 
 std::filesystem::path getRenderShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "framework" / "render" / "shaders";
-    return std::filesystem::path(RTLAB_RENDER_SHADER_DIR);
+    return gpu::findShaderDir("framework/render/shaders",
+                              std::filesystem::path(RTLAB_RENDER_SHADER_DIR));
 }
 
 struct GBufferPass::State {

@@ -11,7 +11,6 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 
 namespace rtlab::voxelgi {
@@ -53,9 +52,8 @@ gpu::ComputePipeline makePipeline(gpu::Context& context, const char* file, const
 
 std::filesystem::path VoxelizerGpu::getShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "framework" / "families" / "voxel_gi" / "shaders";
-    return std::filesystem::path(RTLAB_VOXEL_GI_SHADER_DIR);
+    return gpu::findShaderDir("framework/families/voxel_gi/shaders",
+                              std::filesystem::path(RTLAB_VOXEL_GI_SHADER_DIR));
 }
 
 gpu::Buffer& VoxelizerGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name)

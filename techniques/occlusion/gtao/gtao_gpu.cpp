@@ -5,16 +5,14 @@
 #include "gpu/shader_compiler.h"
 #include "render/gbuffer_pass.h"
 
-#include <cstdlib>
 #include <string>
 
 namespace rtlab::occlusion {
 
 std::filesystem::path GtaoGpu::getShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "techniques" / "occlusion" / "gtao" / "shaders";
-    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+    return gpu::findShaderDir("techniques/occlusion/gtao/shaders",
+                              std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders");
 }
 
 void GtaoGpu::prepare(gpu::Context& context, int width, int height)

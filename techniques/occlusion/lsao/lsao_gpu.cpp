@@ -3,16 +3,14 @@
 #include "gpu/shader_compiler.h"
 #include "render/gbuffer_pass.h"
 
-#include <cstdlib>
 #include <string>
 
 namespace rtlab::occlusion::lsao {
 
 std::filesystem::path getShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "techniques" / "occlusion" / "lsao" / "shaders";
-    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+    return gpu::findShaderDir("techniques/occlusion/lsao/shaders",
+                              std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders");
 }
 
 namespace {

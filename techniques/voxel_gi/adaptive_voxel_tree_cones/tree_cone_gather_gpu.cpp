@@ -1,8 +1,8 @@
 #include "tree_cone_gather_gpu.h"
+#include "gpu/shader_compiler.h"
 
 #include <glm/vec4.hpp>
 
-#include <cstdlib>
 
 namespace rtlab::voxelgi {
 
@@ -21,9 +21,8 @@ static_assert(sizeof(VoxelTreeNode) == 3 * sizeof(std::uint32_t), "the shader re
 
 std::filesystem::path TreeConeGatherGpu::getShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "techniques" / "voxel_gi" / "adaptive_voxel_tree_cones" / "shaders";
-    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+    return gpu::findShaderDir("techniques/voxel_gi/adaptive_voxel_tree_cones/shaders",
+                              std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders");
 }
 
 void TreeConeGatherGpu::gatherCones(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,

@@ -1,11 +1,11 @@
 #include "cascade_gather_gpu.h"
+#include "gpu/shader_compiler.h"
 
 #include "core/error.h"
 
 #include <glm/vec4.hpp>
 
 #include <algorithm>
-#include <cstdlib>
 
 namespace rtlab::voxelgi {
 
@@ -48,9 +48,8 @@ std::vector<GpuCascadeLevel> describeGpuLevels(const CascadeVolume& volume, cons
 
 std::filesystem::path CascadeGatherGpu::getShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "techniques" / "voxel_gi" / "cascades" / "shaders";
-    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+    return gpu::findShaderDir("techniques/voxel_gi/cascades/shaders",
+                              std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders");
 }
 
 glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume& volume)

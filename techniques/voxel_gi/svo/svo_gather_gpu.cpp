@@ -1,10 +1,10 @@
 #include "svo_gather_gpu.h"
+#include "gpu/shader_compiler.h"
 
 #include <glm/vec4.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 
 namespace rtlab::voxelgi {
 
@@ -21,9 +21,8 @@ static_assert(sizeof(GatherConstants) == 48, "must match svo_gather.comp");
 
 std::filesystem::path OctreeGatherGpu::getShaderDir()
 {
-    if (const char* root = std::getenv("RTLAB_SOURCE_DIR"); root != nullptr && *root != '\0')
-        return std::filesystem::path(root) / "techniques" / "voxel_gi" / "svo" / "shaders";
-    return std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders";
+    return gpu::findShaderDir("techniques/voxel_gi/svo/shaders",
+                              std::filesystem::path(RTLAB_TECHNIQUE_DIR) / "shaders");
 }
 
 void OctreeGatherGpu::gatherCones(gpu::Context& context, const SparseVoxelOctree& tree,
