@@ -75,6 +75,17 @@ inline void addRoom(scene::RenderScene& s, glm::vec3 lo, glm::vec3 hi, float thi
     addBox(s, lo, hi, material, true);
 }
 
+//! A closed room [-0.4, 0.4]^3 (walls 0.1) with a box on its floor at x in [x, x + 0.13]: moving
+//! `x` is an edit (triangles removed and added), as a dig is.
+inline scene::RenderScene makeRoomWithBox(float x, glm::vec3 emission = {})
+{
+    scene::RenderScene s;
+    const auto m = addMaterial(s, {0.6f, 0.5f, 0.4f}, emission);
+    addRoom(s, glm::vec3(-0.4f), glm::vec3(0.4f), 0.1f, m);
+    addBox(s, glm::vec3(x, -0.4f, -0.2f), glm::vec3(x + 0.13f, -0.27f, -0.05f), m);
+    return s;
+}
+
 //! A room open to the sky on two sides around `offset`, a box inside, a point light: sky, point
 //! light and both bounces all contribute (the Vulkan gathers' parity scene).
 inline scene::RenderScene makeOpenRoom(glm::vec3 offset)

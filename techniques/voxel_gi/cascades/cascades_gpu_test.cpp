@@ -295,14 +295,8 @@ void expectSameVoxelsUpToRounding(const CascadeVolume& a, const CascadeVolume& b
 // voxels the C++ path gives.
 TEST(CascadesGpu, VulkanVoxelizationScrollsAndEditsLikeTheCppOne)
 {
-    const auto make = [](float x) {
-        scene::RenderScene s;
-        const auto m = addMaterial(s, {0.6f, 0.5f, 0.4f}, {0.1f, 0.0f, 0.0f});
-        addRoom(s, glm::vec3(-0.4f), glm::vec3(0.4f), 0.1f, m);
-        addBox(s, glm::vec3(x, -0.4f, -0.2f), glm::vec3(x + 0.13f, -0.27f, -0.05f), m);
-        return s;
-    };
-    const scene::RenderScene before = make(-0.2f), after = make(-0.14f);
+    const glm::vec3 emission(0.1f, 0.0f, 0.0f);
+    const scene::RenderScene before = makeRoomWithBox(-0.2f, emission), after = makeRoomWithBox(-0.14f, emission);
     CascadeSettings settings = testSettings();
     settings.resolution = 16;
     settings.voxelSize = 1.0 / 16.0;
