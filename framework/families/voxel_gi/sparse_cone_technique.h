@@ -74,7 +74,8 @@ public:
                                                 mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
                                             else
                                                 mStructure->gatherCones(reduced, cones);
-                                        });
+                                        },
+                                        &mCombineMs);
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
@@ -103,7 +104,8 @@ public:
             {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mStructure->getMeanStepsPerCone()},
             {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
             {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
-            {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0}};
+            {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
+            {"combine_ms", mCombineMs}};
         for (auto& extra : structureCounters())
             c.push_back(std::move(extra));
         return c;
@@ -127,6 +129,7 @@ private:
     std::string mGeometryKey, mLightsKey;
     bool mBuilt = false;
     bool mGatheredOnGpu = false;
+    double mCombineMs = std::nan(""); // the gather beyond its cones: reduction and combine
 };
 
 } // namespace rtlab::voxelgi

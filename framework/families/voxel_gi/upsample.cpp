@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -181,8 +182,15 @@ Image<glm::vec3> upsampleIrradiance(const Image<glm::vec3>& low, const ReducedGB
     return out;
 }
 
-double computeCapsuleConeOcclusion(const glm::dvec3& p, const glm::dvec3& dir, double coneHalfAngle,
-                                   const glm::vec3& a, const glm::vec3& b, float radius)
+namespace {
+
+// A cone's half angle with its cosine and sine, computed once for many capsule tests.
+struct ConeAngle {
+    double half, cosHalf, sinHalf;
+};
+
+double occludeCone(const glm::dvec3& p, const glm::dvec3& dir, const ConeAngle& cone, const glm::vec3& a,
+                   const glm::vec3& b, float radius)
 {
     const glm::dvec3 A(a), u = glm::dvec3(b) - A;
     const double uu = glm::dot(u, u);
@@ -204,19 +212,33 @@ double computeCapsuleConeOcclusion(const glm::dvec3& p, const glm::dvec3& dir, d
     const double distance = glm::length(toCentre);
     if (!(distance > r))
         return 0.0;
-    const double capAngle = std::asin(std::min(1.0, r / distance));
+    // Disjoint caps (the angle between them at least the sum of their half angles) are tested on
+    // cosines first, with no inverse trigonometric function.
+    const double sinCap = std::min(1.0, r / distance), cosCap = std::sqrt(1.0 - sinCap * sinCap);
+    const double cosOuter = cone.cosHalf * cosCap - cone.sinHalf * sinCap;
+    if (glm::dot(toCentre / distance, dir) < cosOuter - 1e-9) // margin: rounding of the two paths
+        return 0.0;
+    const double capAngle = std::asin(sinCap);
     const double between = std::acos(std::clamp(glm::dot(toCentre / distance, dir), -1.0, 1.0));
-    const double outer = coneHalfAngle + capAngle, inner = std::abs(coneHalfAngle - capAngle);
+    const double outer = cone.half + capAngle, inner = std::abs(cone.half - capAngle);
     if (between >= outer)
         return 0.0;
-    const double coneSolid = 1.0 - std::cos(coneHalfAngle); // solid angles / 2 pi
-    const double smaller = 1.0 - std::cos(std::min(coneHalfAngle, capAngle));
+    const double coneSolid = 1.0 - cone.cosHalf; // solid angles / 2 pi
+    const double smaller = 1.0 - std::cos(std::min(cone.half, capAngle));
     double share = 1.0;
     if (between > inner) {
         const double x = std::clamp(1.0 - (between - inner) / (outer - inner), 0.0, 1.0);
         share = x * x * (3.0 - 2.0 * x);
     }
     return std::clamp(smaller * share / coneSolid, 0.0, 1.0);
+}
+
+} // namespace
+
+double computeCapsuleConeOcclusion(const glm::dvec3& p, const glm::dvec3& dir, double coneHalfAngle,
+                                   const glm::vec3& a, const glm::vec3& b, float radius)
+{
+    return occludeCone(p, dir, {coneHalfAngle, std::cos(coneHalfAngle), std::sin(coneHalfAngle)}, a, b, radius);
 }
 
 Image<glm::vec3> combineCones(const ConeCombineInputs& in)
@@ -233,9 +255,40 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
     cones.directions = scene::getConeDirections();
     cones.halfAngle = in.coneHalfAngle;
     cones.tanHalfAngle = std::tan(in.coneHalfAngle);
+    const ConeAngle angle{in.coneHalfAngle, std::cos(in.coneHalfAngle), std::sin(in.coneHalfAngle)};
+    // Per capsule, once: its segment, the sphere around it, and the squared distances within which
+    // it is near a pixel (40 radii from the segment; from the sphere's centre, a bound of that).
+    struct CapsuleBounds {
+        const scene::PosedCapsule* capsule;
+        glm::dvec3 a, u, centre;
+        double inverseLength2, bound, near2, reach2;
+    };
+    std::vector<CapsuleBounds> bounds;
+    if (in.capsules != nullptr)
+        for (const scene::PosedCapsule& c : *in.capsules) {
+            CapsuleBounds b;
+            b.capsule = &c;
+            b.a = glm::dvec3(c.capsule.a);
+            b.u = glm::dvec3(c.capsule.b) - b.a;
+            b.centre = b.a + 0.5 * b.u;
+            const double uu = glm::dot(b.u, b.u);
+            b.inverseLength2 = uu > 0.0 ? 1.0 / uu : 0.0;
+            const double r = double(c.capsule.radius);
+            b.bound = 0.5 * std::sqrt(uu) + r;
+            b.near2 = (40.0 * r) * (40.0 * r);
+            b.reach2 = (0.5 * std::sqrt(uu) + 40.0 * r) * (0.5 * std::sqrt(uu) + 40.0 * r);
+            bounds.push_back(b);
+        }
     Image<glm::vec3> out(full.width, full.height, glm::vec3(0.0f));
     tbb::parallel_for(0, full.height, [&](int y) {
-        std::vector<const scene::PosedCapsule*> near;
+        // A capsule near the pixel, with the cosine below which a cone direction's angle to its
+        // bounding sphere's centre is too wide for the cone to touch it (-2: no such bound).
+        struct NearCapsule {
+            const scene::PosedCapsule* capsule;
+            glm::dvec3 towardCentre;
+            double cosLimit;
+        };
+        std::vector<NearCapsule> near;
         for (int x = 0; x < full.width; ++x) {
             int samples[4];
             float weights[4];
@@ -245,17 +298,29 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
             const glm::dvec3 p(full.position.at(x, y)), n(full.normal.at(x, y));
             if (glm::dot(n, n) < 0.5)
                 continue;
-            // Capsules close enough to hide more than 0.25 % of a cone (40 radii).
+            // Capsules close enough to hide more than 0.25 % of a cone (40 radii from the segment).
             near.clear();
-            if (in.capsules != nullptr)
-                for (const auto& c : *in.capsules) {
-                    const glm::dvec3 A(c.capsule.a), u = glm::dvec3(c.capsule.b) - A;
-                    const double uu = glm::dot(u, u);
-                    const glm::dvec3 q =
-                        uu > 0.0 ? A + std::clamp(glm::dot(p - A, u) / uu, 0.0, 1.0) * u : A;
-                    if (glm::length(p - q) < 40.0 * double(c.capsule.radius))
-                        near.push_back(&c);
+            for (const CapsuleBounds& c : bounds) {
+                const glm::dvec3 toCentre = c.centre - p;
+                const double d2 = glm::dot(toCentre, toCentre);
+                if (d2 >= c.reach2)
+                    continue; // farther than 40 radii from any point of the segment
+                const glm::dvec3 q = c.a + std::clamp(glm::dot(p - c.a, c.u) * c.inverseLength2, 0.0, 1.0) * c.u;
+                const glm::dvec3 fromSegment = p - q;
+                if (glm::dot(fromSegment, fromSegment) >= c.near2)
+                    continue;
+                // The sphere around the whole capsule: a cone whose axis is more than the cone's
+                // half angle plus the sphere's angular radius away from the sphere's centre misses
+                // every sphere occludeCone places on the segment, so its occlusion is exactly 0.
+                NearCapsule entry{c.capsule, glm::dvec3(0.0), -2.0};
+                if (d2 > c.bound * c.bound) {
+                    const double distance = std::sqrt(d2);
+                    const double sinB = c.bound / distance, cosB = std::sqrt(1.0 - sinB * sinB);
+                    entry.towardCentre = toCentre / distance;
+                    entry.cosLimit = angle.cosHalf * cosB - angle.sinHalf * sinB; // cos(half angle + asin(sinB))
                 }
+                near.push_back(entry);
+            }
             const auto w = computeIrradianceWeights(cones, n);
             glm::dvec3 e(0.0);
             for (int k = 0; k < kConeCount; ++k) {
@@ -268,10 +333,14 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
                 double visible = 1.0;
                 if (useVisibility)
                     visible = std::clamp(double((*in.visibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
-                for (const auto* c : near)
-                    visible *= 1.0 - computeCapsuleConeOcclusion(
-                                         p, cones.directions[std::size_t(k)], in.coneHalfAngle,
-                                         c->capsule.a, c->capsule.b, c->capsule.radius);
+                const glm::dvec3& dir = cones.directions[std::size_t(k)];
+                for (const NearCapsule& c : near) {
+                    // 1e-9 in cosine keeps rounding from culling a cone that grazes the sphere.
+                    if (glm::dot(c.towardCentre, dir) < c.cosLimit - 1e-9)
+                        continue;
+                    visible *= 1.0 - occludeCone(p, dir, angle, c.capsule->capsule.a, c.capsule->capsule.b,
+                                                 c.capsule->capsule.radius);
+                }
                 e += w[std::size_t(k)] * visible * radiance;
             }
             out.at(x, y) = glm::max(glm::vec3(e), glm::vec3(0.0f));
@@ -283,11 +352,16 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
 Image<glm::vec3> gatherConesReduced(
     const scene::GBuffer& full, int traceStep, double coneHalfAngle,
     const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
-    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones)
+    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones,
+    double* combineMs)
 {
+    using Clock = std::chrono::steady_clock;
+    const auto start = Clock::now();
     const ReducedGBuffer reduced = reduceGBuffer(full, traceStep);
+    const auto reducedAt = Clock::now();
     std::vector<glm::vec3> cones;
     traceCones(reduced.gbuffer, cones);
+    const auto tracedAt = Clock::now();
     ConeCombineInputs combine;
     combine.coneRadiance = &cones;
     combine.reduced = &reduced;
@@ -295,7 +369,10 @@ Image<glm::vec3> gatherConesReduced(
     combine.visibility = visibility;
     combine.capsules = capsules;
     combine.coneHalfAngle = coneHalfAngle;
-    return combineCones(combine);
+    Image<glm::vec3> irradiance = combineCones(combine);
+    if (combineMs != nullptr)
+        *combineMs = std::chrono::duration<double, std::milli>((reducedAt - start) + (Clock::now() - tracedAt)).count();
+    return irradiance;
 }
 
 Image<glm::vec3> traceRaysReduced(const scene::GBuffer& full, int traceStep,

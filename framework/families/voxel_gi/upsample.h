@@ -58,11 +58,13 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in);
 //! A cone-traced structure's pixel gather as the family runs it (cascades, svo): the G-buffer
 //! reduced to one pixel per traceStep^2 block, `traceCones(reduced, coneRadiance)` fills
 //! [low-res pixel * 16 + cone] there, and combineCones brings it back to full resolution with the
-//! cone visibilities and capsules (either may be null).
+//! cone visibilities and capsules (either may be null). `combineMs`, when given, receives the
+//! wall time of the reduction and the combine (the gather's time beyond `traceCones`).
 Image<glm::vec3> gatherConesReduced(
     const scene::GBuffer& full, int traceStep, double coneHalfAngle,
     const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
-    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones);
+    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones,
+    double* combineMs = nullptr);
 
 //! The error split's rays (voxel_gi.h traceVoxelRays) at the same representative pixels as
 //! gatherConesReduced, upsampled the same way: `traceRays(reduced, irradiance)`.

@@ -302,7 +302,8 @@ public:
                 } else {
                     mVolume->gatherCones(reduced, cones);
                 }
-            });
+            },
+            &mCombineMs);
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
@@ -341,6 +342,7 @@ public:
                 {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs()
                                                                          : std::nan("")},
                 {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
+                {"combine_ms", mCombineMs},
                 {"far_cones_traced", double(c.farConesTraced)},
                 {"far_cones_ms", c.farConesMs},
                 {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
@@ -373,6 +375,7 @@ private:
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;
     bool mGatheredOnGpu = false;
+    double mCombineMs = std::nan(""); // the gather beyond its cones: reduction and combine
     int mTraceStep = 4;
 };
 
