@@ -218,13 +218,21 @@ double occludeCone(const glm::dvec3& p, const glm::dvec3& dir, const ConeAngle& 
     const double cosOuter = cone.cosHalf * cosCap - cone.sinHalf * sinCap;
     if (glm::dot(toCentre / distance, dir) < cosOuter - 1e-9) // margin: rounding of the two paths
         return 0.0;
+    const double coneSolid = 1.0 - cone.cosHalf; // solid angles / 2 pi
+    // The smaller cap's solid angle: 1 - cos(min(half, cap)) = 1 - max(cos half, cos cap).
+    const double smaller = 1.0 - std::max(cone.cosHalf, cosCap);
+    // One cap inside the other (the angle between them at most the difference of their half
+    // angles): the whole smaller cap is hidden; tested on cosines too.
+    const double cosInner = cone.cosHalf * cosCap + cone.sinHalf * sinCap;
+    const double cosBetween = std::clamp(glm::dot(toCentre / distance, dir), -1.0, 1.0);
+    if (cosBetween >= cosInner)
+        return std::clamp(smaller / coneSolid, 0.0, 1.0);
+    // Between the two: Oat and Sander's smoothstep in the angle between the caps.
     const double capAngle = std::asin(sinCap);
-    const double between = std::acos(std::clamp(glm::dot(toCentre / distance, dir), -1.0, 1.0));
+    const double between = std::acos(cosBetween);
     const double outer = cone.half + capAngle, inner = std::abs(cone.half - capAngle);
     if (between >= outer)
         return 0.0;
-    const double coneSolid = 1.0 - cone.cosHalf; // solid angles / 2 pi
-    const double smaller = 1.0 - std::cos(std::min(cone.half, capAngle));
     double share = 1.0;
     if (between > inner) {
         const double x = std::clamp(1.0 - (between - inner) / (outer - inner), 0.0, 1.0);
