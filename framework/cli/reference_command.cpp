@@ -80,8 +80,8 @@ int referenceCommand(const ReferenceOptions& options)
         if (options.throughputSamples > 0) {
             const reference::RayThroughput t =
                 reference::measureRayThroughput(renderScene, gbuffer, settings, options.throughputSamples);
-            fmt::print("throughput ({} threads, {} samples per pixel, same run):\n", t.threads,
-                       options.throughputSamples);
+            fmt::print("throughput ({} threads, {} samples per pixel, same run, medians of {} alternating rounds):\n",
+                       t.threads, options.throughputSamples, t.repeats);
             fmt::print("  reference estimator  {:8.2f} Mrays/s\n", t.referenceMraysPerSecond);
             fmt::print("  raw rtcIntersect1    {:8.2f} Mrays/s  (reference / raw = {:.2f})\n",
                        t.rawIntersectMraysPerSecond, t.referenceMraysPerSecond / t.rawIntersectMraysPerSecond);

@@ -3,6 +3,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace rtlab::reference {
@@ -84,6 +85,78 @@ std::uint32_t evaluateOcclusionSample(const TraceContext& context, const Surface
     default:
         return 0;
     }
+}
+
+std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfacePoint& point,
+                                     const PixelSequence& sequence, std::uint32_t first,
+                                     std::uint32_t count, SampleValue* values)
+{
+    const Quantity q = context.quantity;
+    if (q != Quantity::Ao && q != Quantity::AoUniform && q != Quantity::Bent) {
+        std::uint32_t rays = 0; // obscurance needs the hit distance: one closest-hit ray each
+        for (std::uint32_t i = 0; i < count; ++i)
+            rays += evaluateOcclusionSample(context, point, sequence, first + i, values[i]);
+        return rays;
+    }
+    // The same directions and rays as evaluateOcclusionSample, traced as one stream per chunk.
+    const Frame frame = Frame::fromNormal(point.normal);
+    const glm::vec3 origin(point.position + context.rayEpsilon * point.normal);
+    const float tFar = std::isinf(context.radius) ? kInfiniteDistance : float(context.radius);
+    const auto makeRay = [&](const glm::dvec3& w) {
+        RTCRay ray;
+        ray.org_x = origin.x;
+        ray.org_y = origin.y;
+        ray.org_z = origin.z;
+        ray.tnear = 0.0f;
+        const glm::vec3 d(w);
+        ray.dir_x = d.x;
+        ray.dir_y = d.y;
+        ray.dir_z = d.z;
+        ray.time = 0.0f;
+        ray.tfar = tFar;
+        ray.mask = 0xffffffffu;
+        ray.id = 0;
+        ray.flags = 0;
+        return ray;
+    };
+    constexpr std::uint32_t kChunk = 32;
+    const std::uint32_t raysPerSample = q == Quantity::Bent ? 2 : 1;
+    RTCRay rays[2 * kChunk];
+    glm::dvec2 u[kChunk];
+    glm::dvec3 directions[kChunk], uniform[kChunk];
+    for (std::uint32_t begin = 0; begin < count; begin += kChunk) {
+        const std::uint32_t n = std::min(kChunk, count - begin);
+        sequence.get2D(first + begin, n, kPairCosine, u);
+        if (q == Quantity::AoUniform)
+            sampleUniformHemispheres(u, directions, n);
+        else
+            sampleCosineHemispheres(u, directions, n);
+        if (q == Quantity::Bent) {
+            sequence.get2D(first + begin, n, kPairUniform, u);
+            sampleUniformHemispheres(u, uniform, n);
+        }
+        for (std::uint32_t i = 0; i < n; ++i) {
+            directions[i] = frame.toWorld(directions[i]);
+            rays[raysPerSample * i] = makeRay(directions[i]);
+            if (q == Quantity::Bent)
+                rays[2 * i + 1] = makeRay(frame.toWorld(uniform[i]));
+        }
+        context.embree->occluded(rays, raysPerSample * n, true);
+        for (std::uint32_t i = 0; i < n; ++i) {
+            SampleValue& value = values[begin + i];
+            const double visible = rays[raysPerSample * i].tfar < 0.0f ? 0.0 : 1.0;
+            if (q != Quantity::Bent) {
+                value[0] = visible;
+                continue;
+            }
+            value[0] = visible * directions[i].x;
+            value[1] = visible * directions[i].y;
+            value[2] = visible * directions[i].z;
+            value[3] = visible;
+            value[4] = rays[2 * i + 1].tfar < 0.0f ? 0.0 : 1.0;
+        }
+    }
+    return raysPerSample * count;
 }
 
 } // namespace rtlab::reference

@@ -190,4 +190,12 @@ bool EmbreeScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tFa
     return ray.tfar < 0.0f;
 }
 
+void EmbreeScene::occluded(RTCRay* rays, unsigned count, bool coherent) const
+{
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    rtcOccluded1M(mScene, &context, rays, count, sizeof(RTCRay));
+}
+
 } // namespace rtlab::reference

@@ -34,6 +34,9 @@ public:
     bool intersect(const glm::vec3& org, const glm::vec3& dir, float tFar, RayHit& hit) const;
     //! Whether anything lies along org + t dir, 0 <= t <= tFar.
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tFar) const;
+    //! The same for a stream of rays (rtcOccluded1M), traced together: `coherent` when they
+    //! share an origin (Embree then traces them as packets). An occluded ray's tfar becomes -inf.
+    void occluded(RTCRay* rays, unsigned count, bool coherent) const;
 
     RTCScene getHandle() const { return mScene; }
     //! Length of the diagonal of the triangles' bounding box.

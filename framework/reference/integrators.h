@@ -78,6 +78,12 @@ struct SurfacePoint {
 std::uint32_t evaluateOcclusionSample(const TraceContext& context, const SurfacePoint& point,
                                       const PixelSequence& sequence, std::uint32_t index,
                                       SampleValue& value);
+//! Samples first .. first + count - 1 of the same quantities into values[0 .. count - 1], the
+//! same values as evaluateOcclusionSample; ao, ao_uniform and bent trace their rays as Embree
+//! ray streams from the point. Returns the number of rays traced.
+std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfacePoint& point,
+                                     const PixelSequence& sequence, std::uint32_t first,
+                                     std::uint32_t count, SampleValue* values);
 //! direct, indirect, full: E/pi per colour (before albedo). Returns the number of rays traced.
 std::uint32_t evaluateLightSample(const TraceContext& context, const SurfacePoint& point,
                                   const PixelSequence& sequence, std::uint32_t index,

@@ -115,4 +115,22 @@ std::uint32_t PreparedReference::evaluate(std::size_t pixel, std::uint32_t index
     }
 }
 
+std::uint32_t PreparedReference::evaluateBatch(std::size_t pixel, std::uint32_t first, std::uint32_t count,
+                                               SampleValue* values) const
+{
+    const PixelSequence sequence(mSettings.seed, pixel);
+    switch (mContext.quantity) {
+    case Quantity::Direct:
+    case Quantity::Indirect:
+    case Quantity::Full: {
+        std::uint32_t rays = 0;
+        for (std::uint32_t i = 0; i < count; ++i)
+            rays += evaluateLightSample(mContext, mPoints[pixel], sequence, first + i, values[i]);
+        return rays;
+    }
+    default:
+        return evaluateOcclusionBatch(mContext, mPoints[pixel], sequence, first, count, values);
+    }
+}
+
 } // namespace rtlab::reference

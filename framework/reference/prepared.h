@@ -24,6 +24,9 @@ public:
 
     //! Sample `index` of pixel `pixel`; the pixel must be active.
     std::uint32_t evaluate(std::size_t pixel, std::uint32_t index, SampleValue& value) const;
+    //! Samples first .. first + count - 1 of a pixel (progressive.h BatchSampleFunction).
+    std::uint32_t evaluateBatch(std::size_t pixel, std::uint32_t first, std::uint32_t count,
+                                SampleValue* values) const;
 
     const EmbreeScene& getEmbree() const { return mEmbree; }
     const TraceContext& getContext() const { return mContext; }

@@ -80,6 +80,18 @@ double PixelEstimate::getStdErr(int channel) const
 ProgressiveOutput runProgressive(int width, int height, const std::vector<std::uint8_t>& active,
                                  const ProgressiveRule& rule, const SampleFunction& sample)
 {
+    return runProgressive(width, height, active, rule,
+                          [&](std::size_t pixel, std::uint32_t first, std::uint32_t count, SampleValue* values) {
+                              std::uint32_t rays = 0;
+                              for (std::uint32_t i = 0; i < count; ++i)
+                                  rays += sample(pixel, first + i, values[i]);
+                              return rays;
+                          });
+}
+
+ProgressiveOutput runProgressive(int width, int height, const std::vector<std::uint8_t>& active,
+                                 const ProgressiveRule& rule, const BatchSampleFunction& sample)
+{
     ProgressiveOutput out;
     out.pixels.resize(std::size_t(width) * std::size_t(height));
     const int tilesX = (width + kTileSize - 1) / kTileSize;
@@ -89,7 +101,7 @@ ProgressiveOutput runProgressive(int width, int height, const std::vector<std::u
     tbb::parallel_for(
         tbb::blocked_range<int>(0, tilesX * tilesY), [&](const tbb::blocked_range<int>& r) {
             std::uint64_t& localRays = rays.local();
-            SampleValue value{};
+            std::vector<SampleValue> values(std::size_t(std::max(1, rule.batchSize)));
             for (int tile = r.begin(); tile != r.end(); ++tile) {
                 const int x0 = (tile % tilesX) * kTileSize;
                 const int y0 = (tile / tilesX) * kTileSize;
@@ -103,13 +115,14 @@ ProgressiveOutput runProgressive(int width, int height, const std::vector<std::u
                         std::uint32_t n = 0;
                         bool converged = false;
                         while (n < std::uint32_t(rule.maxSamples)) {
-                            const std::uint32_t end = std::min(n + std::uint32_t(rule.batchSize),
-                                                               std::uint32_t(rule.maxSamples));
-                            for (; n < end; ++n) {
-                                value.fill(0.0);
-                                localRays += sample(pixel, n, value);
-                                moments.add(value);
-                            }
+                            const std::uint32_t count = std::min(std::uint32_t(rule.batchSize),
+                                                                 std::uint32_t(rule.maxSamples) - n);
+                            for (std::uint32_t i = 0; i < count; ++i)
+                                values[i].fill(0.0);
+                            localRays += sample(pixel, n, count, values.data());
+                            for (std::uint32_t i = 0; i < count; ++i)
+                                moments.add(values[i]);
+                            n += count;
                             if (moments.meets(rule)) {
                                 converged = true;
                                 break;

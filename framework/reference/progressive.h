@@ -40,7 +40,16 @@ struct ProgressiveOutput {
 using SampleFunction =
     std::function<std::uint32_t(std::size_t pixel, std::uint32_t index, SampleValue& value)>;
 
-//! Runs the rule on every pixel whose `active` flag is set, in parallel over tiles.
+//! Evaluates samples first .. first + count - 1 of pixel `pixel` into values[0 .. count - 1]
+//! (each zeroed before the call); returns the rays it traced. A batch lets an estimator trace
+//! its rays together (Embree ray streams).
+using BatchSampleFunction = std::function<std::uint32_t(std::size_t pixel, std::uint32_t first,
+                                                        std::uint32_t count, SampleValue* values)>;
+//! Runs the rule on every pixel whose `active` flag is set, in parallel over tiles. The samples
+//! are added to the running moments in index order, so batching changes no estimate.
+ProgressiveOutput runProgressive(int width, int height, const std::vector<std::uint8_t>& active,
+                                 const ProgressiveRule& rule, const BatchSampleFunction& sample);
+//! The same, one sample per call.
 ProgressiveOutput runProgressive(int width, int height, const std::vector<std::uint8_t>& active,
                                  const ProgressiveRule& rule, const SampleFunction& sample);
 

@@ -199,8 +199,8 @@ ReferenceResult computeReference(const scene::RenderScene& scene, const scene::G
         rule.maxSamples = settings.maxSamples;
         const ProgressiveOutput out =
             runProgressive(gbuffer.width, gbuffer.height, prepared.getActive(), rule,
-                           [&](std::size_t pixel, std::uint32_t index, SampleValue& value) {
-                               return prepared.evaluate(pixel, index, value);
+                           [&](std::size_t pixel, std::uint32_t first, std::uint32_t count, SampleValue* values) {
+                               return prepared.evaluateBatch(pixel, first, count, values);
                            });
         finalize(result, out, prepared, gbuffer);
         result.stats.rayEpsilon = prepared.getContext().rayEpsilon;

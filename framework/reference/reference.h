@@ -190,12 +190,15 @@ struct RayThroughput {
     double rawIntersectSeconds = 0.0;
     double rawOccludedSeconds = 0.0;
     int threads = 0;
+    int repeats = 0; //!< timed rounds; each figure is the median over them
 };
 
 //! Traces samplesPerPixel samples of settings.quantity per surface pixel (no cache, no early
 //! stop) and, in the same run on the same scene and thread count, the same number of cosine-
 //! distributed rays from the same origins through bare rtcIntersect1 and rtcOccluded1 calls.
+//! After one untimed round of each, `repeats` rounds alternate the three; medians are reported.
 RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,
-                                   const ReferenceSettings& settings, int samplesPerPixel);
+                                   const ReferenceSettings& settings, int samplesPerPixel,
+                                   int repeats = 5);
 
 } // namespace rtlab::reference

@@ -35,10 +35,14 @@ double computeLuminance(const glm::dvec3& rgb);
 //! Cosine-weighted hemisphere via the concentric disk map [Shirley & Chiu 1997] lifted to the
 //! hemisphere [Malley's method]; pdf = cos(theta) / pi.
 glm::dvec3 sampleCosineHemisphere(const glm::dvec2& u);
+//! The same for n points at once (independent samples overlap in the pipeline).
+void sampleCosineHemispheres(const glm::dvec2* u, glm::dvec3* out, std::size_t n);
 double pdfCosineHemisphere(double cosTheta);
 
 //! Uniform hemisphere (z >= 0): z = u.x, pdf = 1 / (2 pi).
 glm::dvec3 sampleUniformHemisphere(const glm::dvec2& u);
+//! The same for n points at once.
+void sampleUniformHemispheres(const glm::dvec2* u, glm::dvec3* out, std::size_t n);
 double pdfUniformHemisphere();
 
 //! Uniform sphere: z = 1 - 2 u.x (Archimedes), pdf = 1 / (4 pi).

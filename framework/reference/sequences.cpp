@@ -4,11 +4,11 @@ namespace rtlab::reference {
 
 std::uint32_t reverseBits32(std::uint32_t x)
 {
+    // The bits within each byte, then the bytes (one bswap).
     x = ((x >> 1) & 0x55555555u) | ((x & 0x55555555u) << 1);
     x = ((x >> 2) & 0x33333333u) | ((x & 0x33333333u) << 2);
     x = ((x >> 4) & 0x0f0f0f0fu) | ((x & 0x0f0f0f0fu) << 4);
-    x = ((x >> 8) & 0x00ff00ffu) | ((x & 0x00ff00ffu) << 8);
-    return (x >> 16) | (x << 16);
+    return __builtin_bswap32(x);
 }
 
 namespace {
@@ -18,7 +18,7 @@ namespace {
 // tabulated per index byte: the XOR of the direction numbers of every subset of 8 bits.
 struct SobolTables {
     std::uint32_t byteColumns[4][256];
-    constexpr SobolTables() : byteColumns{}
+    constexpr SobolTables() : byteColumns{}, reversedByteColumns{}
     {
         std::uint32_t v[32] = {};
         v[0] = 1u << 31;
@@ -31,10 +31,25 @@ struct SobolTables {
                     if (x & (1 << bit))
                         r ^= v[8 * b + bit];
                 byteColumns[b][x] = r;
+                std::uint32_t reversed = 0; // the same columns with their bits reversed
+                for (int bit = 0; bit < 32; ++bit)
+                    if (r & (1u << bit))
+                        reversed |= 1u << (31 - bit);
+                reversedByteColumns[b][x] = reversed;
             }
     }
+    std::uint32_t reversedByteColumns[4][256];
 };
 constexpr SobolTables kSobolTables;
+
+// reverseBits32(computeSobol32(index, 1)), from the reversed columns.
+std::uint32_t computeReversedSobol32Dimension1(std::uint32_t index)
+{
+    return kSobolTables.reversedByteColumns[0][index & 0xffu] ^
+           kSobolTables.reversedByteColumns[1][(index >> 8) & 0xffu] ^
+           kSobolTables.reversedByteColumns[2][(index >> 16) & 0xffu] ^
+           kSobolTables.reversedByteColumns[3][index >> 24];
+}
 
 } // namespace
 
@@ -93,9 +108,11 @@ glm::dvec2 sampleScrambledSobol2D(std::uint32_t index, std::uint64_t streamSeed)
     // Shuffle: nested uniform scrambling of the index maps every aligned block of 2^m indices
     // onto an aligned block of 2^m indices, so prefixes of 2^m samples stay (0,m,2)-nets.
     const std::uint32_t shuffled = scrambleNestedUniform(index, std::uint32_t(h0));
-    const std::uint32_t x =
-        scrambleNestedUniform(computeSobol32(shuffled, 0), std::uint32_t(h0 >> 32));
-    const std::uint32_t y = scrambleNestedUniform(computeSobol32(shuffled, 1), std::uint32_t(h1));
+    // scrambleNestedUniform(v) = reverse(permute(reverse(v))); dimension 0 is reverse(shuffled)
+    // and dimension 1's reversal comes from reversed tables, so two reversals cancel in each.
+    const std::uint32_t x = reverseBits32(permuteLaineKarras(shuffled, std::uint32_t(h0 >> 32)));
+    const std::uint32_t y =
+        reverseBits32(permuteLaineKarras(computeReversedSobol32Dimension1(shuffled), std::uint32_t(h1)));
     return {toUnitInterval(x), toUnitInterval(y)};
 }
 
@@ -108,6 +125,14 @@ glm::dvec2 PixelSequence::get2D(std::uint32_t sampleIndex, std::uint32_t dimensi
 {
     return sampleScrambledSobol2D(sampleIndex,
                                   mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
+}
+
+void PixelSequence::get2D(std::uint32_t first, std::uint32_t count, std::uint32_t dimensionPair,
+                          glm::dvec2* out) const
+{
+    const std::uint64_t stream = mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1);
+    for (std::uint32_t i = 0; i < count; ++i)
+        out[i] = sampleScrambledSobol2D(first + i, stream);
 }
 
 } // namespace rtlab::reference

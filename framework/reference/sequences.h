@@ -31,6 +31,8 @@ class PixelSequence {
 public:
     PixelSequence(std::uint64_t seed, std::uint64_t pixelIndex);
     glm::dvec2 get2D(std::uint32_t sampleIndex, std::uint32_t dimensionPair) const;
+    //! Samples first .. first + count - 1 of one dimension pair into out[0 .. count - 1].
+    void get2D(std::uint32_t first, std::uint32_t count, std::uint32_t dimensionPair, glm::dvec2* out) const;
 
 private:
     std::uint64_t mPixelSeed;

@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <vector>
@@ -24,7 +25,7 @@ double getSecondsSince(std::chrono::steady_clock::time_point start)
 } // namespace
 
 RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,
-                                   const ReferenceSettings& settings, int samplesPerPixel)
+                                   const ReferenceSettings& settings, int samplesPerPixel, int repeats)
 {
     ReferenceSettings s = settings;
     s.batchSize = std::max(1, samplesPerPixel);
@@ -43,14 +44,16 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         rule.batchSize = s.batchSize;
         rule.maxSamples = s.maxSamples;
 
-        auto start = std::chrono::steady_clock::now();
-        const ProgressiveOutput out =
-            runProgressive(gbuffer.width, gbuffer.height, prepared.getActive(), rule,
-                           [&](std::size_t pixel, std::uint32_t index, SampleValue& value) {
-                               return prepared.evaluate(pixel, index, value);
-                           });
-        result.referenceSeconds = getSecondsSince(start);
-        result.referenceRays = out.rayCount;
+        const auto traceReference = [&] {
+            const auto start = std::chrono::steady_clock::now();
+            const ProgressiveOutput out = runProgressive(
+                gbuffer.width, gbuffer.height, prepared.getActive(), rule,
+                [&](std::size_t pixel, std::uint32_t first, std::uint32_t count, SampleValue* values) {
+                    return prepared.evaluateBatch(pixel, first, count, values);
+                });
+            result.referenceRays = out.rayCount;
+            return getSecondsSince(start);
+        };
 
         // The same number of rays as AO would trace: cosine-distributed from the same origins.
         std::vector<RTCRayHit> rays;
@@ -81,27 +84,41 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         }
         result.rawRays = rays.size();
         const RTCScene handle = prepared.getEmbree().getHandle();
-        std::vector<RTCRayHit> work = rays;
-        start = std::chrono::steady_clock::now();
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-                              RTCIntersectContext context;
-                              rtcInitIntersectContext(&context);
-                              for (std::size_t i = r.begin(); i != r.end(); ++i)
-                                  rtcIntersect1(handle, &context, &work[i]);
-                          });
-        result.rawIntersectSeconds = getSecondsSince(start);
-
-        work = rays;
-        start = std::chrono::steady_clock::now();
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
-                          [&](const tbb::blocked_range<std::size_t>& r) {
-                              RTCIntersectContext context;
-                              rtcInitIntersectContext(&context);
-                              for (std::size_t i = r.begin(); i != r.end(); ++i)
-                                  rtcOccluded1(handle, &context, &work[i].ray);
-                          });
-        result.rawOccludedSeconds = getSecondsSince(start);
+        std::vector<RTCRayHit> work;
+        const auto traceRaw = [&](bool closest) {
+            work = rays;
+            const auto start = std::chrono::steady_clock::now();
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                  RTCIntersectContext context;
+                                  rtcInitIntersectContext(&context);
+                                  for (std::size_t i = r.begin(); i != r.end(); ++i)
+                                      if (closest)
+                                          rtcIntersect1(handle, &context, &work[i]);
+                                      else
+                                          rtcOccluded1(handle, &context, &work[i].ray);
+                              });
+            return getSecondsSince(start);
+        };
+        // One untimed round wakes the arena's threads and warms the caches for all three; then
+        // the three alternate, and each keeps its median (a 16-sample run lasts tens of ms,
+        // where one thread start-up or preemption would decide the ratio).
+        traceReference();
+        traceRaw(true);
+        std::vector<double> reference, intersect, occluded;
+        for (int r = 0; r < std::max(1, repeats); ++r) {
+            reference.push_back(traceReference());
+            intersect.push_back(traceRaw(true));
+            occluded.push_back(traceRaw(false));
+        }
+        const auto median = [](std::vector<double> v) {
+            std::sort(v.begin(), v.end());
+            return v[v.size() / 2];
+        };
+        result.referenceSeconds = median(reference);
+        result.rawIntersectSeconds = median(intersect);
+        result.rawOccludedSeconds = median(occluded);
+        result.repeats = int(reference.size());
     });
     auto rate = [](std::uint64_t rays, double seconds) {
         return seconds > 0.0 ? double(rays) / seconds * 1e-6 : 0.0;

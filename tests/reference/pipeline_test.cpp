@@ -2,6 +2,8 @@
 // round trip and bad input.
 #include "reference/reference.h"
 
+#include "reference/prepared.h"
+
 #include "core/error.h"
 #include "test_scenes.h"
 
@@ -82,6 +84,39 @@ TEST(ReferencePipeline, ImagesAreBitwiseIdenticalForOneAndTwoThreads)
         ReferenceSettings s = makeQuickSettings(q);
         s.threadCount = 2;
         expectIdentical(one, computeReference(room.scene, room.gbuffer, s));
+    }
+}
+
+// The occlusion quantities trace a batch's rays as one Embree stream; every sample must be the one
+// evaluateOcclusionSample gives alone, for any batch start and length.
+TEST(ReferencePipeline, StreamedOcclusionBatchesEqualSingleSamples)
+{
+    const Room room;
+    for (Quantity q : {Quantity::Ao, Quantity::AoUniform, Quantity::Bent, Quantity::Obscurance}) {
+        SCOPED_TRACE(getQuantityName(q));
+        ReferenceSettings s = makeQuickSettings(q);
+        s.radius = 1.5;
+        const PreparedReference prepared(room.scene, room.gbuffer, s);
+        int pixels = 0, occludedSamples = 0;
+        for (std::size_t pixel = 0; pixel < prepared.getActive().size(); pixel += 7) {
+            if (!prepared.getActive()[pixel])
+                continue;
+            ++pixels;
+            const std::uint32_t first = std::uint32_t(pixel % 5), count = 45; // crosses a 32-ray chunk
+            std::vector<SampleValue> batch(count, SampleValue{});
+            const std::uint32_t batchRays = prepared.evaluateBatch(pixel, first, count, batch.data());
+            std::uint32_t singleRays = 0;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                SampleValue one{};
+                singleRays += prepared.evaluate(pixel, first + i, one);
+                for (int c = 0; c < kMaxChannels; ++c)
+                    ASSERT_EQ(batch[i][std::size_t(c)], one[std::size_t(c)]) << pixel << " sample " << first + i;
+                occludedSamples += one[q == Quantity::Bent ? 3 : 0] < 1.0 ? 1 : 0;
+            }
+            EXPECT_EQ(batchRays, singleRays);
+        }
+        EXPECT_GT(pixels, 20);
+        EXPECT_GT(occludedSamples, 0); // the room occludes some rays: hits and misses both compared
     }
 }
 

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <cmath>
 #include <set>
 #include <vector>
@@ -21,6 +23,25 @@ TEST(ReferenceSequences, SobolFirstPointsInNaturalOrder)
         EXPECT_EQ(computeSobol32(i, 1) * 0x1.0p-32, d1[i]) << i;
     }
     EXPECT_EQ(computeSobol32(8, 1), 15u << 28); // v_4 = 15 / 16
+}
+
+// sampleScrambledSobol2D cancels the reversals its definition would apply twice; its points must
+// be exactly those of the definition: the shuffled index's Sobol point, each coordinate scrambled.
+TEST(ReferenceSequences, ScrambledSobolEqualsItsDefinition)
+{
+    std::mt19937_64 rng(17);
+    for (int trial = 0; trial < 20000; ++trial) {
+        const std::uint32_t index = trial < 1000 ? std::uint32_t(trial) : std::uint32_t(rng());
+        const std::uint64_t stream = rng();
+        const std::uint64_t h0 = mixBits64(stream), h1 = mixBits64(h0 ^ 0x9e3779b97f4a7c15ull);
+        const std::uint32_t shuffled = scrambleNestedUniform(index, std::uint32_t(h0));
+        const glm::dvec2 expected(
+            toUnitInterval(scrambleNestedUniform(computeSobol32(shuffled, 0), std::uint32_t(h0 >> 32))),
+            toUnitInterval(scrambleNestedUniform(computeSobol32(shuffled, 1), std::uint32_t(h1))));
+        const glm::dvec2 got = sampleScrambledSobol2D(index, stream);
+        ASSERT_EQ(got.x, expected.x) << index;
+        ASSERT_EQ(got.y, expected.y) << index;
+    }
 }
 
 TEST(ReferenceSequences, ReverseBitsIsAnInvolution)
