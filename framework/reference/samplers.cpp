@@ -108,17 +108,27 @@ double pdfUniformSphere()
     return 1.0 / (4.0 * kPi);
 }
 
-glm::dvec3 sampleSphericalGaussian(const glm::dvec2& u, double sharpness)
+namespace {
+
+// sampleSphericalGaussian with expm1(-2k) computed by the caller (once per sky, not per sample).
+glm::dvec3 sampleSphericalGaussian(const glm::dvec2& u, double sharpness, double expm1MinusTwoK)
 {
     // CDF in w = cos(theta): F(w) = (exp(k(w - 1)) - exp(-2k)) / (1 - exp(-2k)). Solving F(w) = 1 -
     // u gives w = 1 + log(u + (1 - u) exp(-2k)) / k [Jakob 2012, "Numerically stable sampling of
     // the von Mises Fisher distribution on S^2"]; log1p/expm1 keep it exact for small and large k.
     const double k = sharpness;
-    const double oneMinusW = -std::log1p((1.0 - u.x) * std::expm1(-2.0 * k)) / k;
+    const double oneMinusW = -std::log1p((1.0 - u.x) * expm1MinusTwoK) / k;
     const double w = std::clamp(1.0 - oneMinusW, -1.0, 1.0);
     const double sinTheta = std::sqrt(std::max(0.0, oneMinusW * (2.0 - oneMinusW)));
     const double phi = 2.0 * kPi * u.y;
     return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), w};
+}
+
+} // namespace
+
+glm::dvec3 sampleSphericalGaussian(const glm::dvec2& u, double sharpness)
+{
+    return sampleSphericalGaussian(u, sharpness, std::expm1(-2.0 * sharpness));
 }
 
 double pdfSphericalGaussian(double cosTheta, double sharpness)
@@ -187,6 +197,8 @@ SkyLobeSampler::SkyLobeSampler(const scene::Sky& sky)
     if (sky.kind != scene::Sky::Kind::Srbf || !(sky.sharpness > 0.0f))
         return;
     mSharpness = sky.sharpness;
+    mExpm1 = std::expm1(-2.0 * mSharpness);
+    mNormalise = mSharpness / (-2.0 * kPi * mExpm1); // the same factor as pdfSphericalGaussian's
     const double integral = scene::integrateSphericalGaussian(mSharpness);
     std::vector<double> weights;
     for (const auto& peak : sky.lobes)
@@ -202,7 +214,7 @@ glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
 {
     double ux = 0.0;
     const std::size_t lobe = mLobes.sample(u.x, &ux);
-    return glm::normalize(mFrames[lobe].toWorld(sampleSphericalGaussian({ux, u.y}, mSharpness)));
+    return glm::normalize(mFrames[lobe].toWorld(sampleSphericalGaussian({ux, u.y}, mSharpness, mExpm1)));
 }
 
 double SkyLobeSampler::pdf(const glm::dvec3& direction) const
@@ -211,7 +223,7 @@ double SkyLobeSampler::pdf(const glm::dvec3& direction) const
     for (std::size_t i = 0; i < mFrames.size(); ++i)
         if (mLobes.pmf(i) > 0.0)
             p += mLobes.pmf(i) *
-                 pdfSphericalGaussian(glm::dot(direction, mFrames[i].normal), mSharpness);
+                 (mNormalise * std::exp(mSharpness * (glm::dot(direction, mFrames[i].normal) - 1.0)));
     return p;
 }
 

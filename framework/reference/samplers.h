@@ -99,6 +99,8 @@ private:
     DiscreteDistribution mLobes;
     std::vector<Frame> mFrames;
     double mSharpness = 0.0;
+    double mExpm1 = 0.0;     //!< expm1(-2 k), shared by every lobe's sample
+    double mNormalise = 0.0; //!< k / (-2 pi expm1(-2 k)), every lobe's pdf factor
 };
 
 } // namespace rtlab::reference
