@@ -625,6 +625,13 @@ double EvaluationStats::getCullingRate() const
     return 1.0 - double(getFieldEvaluations()) / double(bruteForceEvaluations);
 }
 
+double EvaluationStats::getIdealCullingRate() const
+{
+    if (bruteForceEvaluations == 0)
+        return 0.0;
+    return 1.0 - double(samplesInBand) / double(bruteForceEvaluations);
+}
+
 double EvaluationStats::getSamplesPerSecond() const
 {
     return fieldSeconds > 0.0 ? double(samples) / fieldSeconds : 0.0;

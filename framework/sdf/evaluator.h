@@ -111,6 +111,10 @@ struct EvaluationStats {
     std::uint64_t getFieldEvaluations() const { return sampleEvaluations + boundEvaluations; }
     //! 1 - getFieldEvaluations() / bruteForceEvaluations (0 when brute force does nothing).
     double getCullingRate() const;
+    //! The best culling rate any exact evaluator can reach on this grid and band: every sample in
+    //! the band needs at least one primitive evaluation, so 1 - samplesInBand /
+    //! bruteForceEvaluations (0 when brute force does nothing).
+    double getIdealCullingRate() const;
     //! samples / fieldSeconds.
     double getSamplesPerSecond() const;
 };

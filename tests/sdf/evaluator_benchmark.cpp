@@ -5,7 +5,8 @@
 //   build/tests/sdf/sdf_evaluator_benchmark [--benchmark_filter=<regex>] [threads]
 // Counters: samples_per_s (grid samples per wall-clock second), culling_rate (1 - primitive
 // evaluations / brute force's, bound evaluations included), evals (primitive evaluations per run),
-// in_band (samples with |d| <= band), edges (Hermite edges, where computed), emptyN / fullN (cells
+// in_band (samples with |d| <= band), ideal_rate (the culling rate of one primitive evaluation per
+// band sample and nothing else: no exact evaluator culls more), edges (Hermite edges, where computed), emptyN / fullN (cells
 // of level N, 0 = coarsest, proven outside / inside the band).
 
 #include "sdf/evaluator.h"
@@ -40,6 +41,7 @@ void runEvaluator(benchmark::State& state, const scene::SdfModel& model, int res
     state.counters["samples_per_s"] =
         benchmark::Counter(double(stats.samples) * double(state.iterations()), benchmark::Counter::kIsRate);
     state.counters["culling_rate"] = brute ? 0.0 : stats.getCullingRate();
+    state.counters["ideal_rate"] = stats.getIdealCullingRate(); // one evaluation per band sample
     state.counters["evals"] = double(stats.getFieldEvaluations());
     state.counters["in_band"] = double(stats.samplesInBand);
     state.counters["samples"] = double(stats.samples);

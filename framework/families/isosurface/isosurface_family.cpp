@@ -188,6 +188,7 @@ private:
                     mField = mEvaluated->field;
                     const sdf::EvaluationStats& st = mEvaluated->stats;
                     mRow->set("evaluator.culling_rate", st.getCullingRate())
+                        .set("evaluator.ideal_culling_rate", st.getIdealCullingRate())
                         .set("evaluator.samples_per_second", st.getSamplesPerSecond())
                         .set("evaluator.samples_in_band", std::int64_t(st.samplesInBand))
                         .set("evaluator.field_evaluations", std::int64_t(st.getFieldEvaluations()))
@@ -377,7 +378,7 @@ plugin::FamilyInfo describeIsosurfaceFamily()
                          "watertight", "boundary_edges", "non_manifold_edges", "self_intersections",
                          "angle.min_deg", "angle.sliver_fraction",
                          "counter.vertices_left_cell_share", "extract.mcells_per_s",
-                         "evaluator.culling_rate"},
+                         "evaluator.culling_rate", "evaluator.ideal_culling_rate"},
         .convergence = true,
         .histograms = {{.column = "angle.histogram_10deg",
                         .name = "angles",
