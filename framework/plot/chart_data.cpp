@@ -28,6 +28,14 @@ std::vector<std::size_t> findParetoFront(const std::vector<double>& x, const std
     return front;
 }
 
+VariantStyle getVariantStyle(int variant)
+{
+    // vtkPen line types and VTK marker styles, in the order a reader tells them apart best.
+    static constexpr VariantStyle kStyles[] = {{1, 4}, {2, 3}, {3, 5}, {4, 1}, {5, 2}};
+    constexpr int n = int(sizeof kStyles / sizeof kStyles[0]);
+    return kStyles[((variant % n) + n) % n];
+}
+
 std::vector<Color> getSeriesColors(const std::vector<Series>& series, const ColorTable& colors)
 {
     ColorTable table = colors;

@@ -17,6 +17,7 @@
 #include <vtkWeakPointer.h>
 
 #include <algorithm>
+#include <map>
 #include <array>
 #include <cmath>
 
@@ -65,23 +66,23 @@ public:
         const Box plotArea{xAxis->GetPosition1().GetX(), yAxis->GetPosition1().GetY(),
                            xAxis->GetPosition2().GetX(), yAxis->GetPosition2().GetY()};
         std::vector<Box> taken;
-        std::vector<float> points;
-        std::vector<unsigned char> colors;
+        std::map<int, std::pair<std::vector<float>, std::vector<unsigned char>>> byStyle;
         for (const DataMarker& m : mMarkers) {
             const float px = mapToScene(xAxis, m.x, true);
             const float py = mapToScene(yAxis, m.y, false);
             if (!std::isfinite(px) || !std::isfinite(py))
                 continue;
+            auto& [points, colors] = byStyle[m.style];
             points.insert(points.end(), {px, py});
             colors.insert(colors.end(), {m.color.r, m.color.g, m.color.b, 255});
             const float r = mMarkerSize / 2;
             taken.push_back({px - r, py - r, px + r, py + r});
         }
-        if (!points.empty()) {
+        for (auto& [style, drawn] : byStyle) {
             painter->GetPen()->SetWidth(mMarkerSize);
             painter->GetPen()->SetLineType(vtkPen::SOLID_LINE);
-            painter->DrawMarkers(VTK_MARKER_CIRCLE, false, points.data(), int(points.size() / 2),
-                                 colors.data(), 4);
+            painter->DrawMarkers(style, false, drawn.first.data(), int(drawn.first.size() / 2),
+                                 drawn.second.data(), 4);
         }
         const float kGap = std::max(5.0f, mMarkerSize / 2 + 1);
         for (const DataLabel& label : mLabels) {

@@ -35,7 +35,19 @@ struct Series {
     std::vector<double> x;
     std::vector<double> y;
     std::vector<std::string> pointLabels;
+    //! Which configuration of its technique this series is (0 = the first): series that share a
+    //! colour (one technique) are told apart by the line pattern and marker shape of their variant
+    //! (getVariantStyle). Line charts only.
+    int variant = 0;
 };
+
+//! The line pattern and marker of a variant: solid + circle, dashed + square, dotted + diamond,
+//! dash-dot + cross, dash-dot-dot + plus, then repeating.
+struct VariantStyle {
+    int lineType = 1; //!< vtkPen line type (1 solid, 2 dash, 3 dot, 4 dash-dot, 5 dash-dot-dot)
+    int marker = 4;   //!< VTK marker style (4 circle, 3 square, 5 diamond, 1 cross, 2 plus)
+};
+VariantStyle getVariantStyle(int variant);
 
 //! Run time against error, one colour per series. Both axes are minimised.
 struct ScatterSpec {

@@ -71,6 +71,7 @@ struct DataMarker {
     double x = 0.0;
     double y = 0.0;
     Color color;
+    int style = 4; //!< VTK marker style (VTK_MARKER_CIRCLE = 4)
 };
 
 //! Text at a data position of a chart.

@@ -6,6 +6,7 @@
 #include "plot/figure.h"
 
 #include <vtkChartXY.h>
+#include <vtkPen.h>
 #include <vtkPlotLine.h>
 #include <vtkSmartPointer.h>
 #include <vtkTable.h>
@@ -50,12 +51,14 @@ void writeLineChart(const LineSpec& spec, const std::string& pathWithoutExtensio
         auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
         line->SetInputData(table, 0, 1);
         detail::setLineColor(line, colors[s]);
+        const VariantStyle style = getVariantStyle(series.variant);
+        line->GetPen()->SetLineType(style.lineType);
         line->SetWidth(2.0f * scale);
         line->SetMarkerStyle(vtkPlotPoints::NONE); // markers are in the overlay
         line->SetLabel(series.label.empty() ? " " : series.label);
         if (spec.drawMarkers)
             for (std::size_t i = 0; i < x.size(); ++i)
-                markers.push_back({x[i], y[i], colors[s]});
+                markers.push_back({x[i], y[i], colors[s], style.marker});
     }
     detail::addChartOverlay(figure, chart, std::move(markers), 8.0f * scale, {}, 12.0f * scale);
     figure.write(pathWithoutExtension, spec.title);

@@ -160,6 +160,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             std::map<std::string, std::vector<const RunSummary*>> byConfig;
             for (const RunSummary* run : techniqueRuns)
                 byConfig[describeRun(*run, configParams)].push_back(run);
+            int variant = 0; // the technique's configurations: same colour, own line pattern and marker
             for (const auto& [config, runs] : byConfig) {
                 std::map<double, std::pair<double, int>> byCell;
                 for (const RunSummary* run : runs) {
@@ -172,6 +173,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
                 if (byCell.size() < 2)
                     continue;
                 plot::Series s;
+                s.variant = variant++;
                 double sx = 0, sy = 0, sxx = 0, sxy = 0;
                 for (const auto& [h, sum] : byCell) {
                     const double e = sum.first / sum.second;

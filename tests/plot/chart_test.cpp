@@ -216,6 +216,45 @@ TEST_F(ChartTest, LineChartWritesPngAndVectorPdf)
     expectChartFiles(base, spec.size, {spec.title, spec.xLabel, spec.yLabel, "ssao", "rtao"});
 }
 
+// Two configurations of one technique share its colour; the second is dashed with square markers.
+TEST_F(ChartTest, ConfigurationsOfOneTechniqueDifferInLineAndMarker)
+{
+    EXPECT_EQ(getVariantStyle(0).lineType, 1); // solid
+    for (int a = 0; a < 5; ++a)
+        for (int b = a + 1; b < 5; ++b) {
+            EXPECT_NE(getVariantStyle(a).lineType, getVariantStyle(b).lineType) << a << " " << b;
+            EXPECT_NE(getVariantStyle(a).marker, getVariantStyle(b).marker) << a << " " << b;
+        }
+    LineSpec spec;
+    spec.title = "Convergence";
+    spec.xLabel = "cell size h (world units)";
+    spec.yLabel = "Chamfer distance (world units)";
+    spec.series = {{"dc linear", {0.1, 0.05, 0.025}, {0.01, 0.005, 0.0025}, {}, 0},
+                   {"dc midpoint", {0.1, 0.05, 0.025}, {0.02, 0.01, 0.005}, {}, 1}};
+    spec.colors.setColor("dc linear", Color{200, 30, 30});
+    spec.colors.setColor("dc midpoint", Color{200, 30, 30});
+    const std::string dir = test::makeTempDir("variants");
+    writeLineChart(spec, dir + "/two");
+    expectChartFiles(dir + "/two", spec.size, {"dc linear", "dc midpoint"});
+    // The PDF sets a dash pattern (operator d with a non-empty array) only for the second line.
+    const std::string withDash = test::readPdfContent(dir + "/two.pdf");
+    spec.series[1].variant = 0;
+    writeLineChart(spec, dir + "/same");
+    const std::string withoutDash = test::readPdfContent(dir + "/same.pdf");
+    const auto countDashes = [](const std::string& content) {
+        std::size_t n = 0;
+        for (std::size_t at = content.find("] "); at != std::string::npos; at = content.find("] ", at + 1)) {
+            const std::size_t open = content.rfind('[', at);
+            const std::size_t end = content.find('d', at);
+            if (open != std::string::npos && at > open + 1 && end != std::string::npos && end < at + 12 &&
+                content.find_first_not_of("0123456789. ", at + 2) == end)
+                ++n;
+        }
+        return n;
+    };
+    EXPECT_GT(countDashes(withDash), countDashes(withoutDash));
+}
+
 TEST_F(ChartTest, StackedBarsWritePngAndVectorPdf)
 {
     StackedBarSpec spec;
