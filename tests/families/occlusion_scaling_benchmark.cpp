@@ -12,7 +12,8 @@
 //   occlusion_scaling_benchmark [--quick] [--csv path] [--repeats n] [--warmup n]
 //                               [--technique name] [--cpu]
 // --quick: 2 tiny resolutions x 2 knob values, 1 repeat (the ctest that keeps this compiling and
-// running). --cpu: time the plain C++ path (input.gpu = null) by its CPU wall time instead.
+// running). Every technique with a `radius` is also timed at the largest size with radius
+// default / 2, default and default x 2, and the slope of log(time) on log(radius) is printed. --cpu: time the plain C++ path (input.gpu = null) by its CPU wall time instead.
 
 #include "experiment/gpu_timing.h"
 #include "gpu/context.h"
@@ -279,8 +280,55 @@ int main(int argc, char** argv)
     timing.repeats = options.repeats;
     timing.warmup = options.warmup;
 
+    // Times one configuration of a technique on G-buffer s.
+    const auto timeRun = [&](const plugin::TechniqueEntry& entry, const config::ParamSet& params,
+                             std::size_t s) {
+        auto technique = entry.create(params);
+        auto& occlusion = dynamic_cast<plugin::OcclusionTechnique&>(*technique);
+        const SyntheticGBuffer& g = gbuffers[s];
+        plugin::OcclusionInput input;
+        input.linearDepth = &g.depth;
+        input.normal = &g.normal;
+        input.projection = g.projection;
+        input.view = g.view;
+        input.gpu = gpu.get();
+        plugin::OcclusionOutput out;
+        if (gpu)
+            gpu->takeRunLog();
+        const metrics::TimingReport report = metrics::measure(timing, [&] {
+            occlusion.compute(input, out);
+            return gpu ? experiment::collectGpuPassTimes(*gpu) : metrics::GpuPassTimes{};
+        });
+        Run run;
+        run.technique = entry.info.name;
+        run.width = sizes[s].first;
+        run.height = sizes[s].second;
+        run.cpuMedianMs = report.cpuMs.median;
+        run.firstUseMs = report.firstUseMs;
+        const double gpuMs = report.gpuTotalMedianMs();
+        if (gpu && std::isfinite(gpuMs)) {
+            run.timeMs = gpuMs;
+            double iqr = 0.0;
+            for (const auto& [label, stats] : report.gpuMs)
+                iqr += stats.iqr();
+            run.iqrMs = iqr;
+        } else {
+            run.timeMs = report.cpuMs.median;
+            run.iqrMs = report.cpuMs.iqr();
+        }
+        return run;
+    };
+
     std::vector<Run> runs;
     std::vector<std::pair<std::string, Fit>> fits;
+    // The radius axis: each technique with a `radius` at the largest size and its default knob,
+    // radius default / 2, default, default x 2 (LSAO's claim is a cost independent of it).
+    struct RadiusRun {
+        std::string technique;
+        double radius = 0.0;
+        Run run;
+    };
+    std::vector<RadiusRun> radiusRuns;
     std::printf("\n%-14s %-11s %5s %11s %12s %10s %12s\n", "technique", "knob", "value", "size",
                 "time ms", "iqr ms", "first use ms");
     for (const plugin::TechniqueEntry* entry : plugin::builtinRegistry().techniques("occlusion")) {
@@ -292,42 +340,10 @@ int main(int argc, char** argv)
             config::ParamSet params = config::ParamSet::defaultsOf(entry->schema);
             if (!knob.empty())
                 params.set(knob, value);
-            auto technique = entry->create(params);
-            auto& occlusion = dynamic_cast<plugin::OcclusionTechnique&>(*technique);
             for (std::size_t s = 0; s < sizes.size(); ++s) {
-                const SyntheticGBuffer& g = gbuffers[s];
-                plugin::OcclusionInput input;
-                input.linearDepth = &g.depth;
-                input.normal = &g.normal;
-                input.projection = g.projection;
-                input.view = g.view;
-                input.gpu = gpu.get();
-                plugin::OcclusionOutput out;
-                if (gpu)
-                    gpu->takeRunLog();
-                const metrics::TimingReport report = metrics::measure(timing, [&] {
-                    occlusion.compute(input, out);
-                    return gpu ? experiment::collectGpuPassTimes(*gpu) : metrics::GpuPassTimes{};
-                });
-                Run run;
-                run.technique = entry->info.name;
+                Run run = timeRun(*entry, params, s);
                 run.knob = knob;
                 run.knobValue = value;
-                run.width = sizes[s].first;
-                run.height = sizes[s].second;
-                run.cpuMedianMs = report.cpuMs.median;
-                run.firstUseMs = report.firstUseMs;
-                const double gpuMs = report.gpuTotalMedianMs();
-                if (gpu && std::isfinite(gpuMs)) {
-                    run.timeMs = gpuMs;
-                    double iqr = 0.0;
-                    for (const auto& [label, stats] : report.gpuMs)
-                        iqr += stats.iqr();
-                    run.iqrMs = iqr;
-                } else {
-                    run.timeMs = report.cpuMs.median;
-                    run.iqrMs = report.cpuMs.iqr();
-                }
                 std::printf("%-14s %-11s %5lld %5dx%-5d %12.3f %10.3f %12.3f\n",
                             run.technique.c_str(), knob.empty() ? "-" : knob.c_str(),
                             (long long)value, run.width, run.height, run.timeMs, run.iqrMs,
@@ -338,6 +354,33 @@ int main(int argc, char** argv)
         }
         fits.emplace_back(entry->info.name, fitExponents(techniqueRuns));
         runs.insert(runs.end(), techniqueRuns.begin(), techniqueRuns.end());
+        if (const config::ParamSpec* spec = entry->schema.find("radius");
+            spec != nullptr && spec->type == config::ParamType::Float) {
+            const double d = std::get<double>(spec->defaultValue);
+            for (const double factor : {0.5, 1.0, 2.0}) {
+                const double radius = std::clamp(d * factor, spec->min, spec->max);
+                config::ParamSet params = config::ParamSet::defaultsOf(entry->schema);
+                params.set("radius", radius);
+                radiusRuns.push_back({entry->info.name, radius, timeRun(*entry, params, sizes.size() - 1)});
+            }
+        }
+    }
+
+    std::printf("\ntime against the radius (%dx%d, default knob), slope of log(time) on log(radius):\n",
+                sizes.back().first, sizes.back().second);
+    std::printf("%-14s %10s %10s %10s %8s\n", "technique", "r / 2 ms", "r ms", "2r ms", "slope");
+    for (std::size_t i = 0; i + 2 < radiusRuns.size(); i += 3) {
+        double sx = 0, sy = 0, sxx = 0, sxy = 0;
+        for (std::size_t k = i; k < i + 3; ++k) {
+            const double lx = std::log(radiusRuns[k].radius), ly = std::log(radiusRuns[k].run.timeMs);
+            sx += lx;
+            sy += ly;
+            sxx += lx * lx;
+            sxy += lx * ly;
+        }
+        const double slope = (3 * sxy - sx * sy) / (3 * sxx - sx * sx);
+        std::printf("%-14s %10.3f %10.3f %10.3f %8.3f\n", radiusRuns[i].technique.c_str(),
+                    radiusRuns[i].run.timeMs, radiusRuns[i + 1].run.timeMs, radiusRuns[i + 2].run.timeMs, slope);
     }
 
     std::printf("\nleast squares log(time) = a + b log(pixels) + c log(knob):\n");
