@@ -12,7 +12,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
-#include <set>
 #include <sstream>
 
 namespace rtlab::report::detail {
@@ -257,7 +256,12 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
         }
     }
 
-    // 2. Error against each swept numeric parameter: the mean error over the runs with that value.
+    // 2. Error against each swept numeric parameter, over matched runs only: one line per technique
+    //    and setting of the other swept parameters (runs that differ in this parameter alone), so
+    //    that a value swept in only one variant is not compared with the mean of every other run.
+    //    Lines of one technique share its colour and differ in pattern and marker; at most
+    //    kMaxLines per technique, those with the most values first.
+    constexpr std::size_t kMaxLines = 5;
     for (const auto& param : group.varyingParams) {
         const std::string name = param.rfind("param.", 0) == 0 ? param.substr(6) : param;
         plot::LineSpec line;
@@ -265,31 +269,28 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
         line.xLabel = name == "grid" ? "grid (samples per axis)" : name;
         line.yLabel = columns.errorLabel;
         line.colors = colors;
-        for (const auto& [technique, runs] : byTechnique) {
-            std::map<double, std::pair<double, int>> byValue;
-            for (const RunSummary* run : runs) {
-                const double x = run->get(param), y = run->get(columns.error);
-                if (std::isfinite(x) && std::isfinite(y)) {
-                    byValue[x].first += y;
-                    byValue[x].second += 1;
-                }
-            }
-            if (byValue.size() < 2)
-                continue;
-            plot::Series s{technique};
-            for (const auto& [x, sum] : byValue) {
+        const MatchedLines matched =
+            collectMatchedLines(group.runs, param, columns.error, group.varyingParams, kMaxLines);
+        const std::size_t leftOut = matched.leftOut;
+        for (const MatchedLine& m : matched.lines) {
+            plot::Series s{m.label};
+            s.variant = m.variant;
+            for (const auto& [x, y] : m.points) {
                 s.x.push_back(x);
-                s.y.push_back(sum.first / sum.second);
+                s.y.push_back(y);
             }
+            line.colors.setColor(s.label, line.colors.getColor(m.technique));
             line.series.push_back(std::move(s));
         }
         if (line.series.empty())
-            continue; // not numeric, or one value per technique
+            continue; // not numeric, or no two runs that differ in this parameter alone
         const std::string path = plots + "/error_vs_" + makeFileName(name) + "_" + stem;
         plot::writeLineChart(line, path);
         figures.plots.push_back(path);
-        figures.captions.push_back("Mean error against " + name + " on " + group.title +
-                                   " (averaged over the other swept axes).");
+        figures.captions.push_back(
+            "Error against " + name + " on " + group.title +
+            ", over runs that differ in " + name + " alone (one line per setting of the other swept parameters" +
+            (leftOut > 0 ? "; " + std::to_string(leftOut) + " settings with fewer values not drawn" : "") + ").");
     }
 
     // 3. Per-pass time of each technique's Pareto-front runs, stacked.

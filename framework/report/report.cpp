@@ -141,6 +141,91 @@ std::string describeRun(const RunSummary& run, const std::vector<std::string>& v
     return s;
 }
 
+MatchedLines collectMatchedLines(const std::vector<RunSummary>& runs, const std::string& param,
+                                 const std::string& errorColumn, const std::vector<std::string>& varyingParams,
+                                 std::size_t maxLinesPerTechnique)
+{
+    std::vector<std::string> others;
+    for (const auto& p : varyingParams)
+        if (p != param)
+            others.push_back(p);
+    // Run settings that are not technique parameters but change the error as much: the camera
+    // path (a still camera, eight frames with digs), the frame's switches and the frame count.
+    // `names` picks among the parameters and these; `others` with every one of these is the key.
+    static const std::vector<std::string> kRunColumns = {"camera_path", "frame.culling", "frame.gbuffer_on_gpu"};
+    const auto describeSetting = [&](const RunSummary& run, const std::vector<std::string>& names, bool key) {
+        std::vector<std::string> params;
+        for (const auto& n : names)
+            if (std::find(kRunColumns.begin(), kRunColumns.end(), n) == kRunColumns.end() && n != "frames")
+                params.push_back(n);
+        std::string s = describeRun(run, params);
+        const auto wanted = [&](const std::string& n) {
+            return key || std::find(names.begin(), names.end(), n) != names.end();
+        };
+        const auto& first = run.frames.front();
+        for (const auto& column : kRunColumns)
+            if (auto it = first.find(column); it != first.end() && !it->second.empty() && wanted(column))
+                s += (s.empty() ? "" : " ") + column + "=" + it->second;
+        if (wanted("frames"))
+            s += (s.empty() ? "" : " ") + std::string("frames=") + std::to_string(run.frames.size());
+        return s;
+    };
+    // Techniques in first-seen order; per technique, per setting of the others: value -> (sum, n).
+    std::vector<std::string> techniques;
+    std::map<std::string, std::map<std::string, std::map<double, std::pair<double, int>>>> sums;
+    std::map<std::string, std::map<std::string, const RunSummary*>> example;
+    for (const RunSummary& run : runs) {
+        const double x = run.get(param), y = run.get(errorColumn);
+        if (!std::isfinite(x) || !std::isfinite(y))
+            continue;
+        if (!sums.count(run.technique))
+            techniques.push_back(run.technique);
+        const std::string setting = describeSetting(run, others, true);
+        auto& sum = sums[run.technique][setting][x];
+        sum.first += y;
+        sum.second += 1;
+        example[run.technique].emplace(setting, &run);
+    }
+    MatchedLines out;
+    for (const std::string& technique : techniques) {
+        auto& bySetting = sums[technique];
+        std::vector<std::string> settings;
+        for (const auto& [setting, values] : bySetting)
+            if (values.size() >= 2)
+                settings.push_back(setting);
+        std::stable_sort(settings.begin(), settings.end(), [&](const std::string& a, const std::string& b) {
+            return bySetting[a].size() > bySetting[b].size();
+        });
+        if (settings.size() > maxLinesPerTechnique) {
+            out.leftOut += settings.size() - maxLinesPerTechnique;
+            settings.resize(maxLinesPerTechnique);
+        }
+        // The label names the other parameters that differ among this technique's lines.
+        std::vector<std::string> candidates = others;
+        candidates.insert(candidates.end(), {"camera_path", "frame.culling", "frame.gbuffer_on_gpu", "frames"});
+        std::vector<std::string> differing;
+        for (const auto& p : candidates) {
+            std::set<std::string> values;
+            for (const auto& setting : settings)
+                values.insert(describeSetting(*example[technique][setting], {p}, false));
+            if (values.size() > 1)
+                differing.push_back(p);
+        }
+        int variant = 0;
+        for (const auto& setting : settings) {
+            MatchedLine line;
+            line.technique = technique;
+            const std::string detail = describeSetting(*example[technique][setting], differing, false);
+            line.label = technique + (detail.empty() ? "" : " " + detail);
+            line.variant = variant++;
+            for (const auto& [x, sum] : bySetting[setting])
+                line.points[x] = sum.first / sum.second;
+            out.lines.push_back(std::move(line));
+        }
+    }
+    return out;
+}
+
 std::map<std::string, std::map<double, double>>
 collectAcrossScenesLines(const std::vector<Group>& groups, const std::string& family,
                          const plugin::AcrossScenesFigure& spec)

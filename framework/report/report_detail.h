@@ -43,6 +43,25 @@ std::map<std::string, std::map<double, double>>
 collectAcrossScenesLines(const std::vector<Group>& groups, const std::string& family,
                          const plugin::AcrossScenesFigure& spec);
 
+//! One line of an "error against a parameter" figure: a technique's runs that share every other
+//! varying parameter (they differ in the plotted one alone), the mean error at each value.
+struct MatchedLine {
+    std::string technique;
+    std::string label;   //!< the technique, then the other parameters that differ among its lines
+    int variant = 0;     //!< 0, 1, ... within the technique (plot::Series::variant)
+    std::map<double, double> points;
+};
+struct MatchedLines {
+    std::vector<MatchedLine> lines;
+    std::size_t leftOut = 0; //!< settings with two or more values beyond maxLinesPerTechnique
+};
+//! The matched lines of `param` against `errorColumn` for each technique of `runs` (in order):
+//! settings of the other `varyingParams` with at least two finite values of `param`, those with
+//! the most values first, at most maxLinesPerTechnique per technique.
+MatchedLines collectMatchedLines(const std::vector<RunSummary>& runs, const std::string& param,
+                                 const std::string& errorColumn, const std::vector<std::string>& varyingParams,
+                                 std::size_t maxLinesPerTechnique);
+
 struct Figures {
     std::vector<std::string> plots;     //!< paths without extension
     std::vector<std::string> captions;  //!< one per plot

@@ -53,4 +53,54 @@ TEST(ReportLines, SplitByTheDeclaredColumnsAndAveraged)
     EXPECT_DOUBLE_EQ(merged.at("tree").at(1.0), 0.055);
 }
 
+detail::RunSummary makeSweepRun(const std::string& technique, double levels, double noise, double rmse)
+{
+    detail::RunSummary run;
+    run.technique = technique;
+    run.number = {{"param.levels", levels}, {"param.noise", noise}, {"rmse", rmse}};
+    run.frames = {experiment::Row{{"param.levels", std::to_string(int(levels))},
+                                  {"param.noise", std::to_string(noise)}}};
+    return run;
+}
+
+// "Error against a parameter" lines compare runs that differ in that parameter alone: a value swept
+// in one variant only is not set against the mean of every other run.
+TEST(ReportLines, ErrorAgainstAParameterUsesMatchedRunsOnly)
+{
+    const std::vector<std::string> varying = {"param.levels", "param.noise"};
+    // levels swept at noise 0; noise swept (0.1, 0.2) at levels 6 only, where its 0 is the run
+    // (levels 6, noise 0). The runs at levels 4 and 8 must not enter the noise = 0 point.
+    const std::vector<detail::RunSummary> runs = {
+        makeSweepRun("cascades", 4, 0.0, 0.30), makeSweepRun("cascades", 6, 0.0, 0.12),
+        makeSweepRun("cascades", 8, 0.0, 0.10), makeSweepRun("cascades", 6, 0.1, 0.11),
+        makeSweepRun("cascades", 6, 0.2, 0.13), makeSweepRun("svo", 4, 0.0, 0.2),
+        makeSweepRun("svo", 4, 0.1, NAN)};
+    const detail::MatchedLines noise = detail::collectMatchedLines(runs, "param.noise", "rmse", varying, 5);
+    ASSERT_EQ(noise.lines.size(), 1u); // svo has one finite noise value: no line
+    EXPECT_EQ(noise.lines[0].label, "cascades");
+    ASSERT_EQ(noise.lines[0].points.size(), 3u);
+    EXPECT_DOUBLE_EQ(noise.lines[0].points.at(0.0), 0.12); // not (0.30 + 0.12 + 0.10) / 3
+    EXPECT_DOUBLE_EQ(noise.lines[0].points.at(0.2), 0.13);
+
+    // levels: one line at noise 0 (three values); the noise 0.1 and 0.2 settings have one value each.
+    const detail::MatchedLines levels = detail::collectMatchedLines(runs, "param.levels", "rmse", varying, 5);
+    ASSERT_EQ(levels.lines.size(), 1u);
+    EXPECT_EQ(levels.lines[0].points.size(), 3u);
+
+    // Two settings with two or more values: two lines, told apart by label and variant; with room
+    // for one line only the one with more values stays and the other is counted as left out.
+    std::vector<detail::RunSummary> more = runs;
+    more.push_back(makeSweepRun("cascades", 4, 0.1, 0.25));
+    const detail::MatchedLines two = detail::collectMatchedLines(more, "param.levels", "rmse", varying, 5);
+    ASSERT_EQ(two.lines.size(), 2u);
+    EXPECT_EQ(two.lines[0].label, "cascades noise=0.000000");
+    EXPECT_EQ(two.lines[0].variant, 0);
+    EXPECT_EQ(two.lines[1].label, "cascades noise=0.100000");
+    EXPECT_EQ(two.lines[1].variant, 1);
+    const detail::MatchedLines one = detail::collectMatchedLines(more, "param.levels", "rmse", varying, 1);
+    ASSERT_EQ(one.lines.size(), 1u);
+    EXPECT_EQ(one.lines[0].points.size(), 3u);
+    EXPECT_EQ(one.leftOut, 1u);
+}
+
 } // namespace
