@@ -45,6 +45,20 @@ std::vector<Color> getSeriesColors(const std::vector<Series>& series, const Colo
     return result;
 }
 
+FigureSize widenForLegend(FigureSize size, const std::vector<Series>& series)
+{
+    // Figure::getFontScale; the legend's labels are 13 px at scale 1, about 0.56 em per character,
+    // plus the line swatch and padding; the axes and their labels take about 110 px.
+    const float scale = std::max(0.5f, std::min(float(size.width) / 1000.0f, float(size.height) / 700.0f));
+    std::size_t longest = 0;
+    for (const Series& s : series)
+        longest = std::max(longest, s.label.size());
+    const double legend = (60.0 + 0.56 * 13.0 * double(longest)) * scale;
+    const int needed = int(std::ceil((110.0 + 600.0 + 20.0) * scale + legend));
+    size.width = std::min(16384, std::max(size.width, needed));
+    return size;
+}
+
 bool isLogAxis(AxisScale scale, const std::vector<double>& values)
 {
     if (scale != AxisScale::Automatic)

@@ -121,6 +121,11 @@ std::vector<ParetoFrontLine> computeParetoFronts(const ScatterSpec& spec);
 //! copy of `colors`).
 std::vector<Color> getSeriesColors(const std::vector<Series>& series, const ColorTable& colors);
 
+//! The figure size a chart with these series' legend is drawn at: `size`, widened where the
+//! legend (right of the plot, as wide as its longest label) would leave the plot area narrower
+//! than 600 pixels at the figure's font scale, so that a legend never squeezes the plot.
+FigureSize widenForLegend(FigureSize size, const std::vector<Series>& series);
+
 //! Whether an axis over `values` is drawn logarithmic: Log, Linear, or for Automatic every finite
 //! value > 0 and max / min >= kAutoLogRatio.
 bool isLogAxis(AxisScale scale, const std::vector<double>& values);

@@ -25,7 +25,8 @@ void writeLineChart(const LineSpec& spec, const std::string& pathWithoutExtensio
     const auto colors = getSeriesColors(spec.series, spec.colors);
 
     auto lock = detail::lockRendering();
-    detail::Figure figure(spec.size.width, spec.size.height);
+    const FigureSize size = widenForLegend(spec.size, spec.series);
+    detail::Figure figure(size.width, size.height);
     const float scale = figure.getFontScale();
     vtkChartXY* chart = detail::addChart(figure, spec.title, xAxis, yAxis);
     std::vector<detail::DataMarker> markers;

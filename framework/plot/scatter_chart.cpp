@@ -41,7 +41,8 @@ void writeScatter(const ScatterSpec& spec, const std::string& pathWithoutExtensi
         spec.drawParetoFronts ? computeParetoFronts(spec) : std::vector<ParetoFrontLine>{};
 
     auto lock = detail::lockRendering();
-    detail::Figure figure(spec.size.width, spec.size.height);
+    const FigureSize size = widenForLegend(spec.size, spec.series);
+    detail::Figure figure(size.width, size.height);
     const float scale = figure.getFontScale();
     vtkChartXY* chart = detail::addChart(figure, spec.title, xAxis, yAxis);
 

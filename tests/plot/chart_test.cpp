@@ -255,6 +255,26 @@ TEST_F(ChartTest, ConfigurationsOfOneTechniqueDifferInLineAndMarker)
     EXPECT_GT(countDashes(withDash), countDashes(withoutDash));
 }
 
+// A legend with long labels widens the figure instead of squeezing the plot area.
+TEST_F(ChartTest, LongLegendLabelsWidenTheFigure)
+{
+    LineSpec spec;
+    spec.title = "Error against resolution";
+    spec.xLabel = "resolution (voxels per axis)";
+    spec.yLabel = "RMSE (unitless)";
+    const std::string longLabel =
+        "cascades inject_device=cpu levels=6 supersampling=4 voxelize_device=cpu schedule=one_pass";
+    spec.series = {{longLabel, {16, 32, 64}, {0.14, 0.12, 0.13}, {}}, {"svo", {64, 128}, {0.12, 0.15}, {}}};
+    const FigureSize widened = widenForLegend(spec.size, spec.series);
+    EXPECT_GT(widened.width, spec.size.width);
+    EXPECT_EQ(widened.height, spec.size.height);
+    // Short labels keep the requested size.
+    EXPECT_EQ(widenForLegend(spec.size, {{"svo", {1}, {1}, {}}}).width, spec.size.width);
+    const std::string base = test::makeTempDir("legend") + "/long";
+    writeLineChart(spec, base);
+    expectChartFiles(base, widened, {"svo"});
+}
+
 TEST_F(ChartTest, StackedBarsWritePngAndVectorPdf)
 {
     StackedBarSpec spec;
