@@ -128,8 +128,11 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
                 any = any || std::isfinite(s.y[i]);
             }
         }
-        if (!any)
+        if (!any) {
+            figures.notes.push_back("No chart of " + label + " on " + group.title +
+                                    ": no run has a finite value (" + column + ").");
             continue;
+        }
         const std::string path = plots + "/time_vs_" + makeFileName(column) + "_" + stem;
         plot::writeScatter(extra, path);
         figures.plots.push_back(path);
@@ -405,6 +408,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
     Figures lit = writeLitFrameFigures(group, directory, colors);
     figures.plots.insert(figures.plots.end(), lit.plots.begin(), lit.plots.end());
     figures.captions.insert(figures.captions.end(), lit.captions.begin(), lit.captions.end());
+    figures.notes.insert(figures.notes.end(), lit.notes.begin(), lit.notes.end());
     return figures;
 }
 

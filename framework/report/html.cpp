@@ -80,6 +80,8 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
               << "\"><figcaption>" << escapeHtml(figures[gi].captions[i]) << " <a href=\"" << escapeHtml(rel)
               << ".pdf\">PDF</a></figcaption></figure>\n";
         }
+        for (const std::string& note : figures[gi].notes)
+            h << "<p class=\"note\">" << escapeHtml(note) << "</p>\n";
         // The runs, sorted by error, with the columns a reader compares.
         std::vector<const RunSummary*> runs;
         for (const auto& r : g.runs)

@@ -65,6 +65,7 @@ MatchedLines collectMatchedLines(const std::vector<RunSummary>& runs, const std:
 struct Figures {
     std::vector<std::string> plots;     //!< paths without extension
     std::vector<std::string> captions;  //!< one per plot
+    std::vector<std::string> notes;     //!< one line per chart left out (no finite value to draw)
 };
 
 //! Writes every figure of `group` under directory/plots; returns them with captions.

@@ -103,4 +103,39 @@ TEST(ReportLines, ErrorAgainstAParameterUsesMatchedRunsOnly)
     EXPECT_EQ(one.leftOut, 1u);
 }
 
+// A further error column without a finite value in the group (edge-Chamfer on a sphere) gives no
+// empty chart but a one-line note; a column with values gives its chart.
+TEST(ReportLines, AnErrorColumnWithoutValuesIsANoteNotAnEmptyChart)
+{
+    detail::Group group;
+    group.key = "sphere_64";
+    group.title = "sphere, 64";
+    group.family = "isosurface";
+    group.columns.cost = "t";
+    group.columns.costLabel = "time (ms)";
+    group.columns.error = "chamfer";
+    group.columns.errorLabel = "Chamfer distance (world units)";
+    group.columns.extraErrors = {{"edge", "edge-Chamfer distance (world units)"},
+                                 {"hausdorff", "Hausdorff distance (world units)"}};
+    for (int i = 0; i < 3; ++i) {
+        detail::RunSummary run;
+        run.runId = "run" + std::to_string(i);
+        run.technique = "marching_cubes";
+        run.number = {{"t", 1.0 + i}, {"chamfer", 0.1 / (1 + i)}, {"edge", NAN}, {"hausdorff", 0.3 / (1 + i)}};
+        run.frames = {experiment::Row{{"t", "1"}}};
+        group.runs.push_back(run);
+    }
+    const std::string directory = ::testing::TempDir() + "/report_notes";
+    const detail::Figures figures = detail::writeGroupFigures(group, directory, {"marching_cubes"});
+    ASSERT_EQ(figures.notes.size(), 1u);
+    EXPECT_NE(figures.notes[0].find("edge-Chamfer"), std::string::npos) << figures.notes[0];
+    bool edgeChart = false, hausdorffChart = false;
+    for (const std::string& plot : figures.plots) {
+        edgeChart = edgeChart || plot.find("time_vs_edge") != std::string::npos;
+        hausdorffChart = hausdorffChart || plot.find("time_vs_hausdorff") != std::string::npos;
+    }
+    EXPECT_FALSE(edgeChart);
+    EXPECT_TRUE(hausdorffChart);
+}
+
 } // namespace
