@@ -269,7 +269,10 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
         const std::string name = param.rfind("param.", 0) == 0 ? param.substr(6) : param;
         plot::LineSpec line;
         line.title = group.title + ": error against " + name;
-        line.xLabel = name == "grid" ? "grid (samples per axis)" : name;
+        const auto unit = group.paramUnits.find(param);
+        line.xLabel = name == "grid" ? "grid (samples per axis)"
+                      : unit != group.paramUnits.end() ? name + " (" + unit->second + ")"
+                                                       : name;
         line.yLabel = columns.errorLabel;
         line.colors = colors;
         const MatchedLines matched =

@@ -122,6 +122,15 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows,
             for (const auto& [k, vs] : values)
                 if (vs.size() > 1)
                     g.varyingParams.push_back(k);
+        // The units of the varying parameters, from the schemas of the group's techniques.
+        const std::string family = g.family.substr(0, g.family.find('+'));
+        for (const auto& run : g.runs)
+            if (const plugin::TechniqueEntry* entry = registry.findTechnique(family, run.technique))
+                for (const auto& k : g.varyingParams)
+                    if (k.rfind("param.", 0) == 0 && !g.paramUnits.count(k))
+                        if (const config::ParamSpec* spec = entry->schema.find(k.substr(6));
+                            spec != nullptr && !spec->unit.empty())
+                            g.paramUnits[k] = spec->unit;
         out.push_back(std::move(g));
     }
     return out;

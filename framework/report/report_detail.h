@@ -30,6 +30,7 @@ struct Group {
     FamilyColumns columns; //!< what the family declares for its figures
     std::vector<RunSummary> runs;
     std::vector<std::string> varyingParams;  //!< param.* columns and "grid" with more than one value
+    std::map<std::string, std::string> paramUnits; //!< param.* column -> its schema's unit, where it has one
 };
 
 std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows, const plugin::Registry& registry);
