@@ -194,13 +194,40 @@ void computeAxisRange(const std::vector<double>& values, bool log, double& min, 
         min = 0;
 }
 
+std::string wrapText(const std::string& text, std::size_t maxChars)
+{
+    std::string out, line;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        std::size_t end = text.find(' ', start);
+        if (end == std::string::npos)
+            end = text.size();
+        const std::string word = text.substr(start, end - start);
+        if (!line.empty() && line.size() + 1 + word.size() > maxChars) {
+            out += (out.empty() ? "" : "\n") + line;
+            line = word;
+        } else {
+            line += (line.empty() ? "" : " ") + word;
+        }
+        start = end + 1;
+    }
+    if (!line.empty())
+        out += (out.empty() ? "" : "\n") + line;
+    return out;
+}
+
 vtkChartXY* addChart(Figure& figure, const std::string& title, const AxisSetup& x,
                      const AxisSetup& y)
 {
     const float scale = figure.getFontScale();
     vtkNew<vtkChartXY> chart;
     figure.addItem(chart);
-    chart->SetTitle(title);
+    // A long title wraps at spaces (18 px bold: about 0.6 em per character). VTK centres it over
+    // the plot area, which a legend may narrow to its 600 px minimum (widenForLegend): the title
+    // may pass that by the axis margin on either side, about 720 px in all.
+    const float titleWidth = std::min(float(figure.getWidth() - 40), 720.0f * scale);
+    const std::size_t maxChars = std::max<std::size_t>(20, std::size_t(titleWidth / (0.6f * 18.0f * scale)));
+    chart->SetTitle(wrapText(title, maxChars));
     styleText(chart->GetTitleProperties(), 18 * scale, true);
     chart->SetAutoAxes(false);
     setupAxis(chart->GetAxis(vtkAxis::BOTTOM), x, scale, figure.getWidth());

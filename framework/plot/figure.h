@@ -66,6 +66,10 @@ void setPlotColor(vtkPlot* plot, Color color, unsigned char alpha = 255);
 //! Colour of a line plot's pen, with no fill (the PDF device fills polylines with the brush).
 void setLineColor(vtkPlot* plot, Color color);
 
+//! `text` with its spaces turned into line breaks where a line would pass maxChars characters
+//! (a word longer than that stays whole on its own line).
+std::string wrapText(const std::string& text, std::size_t maxChars);
+
 //! A marker at a data position of a chart.
 struct DataMarker {
     double x = 0.0;

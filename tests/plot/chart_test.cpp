@@ -1,4 +1,5 @@
 #include "plot/charts.h"
+#include "plot/figure.h"
 
 #include "core/error.h"
 #include "experiment/analysis.h"
@@ -259,7 +260,8 @@ TEST_F(ChartTest, ConfigurationsOfOneTechniqueDifferInLineAndMarker)
 TEST_F(ChartTest, LongLegendLabelsWidenTheFigure)
 {
     LineSpec spec;
-    spec.title = "Error against resolution";
+    spec.title = "voxel_gi: tomorrow_town, 320x180: error against resolution, over runs that differ in "
+                 "resolution alone, one line per setting of the other swept parameters";
     spec.xLabel = "resolution (voxels per axis)";
     spec.yLabel = "RMSE (unitless)";
     const std::string longLabel =
@@ -273,6 +275,16 @@ TEST_F(ChartTest, LongLegendLabelsWidenTheFigure)
     const std::string base = test::makeTempDir("legend") + "/long";
     writeLineChart(spec, base);
     expectChartFiles(base, widened, {"svo"});
+}
+
+TEST(FigureText, LongTitlesWrapAtSpaces)
+{
+    EXPECT_EQ(detail::wrapText("short title", 40), "short title");
+    EXPECT_EQ(detail::wrapText("voxel_gi: tomorrow_town, 320x180: time per pass of the runs", 30),
+              "voxel_gi: tomorrow_town,\n320x180: time per pass of the\nruns");
+    EXPECT_EQ(detail::wrapText("averyveryverylongword fits", 10), "averyveryverylongword\nfits");
+    const std::string wrapped = detail::wrapText(std::string(200, 'a') + " b c d e f g", 12);
+    EXPECT_EQ(wrapped.substr(0, 200), std::string(200, 'a'));
 }
 
 TEST_F(ChartTest, StackedBarsWritePngAndVectorPdf)
