@@ -91,6 +91,11 @@ struct StackedBarSpec {
     FigureSize size;
 };
 
+//! Whether every line of every bar label fits under its bar (12 px text, about 0.55 em per
+//! character, in the plot width the figure leaves the bars). When not, callers number the bars and
+//! give the labels in a key.
+bool barLabelsFit(const StackedBarSpec& spec);
+
 //! Writes <pathWithoutExtension>.png and .pdf, creating the folder if needed. Throws rtlab::Error
 //! when the input is inconsistent or a file cannot be written.
 void writeScatter(const ScatterSpec& spec, const std::string& pathWithoutExtension);

@@ -22,6 +22,25 @@
 
 namespace rtlab::plot {
 
+bool barLabelsFit(const StackedBarSpec& spec)
+{
+    if (spec.bars.empty())
+        return true;
+    const float scale = std::max(0.5f, std::min(float(spec.size.width) / 1000.0f, float(spec.size.height) / 700.0f));
+    // The plot spans the figure less the y axis and the pass legend (about 250 px at scale 1).
+    const double perBar = (double(spec.size.width) - 250.0 * scale) / double(spec.bars.size());
+    std::size_t longest = 0;
+    for (const std::string& label : spec.bars) {
+        std::size_t start = 0;
+        while (start <= label.size()) {
+            const std::size_t end = std::min(label.find('\n', start), label.size());
+            longest = std::max(longest, end - start);
+            start = end + 1;
+        }
+    }
+    return double(longest) * 0.55 * 12.0 * scale <= 0.9 * perBar;
+}
+
 void writeStackedBars(const StackedBarSpec& spec, const std::string& pathWithoutExtension)
 {
     if (spec.values.size() != spec.bars.size())

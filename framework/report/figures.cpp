@@ -324,11 +324,20 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             bars.bars.resize(16);
             bars.values.resize(16);
         }
+        // Labels that do not fit under their bars become numbers, with the key in the caption.
+        std::string key;
+        if (!plot::barLabelsFit(bars))
+            for (std::size_t b = 0; b < bars.bars.size(); ++b) {
+                std::string label = bars.bars[b];
+                std::replace(label.begin(), label.end(), '\n', ' ');
+                key += (key.empty() ? " Bars: " : "; ") + std::to_string(b + 1) + " = " + label;
+                bars.bars[b] = std::to_string(b + 1);
+            }
         const std::string path = plots + "/pass_times_" + stem;
         plot::writeStackedBars(bars, path);
         figures.plots.push_back(path);
-        figures.captions.push_back(
-            "Time per pass of the runs on each technique's Pareto front on " + group.title + ".");
+        figures.captions.push_back("Time per pass of the runs on each technique's Pareto front on " +
+                                   group.title + "." + (key.empty() ? "" : key + "."));
     }
 
     // 4. Images (families that write them, findRunImages): reference | each technique's

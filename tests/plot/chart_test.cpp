@@ -287,6 +287,19 @@ TEST(FigureText, LongTitlesWrapAtSpaces)
     EXPECT_EQ(wrapped.substr(0, 200), std::string(200, 'a'));
 }
 
+TEST(BarLabels, LongLabelsUnderManyBarsDoNotFit)
+{
+    StackedBarSpec spec;
+    spec.bars = {"gtao", "lsao", "ssdo"};
+    EXPECT_TRUE(barLabelsFit(spec));
+    spec.bars = {"gtao\nslices=2", "lsao\ndirections=36"}; // each line counts, not the whole label
+    EXPECT_TRUE(barLabelsFit(spec));
+    spec.bars.assign(16, "adaptive_voxel_tree_cones\nresolution=64 depth=3 inner_layers=4");
+    EXPECT_FALSE(barLabelsFit(spec));
+    spec.bars.assign(16, "12");
+    EXPECT_TRUE(barLabelsFit(spec));
+}
+
 TEST_F(ChartTest, StackedBarsWritePngAndVectorPdf)
 {
     StackedBarSpec spec;
