@@ -345,7 +345,7 @@ struct Loader {
         config::checkKeys(file, node,
                           {"scene", "grid", "resolution", "frames", "camera_path", "metrics",
                            "timing", "reference", "frame", "techniques"},
-                          {"scene", "techniques"}, "base");
+                          {"scene"}, "base");
         RunConfig run;
         readScene(node["scene"], run);
         if (node["grid"])
@@ -360,7 +360,10 @@ struct Loader {
             readTiming(node["timing"], run);
         if (node["frame"])
             readFrame(node["frame"], run);
-        readTechniques(node["techniques"], run);
+        // Without base techniques every run takes its technique from the sweep (a study of
+        // several families, one variant each); expand() checks that each run has one.
+        if (node["techniques"])
+            readTechniques(node["techniques"], run);
         if (node["camera_path"])
             readCameraPath(node["camera_path"], run);
         if (node["metrics"])
@@ -447,6 +450,12 @@ struct Loader {
                                   std::vector<std::string>& keys) const
     {
         std::vector<RunConfig> runs = expandAxes(sweep, {base}, base, keys, true);
+        for (std::size_t i = 0; i < runs.size(); ++i)
+            if (runs[i].techniques.empty())
+                file.fail(sweep ? sweep : file.root()["base"],
+                          "run " + std::to_string(i + 1) + " of the expansion (" + runs[i].id() +
+                              ") has no technique: give base a `techniques:` entry, or set "
+                              "<family>.technique in every variant");
         std::map<std::string, std::size_t> seen;
         for (std::size_t i = 0; i < runs.size(); ++i)
             if (!seen.emplace(runs[i].hash(), i).second)

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <set>
 #include <sstream>
 
 namespace rtlab::report::detail {
@@ -162,6 +163,15 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             std::map<std::string, std::vector<const RunSummary*>> byConfig;
             for (const RunSummary* run : techniqueRuns)
                 byConfig[describeRun(*run, configParams)].push_back(run);
+            // Labels name only the parameters that differ among this technique's configurations.
+            std::vector<std::string> differing;
+            for (const auto& p : configParams) {
+                std::set<std::string> values;
+                for (const auto& [config, runs] : byConfig)
+                    values.insert(describeRun(*runs.front(), {p}));
+                if (values.size() > 1)
+                    differing.push_back(p);
+            }
             int variant = 0; // the technique's configurations: same colour, own line pattern and marker
             for (const auto& [config, runs] : byConfig) {
                 std::map<double, std::pair<double, int>> byCell;
@@ -191,7 +201,8 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
                 const double order = (n * sxy - sx * sy) / (n * sxx - sx * sx);
                 char text[64];
                 std::snprintf(text, sizeof text, "%.2f", order);
-                const std::string name = technique + (config.empty() ? "" : " " + config);
+                const std::string detail = describeRun(*runs.front(), differing);
+                const std::string name = technique + (detail.empty() ? "" : " " + detail);
                 s.label = name + " (order " + text + ")";
                 orders += (orders.empty() ? "" : ", ") + name + " " + text;
                 plot::Color c = line.colors.getColor(technique);

@@ -83,5 +83,27 @@ TEST(IsosurfaceDriver,
     EXPECT_EQ(row.at("exact_distance"), "false") << "a CSG landscape's field is a distance bound";
 }
 
+// A smooth shape has no sharp features: its edge-Chamfer and edge-F1 are left empty (the score
+// against no curves would be a vacuous 0 and 1), a box's are measured.
+TEST(IsosurfaceDriver, EdgeMetricsOnlyWhereTheShapeHasSharpFeatures)
+{
+    const auto rows = runStudy("edges", R"(base:
+  scene: sphere
+  grid: 24
+  timing: {warmup: 0, repeats: 1}
+  techniques: {isosurface: {technique: marching_cubes}}
+sweep:
+  scene: [sphere, box]
+)");
+    ASSERT_EQ(rows.size(), 2u);
+    for (const auto& row : rows) {
+        ASSERT_EQ(row.at("status"), "ok") << row.at("error");
+        const bool box = row.at("scene") == "box";
+        EXPECT_EQ(experiment::getNumber(row, "edge.feature_segments"), box ? 12.0 : 0.0) << row.at("scene");
+        EXPECT_EQ(std::isfinite(experiment::getNumber(row, "edge.chamfer")), box) << row.at("scene");
+        EXPECT_EQ(std::isfinite(experiment::getNumber(row, "edge.f1")), box) << row.at("scene");
+    }
+}
+
 } // namespace
 } // namespace rtlab

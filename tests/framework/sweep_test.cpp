@@ -170,6 +170,46 @@ sweep:
                                                      "isosurface.mode"}));
 }
 
+// A study of two families: the base names no technique, each variant names its family's.
+TEST(Sweep, BaseWithoutTechniquesTakesThemFromEachVariant)
+{
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: sphere
+  grid: 32
+sweep:
+  variants:
+    - {isosurface.technique: [marching_cubes, dual_contouring]}
+    - {scene: [ao_testbed], resolution: [[64, 36]], occlusion.technique: [gtao]}
+)",
+                                               "two_families.yaml", plugin::builtinRegistry());
+    ASSERT_EQ(e.runs.size(), 3u);
+    EXPECT_EQ(e.runs[0].techniques.count("isosurface"), 1u);
+    EXPECT_EQ(e.runs[1].techniques.at("isosurface").technique, "dual_contouring");
+    ASSERT_EQ(e.runs[2].techniques.size(), 1u);
+    EXPECT_EQ(e.runs[2].techniques.at("occlusion").technique, "gtao");
+
+    // A run that ends up with no technique is an error naming the run.
+    const auto registry = test::makeTestRegistry();
+    std::string error;
+    try {
+        experiment::parseExperiment(R"(base:
+  scene: sphere
+sweep:
+  variants:
+    - {isosurface.technique: [fake_mesher]}
+    - {scene: [box]}
+)",
+                                    "missing.yaml", registry);
+    } catch (const InputError& ex) {
+        error = ex.what();
+    }
+    EXPECT_NE(error.find("missing.yaml:"), std::string::npos) << error;
+    EXPECT_NE(error.find("run 2 of the expansion"), std::string::npos) << error;
+    EXPECT_NE(error.find("has no technique"), std::string::npos) << error;
+    EXPECT_NE(errorOf("base:\n  scene: sphere\n").find("has no technique"), std::string::npos)
+        << errorOf("base:\n  scene: sphere\n");
+}
+
 TEST(Sweep, CameraPathMetricsAndGroundTruthOverrideAreBaseKeysAndCameraPathAnAxis)
 {
     const auto registry = test::makeTestRegistry();

@@ -280,9 +280,15 @@ private:
             const auto score = metrics::measureSharpFeatures(
                 mMesh, *mSubject.features, {.minCreaseDeg = 30.0, .tolerance = tolerance});
             mRow->set("edge.f1_tolerance", tolerance);
-            mRow->set("edge.chamfer", score.edgeChamfer)
-                .set("edge.chamfer_cells", score.edgeChamfer / mField.spacing)
-                .set("edge.f1", score.f1)
+            // A shape without sharp features (a sphere) has no edge-Chamfer or edge-F1 to speak of:
+            // the score against no curves is vacuous (0 and 1), so the row leaves them empty and
+            // the report says so instead of drawing a chart of zeros.
+            const bool none = mSubject.features->empty();
+            const double nan = std::nan("");
+            mRow->set("edge.feature_segments", std::int64_t(mSubject.features->size()));
+            mRow->set("edge.chamfer", none ? nan : score.edgeChamfer)
+                .set("edge.chamfer_cells", none ? nan : score.edgeChamfer / mField.spacing)
+                .set("edge.f1", none ? nan : score.f1)
                 .set("edge.precision", score.precision)
                 .set("edge.recall", score.recall);
         });
