@@ -59,6 +59,17 @@ int main(int argc, char** argv)
     const plot::ColorTable colors(std::vector<std::string>(techniques.begin(), techniques.end()));
 
     for (const auto& [scene, sceneRows] : byScene) {
+        // A scene of another family's study (the smoke study also holds AO runs, whose columns
+        // are ao.*) has no run with both columns: say so rather than draw an empty chart.
+        bool any = false;
+        for (const auto& r : sceneRows)
+            any = any || (std::isfinite(experiment::getNumber(r, cost)) &&
+                          std::isfinite(experiment::getNumber(r, error)));
+        if (!any) {
+            std::printf("\n### %s: no run has both %s and %s; skipped\n", scene.c_str(), cost.c_str(),
+                        error.c_str());
+            continue;
+        }
         // 4. The Pareto plot: one series per technique; every other run is dominated by a front
         //    run that is at least as fast and at least as accurate.
         plot::ScatterSpec scatter;
