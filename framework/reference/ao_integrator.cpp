@@ -102,23 +102,7 @@ std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfaceP
     const Frame frame = Frame::fromNormal(point.normal);
     const glm::vec3 origin(point.position + context.rayEpsilon * point.normal);
     const float tFar = std::isinf(context.radius) ? kInfiniteDistance : float(context.radius);
-    const auto makeRay = [&](const glm::dvec3& w) {
-        RTCRay ray;
-        ray.org_x = origin.x;
-        ray.org_y = origin.y;
-        ray.org_z = origin.z;
-        ray.tnear = 0.0f;
-        const glm::vec3 d(w);
-        ray.dir_x = d.x;
-        ray.dir_y = d.y;
-        ray.dir_z = d.z;
-        ray.time = 0.0f;
-        ray.tfar = tFar;
-        ray.mask = 0xffffffffu;
-        ray.id = 0;
-        ray.flags = 0;
-        return ray;
-    };
+    const auto rayAlong = [&](const glm::dvec3& w) { return makeRay(origin, glm::vec3(w), tFar); };
     constexpr std::uint32_t kChunk = 32;
     const std::uint32_t raysPerSample = q == Quantity::Bent ? 2 : 1;
     RTCRay rays[2 * kChunk];
@@ -137,9 +121,9 @@ std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfaceP
         }
         for (std::uint32_t i = 0; i < n; ++i) {
             directions[i] = frame.toWorld(directions[i]);
-            rays[raysPerSample * i] = makeRay(directions[i]);
+            rays[raysPerSample * i] = rayAlong(directions[i]);
             if (q == Quantity::Bent)
-                rays[2 * i + 1] = makeRay(frame.toWorld(uniform[i]));
+                rays[2 * i + 1] = rayAlong(frame.toWorld(uniform[i]));
         }
         context.embree->occluded(rays, raysPerSample * n, true);
         for (std::uint32_t i = 0; i < n; ++i) {

@@ -172,19 +172,7 @@ bool EmbreeScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tFa
 {
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    RTCRay ray;
-    ray.org_x = org.x;
-    ray.org_y = org.y;
-    ray.org_z = org.z;
-    ray.tnear = 0.0f;
-    ray.dir_x = dir.x;
-    ray.dir_y = dir.y;
-    ray.dir_z = dir.z;
-    ray.time = 0.0f;
-    ray.tfar = tFar;
-    ray.mask = 0xffffffffu;
-    ray.id = 0;
-    ray.flags = 0;
+    RTCRay ray = makeRay(org, dir, tFar);
     rtcOccluded1(mScene, &context, &ray);
     // Embree sets tfar to -inf when the ray is occluded.
     return ray.tfar < 0.0f;

@@ -53,4 +53,23 @@ private:
 //! The largest float tFar Embree accepts as "no limit".
 constexpr float kInfiniteDistance = std::numeric_limits<float>::infinity();
 
+//! An Embree ray org + t dir, 0 <= t <= tFar, every mask bit set, time 0.
+inline RTCRay makeRay(const glm::vec3& org, const glm::vec3& dir, float tFar)
+{
+    RTCRay ray;
+    ray.org_x = org.x;
+    ray.org_y = org.y;
+    ray.org_z = org.z;
+    ray.tnear = 0.0f;
+    ray.dir_x = dir.x;
+    ray.dir_y = dir.y;
+    ray.dir_z = dir.z;
+    ray.time = 0.0f;
+    ray.tfar = tFar;
+    ray.mask = 0xffffffffu;
+    ray.id = 0;
+    ray.flags = 0;
+    return ray;
+}
+
 } // namespace rtlab::reference

@@ -69,15 +69,7 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
             for (std::uint32_t i = 0; i < std::uint32_t(s.maxSamples); ++i) {
                 const glm::vec3 d(frame.toWorld(sampleCosineHemisphere(sequence.get2D(i, 0))));
                 RTCRayHit rh{};
-                rh.ray.org_x = o.x;
-                rh.ray.org_y = o.y;
-                rh.ray.org_z = o.z;
-                rh.ray.dir_x = d.x;
-                rh.ray.dir_y = d.y;
-                rh.ray.dir_z = d.z;
-                rh.ray.tnear = 0.0f;
-                rh.ray.tfar = tFar;
-                rh.ray.mask = 0xffffffffu;
+                rh.ray = makeRay(o, d, tFar);
                 rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
                 rays.push_back(rh);
             }
