@@ -110,6 +110,9 @@ std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfaceP
     glm::dvec3 directions[kChunk], uniform[kChunk];
     for (std::uint32_t begin = 0; begin < count; begin += kChunk) {
         const std::uint32_t n = std::min(kChunk, count - begin);
+        // The points and directions in loops of their own, so that independent samples overlap in
+        // the pipeline: 0.66 of bare rtcIntersect1 on cornell_box (ao, 16 spp) against 0.56 when each
+        // sample's point, direction and ray are made in turn.
         sequence.get2D(first + begin, n, kPairCosine, u);
         if (q == Quantity::AoUniform)
             sampleUniformHemispheres(u, directions, n);
