@@ -5,8 +5,13 @@
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include <algorithm>
 #include <array>
@@ -15,6 +20,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -50,40 +56,165 @@ private:
     std::size_t mStride[3];
 };
 
-//! Calls visit(x, y, axis) for every crossed grid edge starting in sample layer z, in the one
-//! order that both passes share: rows (y), then samples (x), then axes x, y, z. The edges of
-//! layer z are its x and y edges and the z edges from z to z + 1.
-template <class Visit>
-void visitCrossedEdges(const Grid& grid, const std::vector<std::uint8_t>& inside, int z,
-                       Visit&& visit)
+// The grid walk follows the idea of Flying Edges [Schroeder, Maynard & Geveci 2015]: classify
+// each x-row of samples once, then touch only the rows and cells the surface crosses. Here a row's
+// classification is a bit mask (one bit per sample, 64 per word), so the crossed edges of a row
+// and the cells with mixed corners come out of XORs of neighbouring rows, whole words at a time,
+// and the walk visits set bits only; Flying Edges keeps per-row edge cases and trim ranges instead.
+
+//! The smallest float t >= iso, so that for every float v, v < t exactly when double(v) < iso:
+//! the float comparison classifies like the double one without widening each sample.
+float getInsideThreshold(double iso)
 {
-    const int nx = grid.size(0);
-    const int ny = grid.size(1);
-    const bool hasUp = z + 1 < grid.size(2);
-    for (int y = 0; y < ny; ++y) {
-        const bool hasY = y + 1 < ny;
-        std::size_t i = grid.index(0, y, z);
-        for (int x = 0; x < nx; ++x, ++i) {
-            const std::uint8_t in = inside[i];
-            if (x + 1 < nx && in != inside[i + 1])
-                visit(x, y, 0);
-            if (hasY && in != inside[i + grid.stride(1)])
-                visit(x, y, 1);
-            if (hasUp && in != inside[i + grid.stride(2)])
-                visit(x, y, 2);
+    constexpr float kMax = std::numeric_limits<float>::max();
+    if (iso > double(kMax))
+        return std::numeric_limits<float>::infinity();
+    if (iso <= -double(kMax))
+        return -kMax;
+    float t = static_cast<float>(iso);
+    if (double(t) < iso)
+        t = std::nextafter(t, std::numeric_limits<float>::infinity());
+    return t;
+}
+
+//! Inside bits of every x-row of samples: bit x % 64 of word x / 64 is set when sample x is
+//! inside (value < iso). Bits at and past nx are 0 in every row.
+class SignRows {
+public:
+    explicit SignRows(const glm::ivec3& samples)
+        : mNx(samples.x), mNy(samples.y), mWords((std::size_t(samples.x) + 63) / 64),
+          mBits(std::make_unique_for_overwrite<std::uint64_t[]>(mWords * std::size_t(samples.y) *
+                                                               std::size_t(samples.z)))
+    {
+        // classify() writes every word of every row
+    }
+
+    std::size_t words() const { return mWords; }
+    std::uint64_t* row(int y, int z) { return &mBits[(std::size_t(z) * mNy + y) * mWords]; }
+    const std::uint64_t* row(int y, int z) const
+    {
+        return &mBits[(std::size_t(z) * mNy + y) * mWords];
+    }
+
+    //! Classifies the samples of row (y, z), `values` pointing at its sample 0. Returns false
+    //! when the row holds a NaN (classified outside; the caller reports it).
+    bool classify(const float* values, float threshold, std::uint64_t* bits) const
+    {
+        bool finiteOrInf = true;
+        for (std::size_t w = 0; w < mWords; ++w) {
+            const float* v = values + 64 * w;
+            const int n = std::min(64, mNx - int(64 * w));
+            std::uint64_t mask = 0;
+            int k = 0;
+#if defined(__SSE2__)
+            const __m128 t = _mm_set1_ps(threshold);
+            __m128 nan = _mm_setzero_ps();
+            for (; k + 4 <= n; k += 4) {
+                const __m128 x = _mm_loadu_ps(v + k);
+                mask |= std::uint64_t(_mm_movemask_ps(_mm_cmplt_ps(x, t))) << k;
+                nan = _mm_or_ps(nan, _mm_cmpunord_ps(x, x));
+            }
+            finiteOrInf = finiteOrInf && _mm_movemask_ps(nan) == 0;
+#endif
+            for (; k < n; ++k) {
+                mask |= std::uint64_t(v[k] < threshold) << k;
+                finiteOrInf = finiteOrInf && !std::isnan(v[k]);
+            }
+            bits[w] = mask;
+        }
+        return finiteOrInf;
+    }
+
+    //! Bit x set when samples x and x + 1 of `row` differ, for x < nx - 1.
+    void getXCrossings(const std::uint64_t* row, std::uint64_t* out) const
+    {
+        for (std::size_t w = 0; w < mWords; ++w) {
+            const std::uint64_t next = w + 1 < mWords ? row[w + 1] : 0;
+            out[w] = row[w] ^ ((row[w] >> 1) | (next << 63));
+        }
+        clearLastSample(out);
+    }
+
+    //! Clears bit nx - 1: no edge or cell starts at the last sample of a row.
+    void clearLastSample(std::uint64_t* mask) const
+    {
+        mask[std::size_t(mNx - 1) / 64] &= ~(std::uint64_t(1) << ((mNx - 1) % 64));
+    }
+
+private:
+    int mNx;
+    int mNy;
+    std::size_t mWords;
+    std::unique_ptr<std::uint64_t[]> mBits;
+};
+
+//! Up to 256 samples per row stay on the stack; longer rows use the heap.
+class WordBuffer {
+public:
+    explicit WordBuffer(std::size_t words) : mHeap(words > kLocal ? words : 0)
+    {
+        mData = words > kLocal ? mHeap.data() : mLocal;
+    }
+    std::uint64_t* data() { return mData; }
+
+private:
+    static constexpr std::size_t kLocal = 4;
+    std::uint64_t mLocal[kLocal];
+    std::vector<std::uint64_t> mHeap;
+    std::uint64_t* mData;
+};
+
+//! Calls visit(x, axis) for the crossed edges starting in sample row (y, z), in the order both
+//! passes share: samples (x), then axes x, y, z. The row's edges are its x edges and the y and z
+//! edges to the next row and layer (`nextY`, `nextZ`: null where there is none).
+template <class Visit>
+void visitCrossedEdges(const SignRows& rows, const std::uint64_t* row, const std::uint64_t* nextY,
+                       const std::uint64_t* nextZ, std::uint64_t* scratch, Visit&& visit)
+{
+    rows.getXCrossings(row, scratch);
+    for (std::size_t w = 0; w < rows.words(); ++w) {
+        const std::uint64_t ex = scratch[w];
+        const std::uint64_t ey = nextY ? row[w] ^ nextY[w] : 0;
+        const std::uint64_t ez = nextZ ? row[w] ^ nextZ[w] : 0;
+        for (std::uint64_t any = ex | ey | ez; any != 0; any &= any - 1) {
+            const int bit = std::countr_zero(any);
+            const int x = int(64 * w) + bit;
+            if ((ex >> bit) & 1)
+                visit(x, 0);
+            if ((ey >> bit) & 1)
+                visit(x, 1);
+            if ((ez >> bit) & 1)
+                visit(x, 2);
         }
     }
+}
+
+//! The number of crossed edges starting in sample row (y, z) (see visitCrossedEdges).
+std::uint64_t countCrossedEdges(const SignRows& rows, const std::uint64_t* row,
+                                const std::uint64_t* nextY, const std::uint64_t* nextZ,
+                                std::uint64_t* scratch)
+{
+    rows.getXCrossings(row, scratch);
+    std::uint64_t count = 0;
+    for (std::size_t w = 0; w < rows.words(); ++w) {
+        count += std::uint64_t(std::popcount(scratch[w]));
+        if (nextY)
+            count += std::uint64_t(std::popcount(row[w] ^ nextY[w]));
+        if (nextZ)
+            count += std::uint64_t(std::popcount(row[w] ^ nextZ[w]));
+    }
+    return count;
 }
 
 //! Vertex index of every crossed edge starting in one sample layer, per axis, indexed y * nx + x.
 //! Entries of edges that are not crossed are stale; the case table never asks for them.
 struct LayerVertices {
-    std::vector<std::uint32_t> edge[3];
+    std::unique_ptr<std::uint32_t[]> edge[3]; // left uninitialised: only crossed edges are read
 
     explicit LayerVertices(std::size_t layerSize)
     {
         for (auto& e : edge)
-            e.resize(layerSize);
+            e = std::make_unique_for_overwrite<std::uint32_t[]>(layerSize);
     }
 };
 
@@ -91,8 +222,17 @@ struct LayerVertices {
 //! grid, one-sided on its boundary.
 glm::dvec3 computeGradient(const Grid& grid, int x, int y, int z)
 {
-    const int coord[3] = {x, y, z};
     const std::size_t i = grid.index(x, y, z);
+    if (x > 0 && y > 0 && z > 0 && x + 1 < grid.size(0) && y + 1 < grid.size(1) &&
+        z + 1 < grid.size(2)) {
+        // Inside the grid (nearly every vertex): the same differences without the per-axis tests.
+        const std::size_t sy = grid.stride(1);
+        const std::size_t sz = grid.stride(2);
+        return {0.5 * (grid.relative(i + 1) - grid.relative(i - 1)),
+                0.5 * (grid.relative(i + sy) - grid.relative(i - sy)),
+                0.5 * (grid.relative(i + sz) - grid.relative(i - sz))};
+    }
+    const int coord[3] = {x, y, z};
     glm::dvec3 gradient(0.0);
     for (int axis = 0; axis < 3; ++axis) {
         const std::size_t step = grid.stride(axis);
@@ -126,10 +266,9 @@ constexpr std::uint32_t kInteriorFlag = 0x80000000u;
 
 class Mesher {
 public:
-    Mesher(const Grid& grid, const ExtractionOptions& options,
-           const std::vector<std::uint8_t>& inside, const std::vector<std::uint64_t>& layerOffset,
-           TriangleMesh& mesh)
-        : mGrid(grid), mOptions(options), mInside(inside), mLayerOffset(layerOffset), mMesh(mesh),
+    Mesher(const Grid& grid, const ExtractionOptions& options, const SignRows& rows,
+           const std::vector<std::uint64_t>& layerOffset, TriangleMesh& mesh)
+        : mGrid(grid), mOptions(options), mRows(rows), mLayerOffset(layerOffset), mMesh(mesh),
           mTable(CaseTable::getInstance())
     {
         for (int c = 0; c < kCornerCount; ++c)
@@ -138,14 +277,16 @@ public:
     }
 
     //! Meshes cell layers [z0, z1): writes the edge vertices of the sample layers it owns and
-    //! appends its triangles, in cell scan order, to `out`.
-    void meshSlab(int z0, int z1, SlabOutput& out) const
+    //! appends its triangles, in cell scan order, to `out`. `lower` and `upper` are scratch of
+    //! layerSize() entries per axis; their contents on entry do not matter.
+    void meshSlab(int z0, int z1, LayerVertices& lower, LayerVertices& upper,
+                  SlabOutput& out) const
     {
         const int lastLayer = mGrid.size(2) - 1;
-        LayerVertices lower(mGrid.layerSize());
-        LayerVertices upper(mGrid.layerSize());
         // A slab owns the vertices of sample layers z0 .. z1 - 1 (and the top layer if it is the
         // last slab). It numbers layer z1 too, for its top cells, but the next slab writes it.
+        // A closed surface has about two triangles per edge vertex: reserve that many indices.
+        out.triangles.reserve(6 * (mLayerOffset[z1 + 1] - mLayerOffset[z0]));
         numberLayer(z0, lower, true);
         for (int z = z0; z < z1; ++z) {
             numberLayer(z + 1, upper, z + 1 < z1 || z + 1 == lastLayer);
@@ -158,17 +299,25 @@ private:
     void numberLayer(int z, LayerVertices& layer, bool writeVertices) const
     {
         std::uint64_t next = mLayerOffset[z];
+        const int ny = mGrid.size(1);
+        const bool hasUp = z + 1 < mGrid.size(2);
         const std::size_t nx = std::size_t(mGrid.size(0));
-        visitCrossedEdges(mGrid, mInside, z, [&](int x, int y, int axis) {
-            const auto index = static_cast<std::uint32_t>(next++);
-            layer.edge[axis][std::size_t(y) * nx + x] = index;
-            if (!writeVertices)
-                return;
-            const Vertex vertex = computeEdgeVertex(x, y, z, axis);
-            mMesh.positions[index] = glm::vec3(vertex.position);
-            if (mOptions.computeNormals)
-                mMesh.normals[index] = glm::vec3(vertex.normal);
-        });
+        WordBuffer scratch(mRows.words());
+        for (int y = 0; y < ny; ++y) {
+            const std::uint64_t* nextY = y + 1 < ny ? mRows.row(y + 1, z) : nullptr;
+            const std::uint64_t* nextZ = hasUp ? mRows.row(y, z + 1) : nullptr;
+            visitCrossedEdges(mRows, mRows.row(y, z), nextY, nextZ, scratch.data(),
+                              [&](int x, int axis) {
+                                  const auto index = static_cast<std::uint32_t>(next++);
+                                  layer.edge[axis][std::size_t(y) * nx + x] = index;
+                                  if (!writeVertices)
+                                      return;
+                                  const Vertex vertex = computeEdgeVertex(x, y, z, axis);
+                                  mMesh.positions[index] = glm::vec3(vertex.position);
+                                  if (mOptions.computeNormals)
+                                      mMesh.normals[index] = glm::vec3(vertex.normal);
+                              });
+        }
         assert(next == mLayerOffset[z + 1]);
     }
 
@@ -283,43 +432,79 @@ private:
     void meshCellLayer(int z, const LayerVertices& lower, const LayerVertices& upper,
                        SlabOutput& out) const
     {
-        const int nx = mGrid.size(0);
         const int ny = mGrid.size(1);
-        const auto& edges = getCellEdges();
+        const std::size_t words = mRows.words();
+        WordBuffer active(words);
         for (int y = 0; y + 1 < ny; ++y) {
-            std::size_t base = mGrid.index(0, y, z);
-            for (int x = 0; x + 1 < nx; ++x, ++base) {
-                // [Lorensen & Cline 1987] the case index from the signs of the eight corners.
-                unsigned cube = 0;
-                for (int c = 0; c < kCornerCount; ++c)
-                    cube |= unsigned(mInside[base + mCornerOffset[c]]) << c;
-                if (cube == 0 || cube == 255)
-                    continue;
-                const CellTriangulation& cell = mTable.find(cube, decideFaces(cube, base));
-                std::uint32_t interior[kMaxCellExtras];
-                for (int j = 0; j < cell.extraCount; ++j) {
-                    interior[j] = kInteriorFlag | std::uint32_t(out.interior.size());
-                    out.interior.push_back(computeInteriorVertex(x, y, z, cell, j));
-                }
-                for (int k = 0; k < 3 * cell.triangleCount; ++k) {
-                    const int id = cell.vertices[k];
-                    if (id >= kExtraVertex) {
-                        out.triangles.push_back(interior[id - kExtraVertex]);
-                        continue;
-                    }
-                    const CellEdge& edge = edges[id];
-                    const LayerVertices& layer = getCornerBit(edge.start, 2) ? upper : lower;
-                    const std::size_t column = std::size_t(y + getCornerBit(edge.start, 1)) * nx +
-                                               std::size_t(x + getCornerBit(edge.start, 0));
-                    out.triangles.push_back(layer.edge[edge.axis][column]);
-                }
+            // The four sample rows holding the corners of this row of cells: corner c lies in
+            // row (c >> 1) & 3, at sample x + (c & 1).
+            const std::uint64_t* row[4] = {mRows.row(y, z), mRows.row(y + 1, z),
+                                           mRows.row(y, z + 1), mRows.row(y + 1, z + 1)};
+            // A cell is active unless its eight corners agree: some row differs from row 0 at
+            // sample x or x + 1, or row 0 changes from x to x + 1.
+            for (std::size_t w = 0; w < words; ++w) {
+                const std::uint64_t d = (row[0][w] ^ row[1][w]) | (row[0][w] ^ row[2][w]) |
+                                        (row[0][w] ^ row[3][w]);
+                const std::uint64_t dNext =
+                    w + 1 < words ? (row[0][w + 1] ^ row[1][w + 1]) |
+                                        (row[0][w + 1] ^ row[2][w + 1]) |
+                                        (row[0][w + 1] ^ row[3][w + 1])
+                                  : 0;
+                const std::uint64_t aNext = w + 1 < words ? row[0][w + 1] : 0;
+                active.data()[w] = d | (d >> 1) | (dNext << 63) |
+                                   (row[0][w] ^ ((row[0][w] >> 1) | (aNext << 63)));
             }
+            mRows.clearLastSample(active.data());
+            for (std::size_t w = 0; w < words; ++w)
+                for (std::uint64_t bits = active.data()[w]; bits != 0; bits &= bits - 1) {
+                    const int x = int(64 * w) + std::countr_zero(bits);
+                    // [Lorensen & Cline 1987] the case index from the signs of the eight corners.
+                    const unsigned cube = getCornerPair(row[0], x) |
+                                          getCornerPair(row[1], x) << 2 |
+                                          getCornerPair(row[2], x) << 4 |
+                                          getCornerPair(row[3], x) << 6;
+                    meshCell(x, y, z, cube, lower, upper, out);
+                }
+        }
+    }
+
+    //! Bits x and x + 1 of a sign row, as bits 0 and 1.
+    static unsigned getCornerPair(const std::uint64_t* row, int x)
+    {
+        const unsigned low = unsigned(row[x >> 6] >> (x & 63)) & 1u;
+        const unsigned high = unsigned(row[(x + 1) >> 6] >> ((x + 1) & 63)) & 1u;
+        return low | high << 1;
+    }
+
+    void meshCell(int x, int y, int z, unsigned cube, const LayerVertices& lower,
+                  const LayerVertices& upper, SlabOutput& out) const
+    {
+        const int nx = mGrid.size(0);
+        const auto& edges = getCellEdges();
+        const std::size_t base = mGrid.index(x, y, z);
+        const CellTriangulation& cell = mTable.find(cube, decideFaces(cube, base));
+        std::uint32_t interior[kMaxCellExtras];
+        for (int j = 0; j < cell.extraCount; ++j) {
+            interior[j] = kInteriorFlag | std::uint32_t(out.interior.size());
+            out.interior.push_back(computeInteriorVertex(x, y, z, cell, j));
+        }
+        for (int k = 0; k < 3 * cell.triangleCount; ++k) {
+            const int id = cell.vertices[k];
+            if (id >= kExtraVertex) {
+                out.triangles.push_back(interior[id - kExtraVertex]);
+                continue;
+            }
+            const CellEdge& edge = edges[id];
+            const LayerVertices& layer = getCornerBit(edge.start, 2) ? upper : lower;
+            const std::size_t column = std::size_t(y + getCornerBit(edge.start, 1)) * nx +
+                                       std::size_t(x + getCornerBit(edge.start, 0));
+            out.triangles.push_back(layer.edge[edge.axis][column]);
         }
     }
 
     const Grid& mGrid;
     const ExtractionOptions& mOptions;
-    const std::vector<std::uint8_t>& mInside;
+    const SignRows& mRows;
     const std::vector<std::uint64_t>& mLayerOffset;
     TriangleMesh& mMesh;
     const CaseTable& mTable;
@@ -362,37 +547,51 @@ void extractIsosurface(const plugin::SampledField& field, double isoValue,
     const int nz = grid.size(2);
     const int grain = std::max(options.grain, 1);
 
-    // Pass 1, per sample layer: inside flags, NaN check, and the number of crossed edges whose
-    // vertex the layer owns. The prefix sum over layers numbers the vertices in scan order, so
-    // the numbering does not depend on how the work is split.
-    std::vector<std::uint8_t> inside(field.values.size());
-    std::vector<std::uint64_t> layerOffset(std::size_t(nz) + 1, 0);
+    // Pass 1, per sample layer: the inside bits of every row and the NaN check.
+    const float threshold = getInsideThreshold(isoValue);
+    SignRows rows(field.samples);
+    const int ny = grid.size(1);
     std::vector<std::size_t> firstNan(std::size_t(nz), kNoNan);
     tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
         for (int z = range.begin(); z != range.end(); ++z) {
+            bool clean = true;
+            for (int y = 0; y < ny; ++y)
+                clean = rows.classify(&field.values[grid.index(0, y, z)], threshold,
+                                      rows.row(y, z)) &&
+                        clean;
+            if (clean)
+                continue;
             const std::size_t begin = std::size_t(z) * grid.layerSize();
-            for (std::size_t i = begin; i != begin + grid.layerSize(); ++i) {
-                const double value = grid.relative(i);
-                if (std::isnan(value) && firstNan[z] == kNoNan)
+            for (std::size_t i = begin; i != begin + grid.layerSize(); ++i)
+                if (std::isnan(field.values[i])) {
                     firstNan[z] = i;
-                inside[i] = value < 0.0 ? 1 : 0;
-            }
+                    break;
+                }
         }
     });
     for (const std::size_t i : firstNan) {
         if (i == kNoNan)
             continue;
         const std::size_t nx = std::size_t(grid.size(0));
-        const std::size_t ny = std::size_t(grid.size(1));
         throw std::invalid_argument("marching_cubes: NaN sample at (" + std::to_string(i % nx) +
-                                    ", " + std::to_string(i / nx % ny) + ", " +
-                                    std::to_string(i / (nx * ny)) +
+                                    ", " + std::to_string(i / nx % std::size_t(ny)) + ", " +
+                                    std::to_string(i / (nx * std::size_t(ny))) +
                                     "); the field must be NaN-free");
     }
+
+    // Pass 2, per sample layer: the number of crossed edges whose vertex the layer owns. The
+    // prefix sum over layers numbers the vertices in scan order, so the numbering does not depend
+    // on how the work is split.
+    std::vector<std::uint64_t> layerOffset(std::size_t(nz) + 1, 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
+        WordBuffer scratch(rows.words());
         for (int z = range.begin(); z != range.end(); ++z) {
             std::uint64_t count = 0;
-            visitCrossedEdges(grid, inside, z, [&](int, int, int) { ++count; });
+            for (int y = 0; y < ny; ++y)
+                count += countCrossedEdges(rows, rows.row(y, z),
+                                           y + 1 < ny ? rows.row(y + 1, z) : nullptr,
+                                           z + 1 < nz ? rows.row(y, z + 1) : nullptr,
+                                           scratch.data());
             layerOffset[std::size_t(z) + 1] = count;
         }
     });
@@ -403,23 +602,31 @@ void extractIsosurface(const plugin::SampledField& field, double isoValue,
         throw std::length_error("marching_cubes: " + std::to_string(edgeVertexCount) +
                                 " edge vertices do not fit 31-bit indices");
 
-    // Pass 2, per slab of `grain` cell layers: edge vertices of the owned layers, written in
+    // Pass 3, per slab of `grain` cell layers: edge vertices of the owned layers, written in
     // place, and the slab's triangles and interior vertices, concatenated afterwards in slab
-    // order, i.e. in cell scan order whatever the grain or thread count.
-    TriangleMesh mesh;
+    // order, i.e. in cell scan order whatever the grain or thread count. Only the crossed edges
+    // and the cells with mixed corners are visited.
+    // Nothing below throws std::invalid_argument, so the mesh is built in `out` itself, reusing
+    // its storage from the last call (as the vtk_flying_edges wrapper does).
+    TriangleMesh& mesh = out;
+    mesh.clear();
     mesh.positions.resize(edgeVertexCount);
     if (options.computeNormals)
         mesh.normals.resize(edgeVertexCount);
     const int cellLayers = nz - 1;
     const int slabCount = (cellLayers + grain - 1) / grain;
     std::vector<SlabOutput> slabs(static_cast<std::size_t>(slabCount));
-    const Mesher mesher(grid, options, inside, layerOffset, mesh);
+    const Mesher mesher(grid, options, rows, layerOffset, mesh);
+    // Each worker keeps its two layers of vertex indices from slab to slab.
+    tbb::enumerable_thread_specific<std::pair<LayerVertices, LayerVertices>> layers(
+        [&] { return std::pair(LayerVertices(grid.layerSize()), LayerVertices(grid.layerSize())); });
     tbb::parallel_for(
         tbb::blocked_range<int>(0, slabCount, 1),
         [&](const tbb::blocked_range<int>& range) {
+            auto& [lower, upper] = layers.local();
             for (int s = range.begin(); s != range.end(); ++s) {
                 const int z0 = s * grain;
-                mesher.meshSlab(z0, std::min(z0 + grain, cellLayers), slabs[s]);
+                mesher.meshSlab(z0, std::min(z0 + grain, cellLayers), lower, upper, slabs[s]);
             }
         },
         tbb::simple_partitioner());
@@ -431,22 +638,38 @@ void extractIsosurface(const plugin::SampledField& field, double isoValue,
         vertexCount += slab.interior.size();
         indexCount += slab.triangles.size();
     }
-    if (vertexCount > std::numeric_limits<std::uint32_t>::max())
+    if (vertexCount > std::numeric_limits<std::uint32_t>::max()) {
+        out.clear();
         throw std::length_error("marching_cubes: " + std::to_string(vertexCount) +
                                 " vertices do not fit 32-bit indices");
-    mesh.indices.reserve(indexCount);
-    for (const SlabOutput& slab : slabs) {
-        const auto firstInterior = static_cast<std::uint32_t>(mesh.positions.size());
-        for (const std::uint32_t index : slab.triangles)
-            mesh.indices.push_back(
-                (index & kInteriorFlag) != 0 ? firstInterior + (index & ~kInteriorFlag) : index);
-        for (const Vertex& vertex : slab.interior) {
-            mesh.positions.push_back(glm::vec3(vertex.position));
-            if (options.computeNormals)
-                mesh.normals.push_back(glm::vec3(vertex.normal));
-        }
     }
-    out = std::move(mesh);
+    std::vector<std::size_t> firstIndex(slabs.size() + 1, 0);
+    std::vector<std::uint32_t> firstInterior(slabs.size() + 1, std::uint32_t(edgeVertexCount));
+    for (std::size_t s = 0; s < slabs.size(); ++s) {
+        firstIndex[s + 1] = firstIndex[s] + slabs[s].triangles.size();
+        firstInterior[s + 1] = firstInterior[s] + std::uint32_t(slabs[s].interior.size());
+    }
+    mesh.indices.resize(indexCount);
+    mesh.positions.resize(vertexCount);
+    if (options.computeNormals)
+        mesh.normals.resize(vertexCount);
+    tbb::parallel_for(std::size_t(0), slabs.size(), [&](std::size_t s) {
+        const SlabOutput& slab = slabs[s];
+        std::uint32_t* indices = mesh.indices.data() + firstIndex[s];
+        if (slab.interior.empty()) { // the common case: nothing to fix up
+            std::copy(slab.triangles.begin(), slab.triangles.end(), indices);
+            return;
+        }
+        for (const std::uint32_t index : slab.triangles)
+            *indices++ = (index & kInteriorFlag) != 0
+                             ? firstInterior[s] + (index & ~kInteriorFlag)
+                             : index;
+        for (std::size_t j = 0; j < slab.interior.size(); ++j) {
+            mesh.positions[firstInterior[s] + j] = glm::vec3(slab.interior[j].position);
+            if (options.computeNormals)
+                mesh.normals[firstInterior[s] + j] = glm::vec3(slab.interior[j].normal);
+        }
+    });
 }
 
 } // namespace rtlab::isosurface::mc

@@ -23,7 +23,8 @@ struct ExtractionOptions {
 //! Replaces `out` with the surface {f = isoValue} of `field`. Samples with f < isoValue are inside,
 //! f >= isoValue outside. Throws std::invalid_argument (leaving `out` untouched) on a NaN sample,
 //! a non-finite iso-value, spacing or origin, or a value count that does not match the sample
-//! counts. A field with fewer than 2 samples along some axis gives an empty mesh.
+//! counts; throws std::length_error (leaving `out` empty) when the mesh needs more than 32-bit
+//! indices. A field with fewer than 2 samples along some axis gives an empty mesh.
 void extractIsosurface(const plugin::SampledField& field, double isoValue,
                        const ExtractionOptions& options, TriangleMesh& out);
 
