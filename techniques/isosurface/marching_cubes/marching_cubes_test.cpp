@@ -474,6 +474,50 @@ TEST(MarchingCubes, RandomFieldsOfManySeedsAreWatertight)
     }
 }
 
+TEST(MarchingCubes, ShiftingAFieldAlongLongRowsShiftsTheMesh)
+{
+    // The grid walk keeps a row's inside flags as 64-sample words and finds crossed edges and
+    // active cells by shifting words into each other. A random 70 x 9 x 8 block (wider than one
+    // word) padded with outside samples, moved right by 0 .. 130 samples, must give the same
+    // triangles and vertex order, the vertices moved by exactly the shift: the padding's rows are
+    // uniform, so no crossing appears or disappears. Shifts on both sides of the word boundaries
+    // (63, 64, 65, 127, 128) catch a lost or doubled carry bit.
+    std::mt19937 rng(91u);
+    std::uniform_real_distribution<float> uniform(-1.0f, 1.0f);
+    const glm::ivec3 block(70, 9, 8);
+    std::vector<float> values(std::size_t(block.x) * block.y * block.z);
+    for (float& v : values)
+        v = uniform(rng);
+    const auto makeShifted = [&](int shift) {
+        plugin::SampledField field;
+        field.samples = glm::ivec3(block.x + shift + 4, block.y + 2, block.z + 2);
+        field.values.assign(std::size_t(field.samples.x) * field.samples.y * field.samples.z, 1.0f);
+        for (int z = 0; z < block.z; ++z)
+            for (int y = 0; y < block.y; ++y)
+                for (int x = 0; x < block.x; ++x)
+                    field.values[field.index(x + shift + 2, y + 1, z + 1)] =
+                        values[(std::size_t(z) * block.y + y) * block.x + x];
+        return field;
+    };
+    const TriangleMesh base = extractMesh(makeShifted(0));
+    expectClosedOriented(analyzeTopology(base));
+    ASSERT_GT(base.indices.size(), 3000u) << "the block should hold a rich surface";
+    for (const int shift : {1, 30, 61, 62, 63, 64, 65, 126, 127, 128, 130}) {
+        SCOPED_TRACE("shift " + std::to_string(shift));
+        const TriangleMesh moved = extractMesh(makeShifted(shift));
+        ASSERT_EQ(moved.indices, base.indices);
+        ASSERT_EQ(moved.positions.size(), base.positions.size());
+        for (std::size_t i = 0; i < base.positions.size(); ++i) {
+            // y and z are computed from the same values; x = shift + the same offset, in floats
+            // of magnitude <= 200: 2^-24 * 200 < 2e-5.
+            EXPECT_NEAR(moved.positions[i].x, base.positions[i].x + float(shift), 2e-5);
+            EXPECT_EQ(moved.positions[i].y, base.positions[i].y);
+            EXPECT_EQ(moved.positions[i].z, base.positions[i].z);
+            EXPECT_NEAR(glm::length(moved.normals[i] - base.normals[i]), 0.0f, 1e-6f);
+        }
+    }
+}
+
 TEST(MarchingCubes, AsymptoticDeciderFollowsTheSaddleValue)
 {
     // Two inside columns, samples (1,1,z) and (2,2,z) for z = 1, 2, in a field of +1. The cell
