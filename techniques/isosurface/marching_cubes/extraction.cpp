@@ -1,6 +1,7 @@
 #include "extraction.h"
 
 #include "case_table.h"
+#include "isosurface/sign_rows.h"
 
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -8,10 +9,6 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 #include <algorithm>
 #include <array>
@@ -27,8 +24,6 @@
 
 namespace rtlab::isosurface::mc {
 namespace {
-
-constexpr std::size_t kNoNan = std::numeric_limits<std::size_t>::max();
 
 //! Read-only view of the field shared by both passes.
 class Grid {
@@ -55,156 +50,6 @@ private:
     glm::ivec3 mSize;
     std::size_t mStride[3];
 };
-
-// The grid walk follows the idea of Flying Edges [Schroeder, Maynard & Geveci 2015]: classify
-// each x-row of samples once, then touch only the rows and cells the surface crosses. Here a row's
-// classification is a bit mask (one bit per sample, 64 per word), so the crossed edges of a row
-// and the cells with mixed corners come out of XORs of neighbouring rows, whole words at a time,
-// and the walk visits set bits only; Flying Edges keeps per-row edge cases and trim ranges instead.
-
-//! The smallest float t >= iso, so that for every float v, v < t exactly when double(v) < iso:
-//! the float comparison classifies like the double one without widening each sample.
-float getInsideThreshold(double iso)
-{
-    constexpr float kMax = std::numeric_limits<float>::max();
-    if (iso > double(kMax))
-        return std::numeric_limits<float>::infinity();
-    if (iso <= -double(kMax))
-        return -kMax;
-    float t = static_cast<float>(iso);
-    if (double(t) < iso)
-        t = std::nextafter(t, std::numeric_limits<float>::infinity());
-    return t;
-}
-
-//! Inside bits of every x-row of samples: bit x % 64 of word x / 64 is set when sample x is
-//! inside (value < iso). Bits at and past nx are 0 in every row.
-class SignRows {
-public:
-    explicit SignRows(const glm::ivec3& samples)
-        : mNx(samples.x), mNy(samples.y), mWords((std::size_t(samples.x) + 63) / 64),
-          mBits(std::make_unique_for_overwrite<std::uint64_t[]>(mWords * std::size_t(samples.y) *
-                                                               std::size_t(samples.z)))
-    {
-        // classify() writes every word of every row
-    }
-
-    std::size_t words() const { return mWords; }
-    std::uint64_t* row(int y, int z) { return &mBits[(std::size_t(z) * mNy + y) * mWords]; }
-    const std::uint64_t* row(int y, int z) const
-    {
-        return &mBits[(std::size_t(z) * mNy + y) * mWords];
-    }
-
-    //! Classifies the samples of row (y, z), `values` pointing at its sample 0. Returns false
-    //! when the row holds a NaN (classified outside; the caller reports it).
-    bool classify(const float* values, float threshold, std::uint64_t* bits) const
-    {
-        bool finiteOrInf = true;
-        for (std::size_t w = 0; w < mWords; ++w) {
-            const float* v = values + 64 * w;
-            const int n = std::min(64, mNx - int(64 * w));
-            std::uint64_t mask = 0;
-            int k = 0;
-#if defined(__SSE2__)
-            const __m128 t = _mm_set1_ps(threshold);
-            __m128 nan = _mm_setzero_ps();
-            for (; k + 4 <= n; k += 4) {
-                const __m128 x = _mm_loadu_ps(v + k);
-                mask |= std::uint64_t(_mm_movemask_ps(_mm_cmplt_ps(x, t))) << k;
-                nan = _mm_or_ps(nan, _mm_cmpunord_ps(x, x));
-            }
-            finiteOrInf = finiteOrInf && _mm_movemask_ps(nan) == 0;
-#endif
-            for (; k < n; ++k) {
-                mask |= std::uint64_t(v[k] < threshold) << k;
-                finiteOrInf = finiteOrInf && !std::isnan(v[k]);
-            }
-            bits[w] = mask;
-        }
-        return finiteOrInf;
-    }
-
-    //! Bit x set when samples x and x + 1 of `row` differ, for x < nx - 1.
-    void getXCrossings(const std::uint64_t* row, std::uint64_t* out) const
-    {
-        for (std::size_t w = 0; w < mWords; ++w) {
-            const std::uint64_t next = w + 1 < mWords ? row[w + 1] : 0;
-            out[w] = row[w] ^ ((row[w] >> 1) | (next << 63));
-        }
-        clearLastSample(out);
-    }
-
-    //! Clears bit nx - 1: no edge or cell starts at the last sample of a row.
-    void clearLastSample(std::uint64_t* mask) const
-    {
-        mask[std::size_t(mNx - 1) / 64] &= ~(std::uint64_t(1) << ((mNx - 1) % 64));
-    }
-
-private:
-    int mNx;
-    int mNy;
-    std::size_t mWords;
-    std::unique_ptr<std::uint64_t[]> mBits;
-};
-
-//! Up to 256 samples per row stay on the stack; longer rows use the heap.
-class WordBuffer {
-public:
-    explicit WordBuffer(std::size_t words) : mHeap(words > kLocal ? words : 0)
-    {
-        mData = words > kLocal ? mHeap.data() : mLocal;
-    }
-    std::uint64_t* data() { return mData; }
-
-private:
-    static constexpr std::size_t kLocal = 4;
-    std::uint64_t mLocal[kLocal];
-    std::vector<std::uint64_t> mHeap;
-    std::uint64_t* mData;
-};
-
-//! Calls visit(x, axis) for the crossed edges starting in sample row (y, z), in the order both
-//! passes share: samples (x), then axes x, y, z. The row's edges are its x edges and the y and z
-//! edges to the next row and layer (`nextY`, `nextZ`: null where there is none).
-template <class Visit>
-void visitCrossedEdges(const SignRows& rows, const std::uint64_t* row, const std::uint64_t* nextY,
-                       const std::uint64_t* nextZ, std::uint64_t* scratch, Visit&& visit)
-{
-    rows.getXCrossings(row, scratch);
-    for (std::size_t w = 0; w < rows.words(); ++w) {
-        const std::uint64_t ex = scratch[w];
-        const std::uint64_t ey = nextY ? row[w] ^ nextY[w] : 0;
-        const std::uint64_t ez = nextZ ? row[w] ^ nextZ[w] : 0;
-        for (std::uint64_t any = ex | ey | ez; any != 0; any &= any - 1) {
-            const int bit = std::countr_zero(any);
-            const int x = int(64 * w) + bit;
-            if ((ex >> bit) & 1)
-                visit(x, 0);
-            if ((ey >> bit) & 1)
-                visit(x, 1);
-            if ((ez >> bit) & 1)
-                visit(x, 2);
-        }
-    }
-}
-
-//! The number of crossed edges starting in sample row (y, z) (see visitCrossedEdges).
-std::uint64_t countCrossedEdges(const SignRows& rows, const std::uint64_t* row,
-                                const std::uint64_t* nextY, const std::uint64_t* nextZ,
-                                std::uint64_t* scratch)
-{
-    rows.getXCrossings(row, scratch);
-    std::uint64_t count = 0;
-    for (std::size_t w = 0; w < rows.words(); ++w) {
-        count += std::uint64_t(std::popcount(scratch[w]));
-        if (nextY)
-            count += std::uint64_t(std::popcount(row[w] ^ nextY[w]));
-        if (nextZ)
-            count += std::uint64_t(std::popcount(row[w] ^ nextZ[w]));
-    }
-    return count;
-}
 
 //! Vertex index of every crossed edge starting in one sample layer, per axis, indexed y * nx + x.
 //! Entries of edges that are not crossed are stale; the case table never asks for them.
@@ -299,25 +144,17 @@ private:
     void numberLayer(int z, LayerVertices& layer, bool writeVertices) const
     {
         std::uint64_t next = mLayerOffset[z];
-        const int ny = mGrid.size(1);
-        const bool hasUp = z + 1 < mGrid.size(2);
         const std::size_t nx = std::size_t(mGrid.size(0));
-        WordBuffer scratch(mRows.words());
-        for (int y = 0; y < ny; ++y) {
-            const std::uint64_t* nextY = y + 1 < ny ? mRows.row(y + 1, z) : nullptr;
-            const std::uint64_t* nextZ = hasUp ? mRows.row(y, z + 1) : nullptr;
-            visitCrossedEdges(mRows, mRows.row(y, z), nextY, nextZ, scratch.data(),
-                              [&](int x, int axis) {
-                                  const auto index = static_cast<std::uint32_t>(next++);
-                                  layer.edge[axis][std::size_t(y) * nx + x] = index;
-                                  if (!writeVertices)
-                                      return;
-                                  const Vertex vertex = computeEdgeVertex(x, y, z, axis);
-                                  mMesh.positions[index] = glm::vec3(vertex.position);
-                                  if (mOptions.computeNormals)
-                                      mMesh.normals[index] = glm::vec3(vertex.normal);
-                              });
-        }
+        mRows.visitCrossedEdges(z, [&](int x, int y, int axis) {
+            const auto index = static_cast<std::uint32_t>(next++);
+            layer.edge[axis][std::size_t(y) * nx + x] = index;
+            if (!writeVertices)
+                return;
+            const Vertex vertex = computeEdgeVertex(x, y, z, axis);
+            mMesh.positions[index] = glm::vec3(vertex.position);
+            if (mOptions.computeNormals)
+                mMesh.normals[index] = glm::vec3(vertex.normal);
+        });
         assert(next == mLayerOffset[z + 1]);
     }
 
@@ -432,48 +269,14 @@ private:
     void meshCellLayer(int z, const LayerVertices& lower, const LayerVertices& upper,
                        SlabOutput& out) const
     {
-        const int ny = mGrid.size(1);
-        const std::size_t words = mRows.words();
-        WordBuffer active(words);
-        for (int y = 0; y + 1 < ny; ++y) {
-            // The four sample rows holding the corners of this row of cells: corner c lies in
-            // row (c >> 1) & 3, at sample x + (c & 1).
-            const std::uint64_t* row[4] = {mRows.row(y, z), mRows.row(y + 1, z),
-                                           mRows.row(y, z + 1), mRows.row(y + 1, z + 1)};
-            // A cell is active unless its eight corners agree: some row differs from row 0 at
-            // sample x or x + 1, or row 0 changes from x to x + 1.
-            for (std::size_t w = 0; w < words; ++w) {
-                const std::uint64_t d = (row[0][w] ^ row[1][w]) | (row[0][w] ^ row[2][w]) |
-                                        (row[0][w] ^ row[3][w]);
-                const std::uint64_t dNext =
-                    w + 1 < words ? (row[0][w + 1] ^ row[1][w + 1]) |
-                                        (row[0][w + 1] ^ row[2][w + 1]) |
-                                        (row[0][w + 1] ^ row[3][w + 1])
-                                  : 0;
-                const std::uint64_t aNext = w + 1 < words ? row[0][w + 1] : 0;
-                active.data()[w] = d | (d >> 1) | (dNext << 63) |
-                                   (row[0][w] ^ ((row[0][w] >> 1) | (aNext << 63)));
-            }
-            mRows.clearLastSample(active.data());
-            for (std::size_t w = 0; w < words; ++w)
-                for (std::uint64_t bits = active.data()[w]; bits != 0; bits &= bits - 1) {
+        for (int y = 0; y + 1 < mGrid.size(1); ++y)
+            for (std::size_t w = 0; w < mRows.words(); ++w)
+                for (std::uint64_t bits = mRows.getActiveCells(y, z, w); bits != 0;
+                     bits &= bits - 1) {
                     const int x = int(64 * w) + std::countr_zero(bits);
                     // [Lorensen & Cline 1987] the case index from the signs of the eight corners.
-                    const unsigned cube = getCornerPair(row[0], x) |
-                                          getCornerPair(row[1], x) << 2 |
-                                          getCornerPair(row[2], x) << 4 |
-                                          getCornerPair(row[3], x) << 6;
-                    meshCell(x, y, z, cube, lower, upper, out);
+                    meshCell(x, y, z, mRows.getCube(x, y, z), lower, upper, out);
                 }
-        }
-    }
-
-    //! Bits x and x + 1 of a sign row, as bits 0 and 1.
-    static unsigned getCornerPair(const std::uint64_t* row, int x)
-    {
-        const unsigned low = unsigned(row[x >> 6] >> (x & 63)) & 1u;
-        const unsigned high = unsigned(row[(x + 1) >> 6] >> ((x + 1) & 63)) & 1u;
-        return low | high << 1;
     }
 
     void meshCell(int x, int y, int z, unsigned cube, const LayerVertices& lower,
@@ -547,35 +350,18 @@ void extractIsosurface(const plugin::SampledField& field, double isoValue,
     const int nz = grid.size(2);
     const int grain = std::max(options.grain, 1);
 
-    // Pass 1, per sample layer: the inside bits of every row and the NaN check.
-    const float threshold = getInsideThreshold(isoValue);
-    SignRows rows(field.samples);
-    const int ny = grid.size(1);
-    std::vector<std::size_t> firstNan(std::size_t(nz), kNoNan);
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
-        for (int z = range.begin(); z != range.end(); ++z) {
-            bool clean = true;
-            for (int y = 0; y < ny; ++y)
-                clean = rows.classify(&field.values[grid.index(0, y, z)], threshold,
-                                      rows.row(y, z)) &&
-                        clean;
-            if (clean)
-                continue;
-            const std::size_t begin = std::size_t(z) * grid.layerSize();
-            for (std::size_t i = begin; i != begin + grid.layerSize(); ++i)
-                if (std::isnan(field.values[i])) {
-                    firstNan[z] = i;
-                    break;
-                }
-        }
-    });
-    for (const std::size_t i : firstNan) {
-        if (i == kNoNan)
-            continue;
+    // Pass 1, per sample layer: the inside bits of every row (framework/isosurface/sign_rows.h:
+    // the grid walk follows Flying Edges [Schroeder, Maynard & Geveci 2015], touching only the
+    // rows and cells the surface crosses) and the NaN check.
+    std::size_t firstNan = SignRows::kNoNan;
+    const SignRows rows(field, isoValue, firstNan);
+    if (firstNan != SignRows::kNoNan) {
         const std::size_t nx = std::size_t(grid.size(0));
-        throw std::invalid_argument("marching_cubes: NaN sample at (" + std::to_string(i % nx) +
-                                    ", " + std::to_string(i / nx % std::size_t(ny)) + ", " +
-                                    std::to_string(i / (nx * std::size_t(ny))) +
+        const std::size_t ny = std::size_t(grid.size(1));
+        throw std::invalid_argument("marching_cubes: NaN sample at (" +
+                                    std::to_string(firstNan % nx) + ", " +
+                                    std::to_string(firstNan / nx % ny) + ", " +
+                                    std::to_string(firstNan / (nx * ny)) +
                                     "); the field must be NaN-free");
     }
 
@@ -584,16 +370,8 @@ void extractIsosurface(const plugin::SampledField& field, double isoValue,
     // on how the work is split.
     std::vector<std::uint64_t> layerOffset(std::size_t(nz) + 1, 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
-        WordBuffer scratch(rows.words());
-        for (int z = range.begin(); z != range.end(); ++z) {
-            std::uint64_t count = 0;
-            for (int y = 0; y < ny; ++y)
-                count += countCrossedEdges(rows, rows.row(y, z),
-                                           y + 1 < ny ? rows.row(y + 1, z) : nullptr,
-                                           z + 1 < nz ? rows.row(y, z + 1) : nullptr,
-                                           scratch.data());
-            layerOffset[std::size_t(z) + 1] = count;
-        }
+        for (int z = range.begin(); z != range.end(); ++z)
+            layerOffset[std::size_t(z) + 1] = rows.countCrossedEdges(z);
     });
     for (int z = 0; z < nz; ++z)
         layerOffset[std::size_t(z) + 1] += layerOffset[z];
