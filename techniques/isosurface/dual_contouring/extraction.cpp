@@ -3,6 +3,7 @@
 #include "qef.h"
 
 #include "isosurface/case_table.h"
+#include "isosurface/sign_rows.h"
 
 #include <glm/geometric.hpp>
 #include <tbb/blocked_range.h>
@@ -23,9 +24,6 @@ namespace rtlab::isosurface::dc {
 namespace {
 
 constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-constexpr std::size_t kNoNan = std::numeric_limits<std::size_t>::max();
-//! Bit of SampleFlags that marks an inside sample; bits 0..2 mark crossed edges along x, y, z.
-constexpr std::uint8_t kInsideBit = 8;
 //! A solved vertex counts as outside its cell when a coordinate leaves [0, 1] by more than this
 //! (cells), which is far above the solvers' rounding and far below any visible displacement.
 constexpr double kOutsideTolerance = 1e-9;
@@ -33,8 +31,6 @@ constexpr double kOutsideTolerance = 1e-9;
 constexpr int kProjectionSteps = 8;
 //! Halvings of a relaxation step whose projection leaves the vertex's cell before it is dropped.
 constexpr int kMaxStepHalvings = 4;
-//! Triangles of one crossed edge at most: a quad with a face vertex on each side, fanned.
-constexpr int kMaxEdgeTriangles = 6;
 //! Boundary neighbours of a vertex at most: one per segment of its patch.
 constexpr std::size_t kMaxNeighbours = 12;
 
@@ -58,7 +54,7 @@ glm::dvec3 axisVector(int axis)
     return v;
 }
 
-//! Read-only view of the field and the per-sample flags shared by all passes. Coordinates are
+//! Read-only view of the field shared by all passes. Coordinates are
 //! grid units: sample (x, y, z) is at (x, y, z), world = origin + spacing * grid.
 class Grid {
 public:
@@ -73,10 +69,6 @@ public:
     int cells(int axis) const { return mSize[axis] - 1; }
     std::size_t stride(int axis) const { return mStride[axis]; }
     std::size_t index(const glm::ivec3& s) const { return mField.index(s.x, s.y, s.z); }
-    std::size_t cellIndex(const glm::ivec3& c) const
-    {
-        return (std::size_t(c.z) * cells(1) + c.y) * cells(0) + c.x;
-    }
     glm::ivec3 sampleOf(std::size_t i) const
     {
         return glm::ivec3(int(i % mStride[1]), int((i / mStride[1]) % mSize.y),
@@ -123,20 +115,37 @@ struct Crossing {
     glm::dvec3 normal{0.0};
 };
 
-//! The crossed edges, numbered in scan order (layer, row, sample, axis), and where to find them.
+//! The crossed edges, numbered in scan order (layer, row, sample, axis), and where to find them:
+//! the sign bits of every sample row (framework/isosurface/sign_rows.h) and, per row and 64-sample
+//! word, the number of the first crossed edge starting there; nothing per sample, so memory and
+//! time follow the surface, not the grid.
 struct EdgeTable {
-    std::vector<std::uint8_t> flags;  //!< per sample: kInsideBit | crossed-axis bits
-    std::vector<std::uint32_t> base;  //!< per sample: number of the first edge starting there
-    std::vector<std::uint64_t> edges; //!< per edge: sample index * 3 + axis
-    std::vector<Crossing> crossings;  //!< per edge
+    explicit EdgeTable(SignRows signs) : rows(std::move(signs)) {}
 
-    //! Number of the crossed edge (sample, axis), or kNone when it is not crossed.
-    std::uint32_t find(std::size_t sample, int axis) const
+    SignRows rows;
+    std::vector<std::uint32_t> wordBase; //!< per sample row (z * ny + y) and word
+    std::vector<std::uint64_t> edges;    //!< per edge: sample index * 3 + axis
+    std::vector<Crossing> crossings;     //!< per edge
+
+    bool isInside(const glm::ivec3& s) const { return rows.isInside(s); }
+
+    //! Number of the crossed edge (sample s, axis), or kNone when it is not crossed.
+    std::uint32_t find(const glm::ivec3& s, int axis) const
     {
-        const std::uint8_t f = flags[sample];
-        if (((f >> axis) & 1u) == 0)
+        const std::size_t w = std::size_t(s.x) >> 6;
+        const int bit = s.x & 63;
+        const SignRows::Crossings c = rows.getCrossings(s.y, s.z, w);
+        if (((c.axis[axis] >> bit) & 1u) == 0)
             return kNone;
-        return base[sample] + std::uint32_t(std::popcount(unsigned(f & ((1u << axis) - 1u))));
+        // Edges before this one in the word: all axes at lower samples, lower axes at this one.
+        const std::uint64_t below = (std::uint64_t(1) << bit) - 1u;
+        std::uint32_t index = std::uint32_t(std::popcount(c.axis[0] & below) +
+                                            std::popcount(c.axis[1] & below) +
+                                            std::popcount(c.axis[2] & below));
+        for (int a = 0; a < axis; ++a)
+            index += std::uint32_t((c.axis[a] >> bit) & 1u);
+        const std::size_t row = std::size_t(s.z) * std::size_t(rows.size(1)) + std::size_t(s.y);
+        return wordBase[row * rows.words() + w] + index;
     }
 };
 
@@ -168,61 +177,17 @@ void validate(const plugin::IsosurfaceInput& input)
         throw std::invalid_argument("dual_contouring: the Hermite data refers to another grid");
 }
 
-//! Pass 1: inside flags and crossed-edge bits per sample, NaN check, edge numbering.
+//! Pass 1 (after the sign bits): the crossed edges, numbered in scan order.
 void buildEdgeTable(const Grid& grid, EdgeTable& table)
 {
-    const int nx = grid.size(0);
+    const SignRows& rows = table.rows;
     const int ny = grid.size(1);
     const int nz = grid.size(2);
-    const std::size_t layer = grid.stride(2);
-    const std::size_t total = layer * nz;
-    table.flags.assign(total, 0);
-    table.base.assign(total, 0);
-
-    std::vector<std::size_t> firstNan(nz, kNoNan);
-    tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
-        for (int z = range.begin(); z != range.end(); ++z) {
-            for (std::size_t i = z * layer; i < (z + 1) * layer; ++i) {
-                const double r = grid.relative(i);
-                if (std::isnan(r) && firstNan[z] == kNoNan)
-                    firstNan[z] = i;
-                table.flags[i] = r < 0.0 ? kInsideBit : 0;
-            }
-        }
-    });
-    for (int z = 0; z < nz; ++z) {
-        if (firstNan[z] != kNoNan) {
-            const glm::ivec3 s = grid.sampleOf(firstNan[z]);
-            throw std::invalid_argument("dual_contouring: NaN sample at (" + std::to_string(s.x) +
-                                        ", " + std::to_string(s.y) + ", " + std::to_string(s.z) +
-                                        ")");
-        }
-    }
-
-    // Crossed-edge bits go to their own array first: a layer's task reads the inside bits of the
-    // layer above, which another task owns.
-    std::vector<std::uint8_t> crossed(total, 0);
+    const std::size_t words = rows.words();
     std::vector<std::uint64_t> layerCount(nz + 1, 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
-        for (int z = range.begin(); z != range.end(); ++z) {
-            std::uint64_t count = 0;
-            for (int y = 0; y < ny; ++y) {
-                std::size_t i = grid.index({0, y, z});
-                for (int x = 0; x < nx; ++x, ++i) {
-                    const std::uint8_t in = table.flags[i] & kInsideBit;
-                    std::uint8_t bits = 0;
-                    if (x + 1 < nx && in != (table.flags[i + 1] & kInsideBit))
-                        bits |= 1;
-                    if (y + 1 < ny && in != (table.flags[i + grid.stride(1)] & kInsideBit))
-                        bits |= 2;
-                    if (z + 1 < nz && in != (table.flags[i + layer] & kInsideBit))
-                        bits |= 4;
-                    crossed[i] = bits;
-                    count += std::popcount(unsigned(bits));
-                }
-            }
-            layerCount[z + 1] = count;
-        }
+        for (int z = range.begin(); z != range.end(); ++z)
+            layerCount[z + 1] = rows.countCrossedEdges(z);
     });
     for (int z = 0; z < nz; ++z)
         layerCount[z + 1] += layerCount[z];
@@ -231,17 +196,22 @@ void buildEdgeTable(const Grid& grid, EdgeTable& table)
         throw std::length_error("dual_contouring: " + std::to_string(edgeCount) +
                                 " crossed edges exceed 32-bit indices");
     table.edges.resize(edgeCount);
+    table.wordBase.resize(std::size_t(nz) * std::size_t(ny) * words);
     tbb::parallel_for(tbb::blocked_range<int>(0, nz), [&](const tbb::blocked_range<int>& range) {
         for (int z = range.begin(); z != range.end(); ++z) {
             std::uint32_t next = std::uint32_t(layerCount[z]);
-            for (std::size_t i = z * layer; i < (z + 1) * layer; ++i) {
-                table.flags[i] |= crossed[i];
-                table.base[i] = next;
-                for (int axis = 0; axis < 3; ++axis) {
-                    if ((crossed[i] >> axis) & 1u)
-                        table.edges[next++] = std::uint64_t(i) * 3u + std::uint64_t(axis);
+            for (int y = 0; y < ny; ++y)
+                for (std::size_t w = 0; w < words; ++w) {
+                    table.wordBase[(std::size_t(z) * ny + y) * words + w] = next;
+                    const SignRows::Crossings c = rows.getCrossings(y, z, w);
+                    for (std::uint64_t any = c.any(); any != 0; any &= any - 1) {
+                        const int bit = std::countr_zero(any);
+                        const std::size_t sample = grid.index({int(64 * w) + bit, y, z});
+                        for (int axis = 0; axis < 3; ++axis)
+                            if ((c.axis[axis] >> bit) & 1u)
+                                table.edges[next++] = std::uint64_t(sample) * 3u + std::uint64_t(axis);
+                    }
                 }
-            }
         }
     });
 }
@@ -446,15 +416,43 @@ struct CellCase {
     std::uint8_t patches = 0; //!< patch vertices of the cell (0 when it has no sign change)
 };
 
+//! The active cells (those with a sign change) and their vertices. Cells are found through bit
+//! masks per row of cells, like the sample rows: per cell row (z * cells.y + y) and 64-cell word,
+//! the active cells' bits and the number of the first active cell in the word.
 struct CellVertices {
-    std::vector<CellCase> cases;             //!< per cell
-    std::vector<std::uint32_t> vertexOfCell; //!< per cell: its first vertex, kNone when inactive
+    std::size_t words = 0; //!< words per cell row
+    int rowsPerLayer = 0;  //!< cells along y
+    std::vector<std::uint64_t> active;
+    std::vector<std::uint32_t> activeBase;
+    std::vector<glm::ivec3> activeCell;      //!< per active cell, in scan order
+    std::vector<CellCase> cases;             //!< per active cell
+    std::vector<std::uint32_t> vertexOfCell; //!< per active cell: its first vertex
     std::vector<glm::ivec3> cell;            //!< per vertex
     std::vector<std::uint16_t> edges; //!< per vertex: its cell edges (getCellEdgeOffsets bits)
     std::vector<std::uint8_t> onFace; //!< per vertex: 1 for a face vertex (see numberCells)
     std::vector<glm::dvec3> local;    //!< per vertex, position relative to its cell, cells
     std::vector<glm::dvec3> normal;   //!< per vertex, unit
     std::vector<QefSystem> qef;       //!< per vertex, kept for the relaxation only
+
+    //! Number of the active cell `cell` (inside the grid), or kNone when it has no sign change.
+    std::uint32_t findActive(const glm::ivec3& cell) const
+    {
+        const std::size_t k =
+            (std::size_t(cell.z) * std::size_t(rowsPerLayer) + std::size_t(cell.y)) * words +
+            (std::size_t(cell.x) >> 6);
+        const int bit = cell.x & 63;
+        if (((active[k] >> bit) & 1u) == 0)
+            return kNone;
+        return activeBase[k] +
+               std::uint32_t(std::popcount(active[k] & ((std::uint64_t(1) << bit) - 1u)));
+    }
+    //! The case of `cell`; an all-zero case (no patch, entry 0) for a cell without sign change.
+    const CellCase& getCase(const glm::ivec3& cell) const
+    {
+        static const CellCase kInactive{};
+        const std::uint32_t k = findActive(cell);
+        return k == kNone ? kInactive : cases[k];
+    }
 };
 
 //! Bit f of a face mask for the faces on the high side of a cell (x, y, z).
@@ -479,39 +477,70 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
     const tables::CaseTable& caseTable = tables::CaseTable::getInstance();
     const bool perComponent = options.vertices == VertexMode::PerComponent;
     const glm::ivec3 cells(grid.cells(0), grid.cells(1), grid.cells(2));
-    const std::size_t cellLayer = std::size_t(cells.x) * cells.y;
-    vertices.cases.assign(cellLayer * cells.z, CellCase{});
-    vertices.vertexOfCell.assign(cellLayer * cells.z, kNone);
-    std::array<std::size_t, 8> corner{};
-    for (int k = 0; k < 8; ++k)
-        corner[k] = grid.index({k & 1, (k >> 1) & 1, (k >> 2) & 1});
+    const SignRows& rows = table.rows;
+    const std::size_t words = rows.words();
+    vertices.words = words;
+    vertices.rowsPerLayer = cells.y;
+    vertices.active.resize(std::size_t(cells.z) * std::size_t(cells.y) * words);
+    vertices.activeBase.resize(vertices.active.size());
+
+    // Active cells, counted per cell layer.
+    std::vector<std::uint64_t> layerActive(cells.z + 1, 0);
+    tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
+        for (int z = r.begin(); z != r.end(); ++z) {
+            std::uint64_t count = 0;
+            for (int y = 0; y < cells.y; ++y)
+                for (std::size_t w = 0; w < words; ++w) {
+                    const std::uint64_t bits = rows.getActiveCells(y, z, w);
+                    vertices.active[(std::size_t(z) * cells.y + y) * words + w] = bits;
+                    count += std::uint64_t(std::popcount(bits));
+                }
+            layerActive[z + 1] = count;
+        }
+    });
+    for (int z = 0; z < cells.z; ++z)
+        layerActive[z + 1] += layerActive[z];
+    const std::uint64_t activeCount = layerActive[cells.z];
+    if (activeCount >= kNone)
+        throw std::length_error("dual_contouring: " + std::to_string(activeCount) +
+                                " cells with a sign change exceed 32-bit indices");
+    vertices.activeCell.resize(activeCount);
+    vertices.cases.resize(activeCount);
+    vertices.vertexOfCell.resize(activeCount);
 
     // Cases and patches.
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
-        for (int z = r.begin(); z != r.end(); ++z)
+        std::array<std::size_t, 8> corner{};
+        for (int k = 0; k < 8; ++k)
+            corner[k] = grid.index({k & 1, (k >> 1) & 1, (k >> 2) & 1});
+        for (int z = r.begin(); z != r.end(); ++z) {
+            std::uint32_t next = std::uint32_t(layerActive[z]);
             for (int y = 0; y < cells.y; ++y)
-                for (int x = 0; x < cells.x; ++x) {
-                    const std::size_t base = grid.index({x, y, z});
-                    unsigned cube = 0;
-                    for (int k = 0; k < 8; ++k)
-                        cube |= unsigned((table.flags[base + corner[k]] & kInsideBit) != 0) << k;
-                    CellCase& c = vertices.cases[grid.cellIndex({x, y, z})];
-                    c.cube = std::uint8_t(cube);
-                    if (cube == 0 || cube == 255)
-                        continue;
-                    if (!perComponent) {
-                        c.patches = 1;
-                        continue;
+                for (std::size_t w = 0; w < words; ++w) {
+                    const std::size_t k = (std::size_t(z) * cells.y + y) * words + w;
+                    vertices.activeBase[k] = next;
+                    for (std::uint64_t bits = vertices.active[k]; bits != 0; bits &= bits - 1) {
+                        const int x = int(64 * w) + std::countr_zero(bits);
+                        vertices.activeCell[next] = glm::ivec3(x, y, z);
+                        CellCase& c = vertices.cases[next++];
+                        const unsigned cube = rows.getCube(x, y, z);
+                        c.cube = std::uint8_t(cube);
+                        if (!perComponent) {
+                            c.patches = 1;
+                            continue;
+                        }
+                        const std::size_t base = grid.index({x, y, z});
+                        std::array<double, 8> values;
+                        for (int j = 0; j < 8; ++j)
+                            values[j] = grid.relative(base + corner[j]);
+                        c.joined = std::uint8_t(tables::decideJoinedFaces(
+                            cube, values, tables::AmbiguityRule::Asymptotic));
+                        const std::size_t entry = caseTable.entryIndex(cube, c.joined);
+                        c.entry = std::uint16_t(entry);
+                        c.patches = std::uint8_t(caseTable.entry(entry).loopCount);
                     }
-                    std::array<double, 8> values;
-                    for (int k = 0; k < 8; ++k)
-                        values[k] = grid.relative(base + corner[k]);
-                    c.joined = std::uint8_t(
-                        tables::decideJoinedFaces(cube, values, tables::AmbiguityRule::Asymptotic));
-                    const std::size_t entry = caseTable.entryIndex(cube, c.joined);
-                    c.entry = std::uint16_t(entry);
-                    c.patches = std::uint8_t(caseTable.entry(entry).loopCount);
                 }
+        }
     });
 
     // Faces that the patches on both sides cross twice, and the vertex count per cell layer.
@@ -519,27 +548,25 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         for (int z = r.begin(); z != r.end(); ++z) {
             std::uint64_t count = 0;
-            for (int y = 0; y < cells.y; ++y)
-                for (int x = 0; x < cells.x; ++x) {
-                    CellCase& c = vertices.cases[grid.cellIndex({x, y, z})];
-                    count += c.patches;
-                    if (!perComponent || c.patches == 0)
+            for (std::uint64_t i = layerActive[z]; i != layerActive[z + 1]; ++i) {
+                CellCase& c = vertices.cases[i];
+                count += c.patches;
+                if (!perComponent)
+                    continue;
+                const unsigned doubled = caseTable.entry(c.entry).doubledFaces;
+                for (int f = 0; f < tables::kFaceCount; ++f) {
+                    if (((doubled >> f) & 1u) == 0)
                         continue;
-                    const unsigned doubled = caseTable.entry(c.entry).doubledFaces;
-                    for (int f = 0; f < tables::kFaceCount; ++f) {
-                        if (((doubled >> f) & 1u) == 0)
-                            continue;
-                        glm::ivec3 other(x, y, z);
-                        other[f / 2] += (f & 1) ? 1 : -1;
-                        if (other[f / 2] < 0 || other[f / 2] >= cells[f / 2])
-                            continue;
-                        const CellCase& n = vertices.cases[grid.cellIndex(other)];
-                        if ((caseTable.entry(n.entry).doubledFaces >> tables::getOppositeFace(f)) &
-                            1u)
-                            c.paired |= std::uint8_t(1u << f);
-                    }
-                    count += 2 * std::popcount(unsigned(c.paired & kHighFaces));
+                    glm::ivec3 other = vertices.activeCell[i];
+                    other[f / 2] += (f & 1) ? 1 : -1;
+                    if (other[f / 2] < 0 || other[f / 2] >= cells[f / 2])
+                        continue;
+                    const CellCase& n = vertices.getCase(other);
+                    if ((caseTable.entry(n.entry).doubledFaces >> tables::getOppositeFace(f)) & 1u)
+                        c.paired |= std::uint8_t(1u << f);
                 }
+                count += 2 * std::popcount(unsigned(c.paired & kHighFaces));
+            }
             layerCount[z + 1] = count;
         }
     });
@@ -555,39 +582,36 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         for (int z = r.begin(); z != r.end(); ++z) {
             std::uint32_t next = std::uint32_t(layerCount[z]);
-            for (int y = 0; y < cells.y; ++y)
-                for (int x = 0; x < cells.x; ++x) {
-                    const std::size_t cellIndex = grid.cellIndex({x, y, z});
-                    const CellCase& c = vertices.cases[cellIndex];
-                    if (c.patches == 0)
+            for (std::uint64_t i = layerActive[z]; i != layerActive[z + 1]; ++i) {
+                const CellCase& c = vertices.cases[i];
+                const glm::ivec3 cell = vertices.activeCell[i];
+                vertices.vertexOfCell[i] = next;
+                if (!perComponent) {
+                    vertices.cell[next] = cell;
+                    vertices.edges[next++] = 0xfff;
+                    continue;
+                }
+                const tables::CellTriangulation& entry = caseTable.entry(c.entry);
+                for (int l = 0; l < entry.loopCount; ++l) {
+                    vertices.cell[next] = cell;
+                    vertices.edges[next++] = toCellEdgeMask(entry.loops[l]);
+                }
+                for (int f = 1; f < tables::kFaceCount; f += 2) {
+                    if (((c.paired >> f) & 1u) == 0)
                         continue;
-                    vertices.vertexOfCell[cellIndex] = next;
-                    if (!perComponent) {
-                        vertices.cell[next] = glm::ivec3(x, y, z);
-                        vertices.edges[next++] = 0xfff;
-                        continue;
-                    }
-                    const tables::CellTriangulation& entry = caseTable.entry(c.entry);
-                    for (int l = 0; l < entry.loopCount; ++l) {
-                        vertices.cell[next] = glm::ivec3(x, y, z);
-                        vertices.edges[next++] = toCellEdgeMask(entry.loops[l]);
-                    }
-                    for (int f = 1; f < tables::kFaceCount; f += 2) {
-                        if (((c.paired >> f) & 1u) == 0)
-                            continue;
-                        const bool joined = ((c.joined >> f) & 1u) != 0;
-                        for (int segment = 0; segment < 2; ++segment) {
-                            unsigned mask = 0;
-                            for (const int e : tables::getCellFaces()[f].edges) {
-                                if (tables::findFaceSegment(c.cube, f, joined, e) == segment)
-                                    mask |= 1u << e;
-                            }
-                            vertices.cell[next] = glm::ivec3(x, y, z);
-                            vertices.edges[next] = toCellEdgeMask(mask);
-                            vertices.onFace[next++] = 1;
+                    const bool joined = ((c.joined >> f) & 1u) != 0;
+                    for (int segment = 0; segment < 2; ++segment) {
+                        unsigned mask = 0;
+                        for (const int e : tables::getCellFaces()[f].edges) {
+                            if (tables::findFaceSegment(c.cube, f, joined, e) == segment)
+                                mask |= 1u << e;
                         }
+                        vertices.cell[next] = cell;
+                        vertices.edges[next] = toCellEdgeMask(mask);
+                        vertices.onFace[next++] = 1;
                     }
                 }
+            }
         }
     });
 }
@@ -597,11 +621,13 @@ std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertices,
                              const ExtractionOptions& options, const glm::ivec3& cell,
                              const glm::ivec3& s, int axis)
 {
-    const std::size_t cellIndex = grid.cellIndex(cell);
-    const std::uint32_t first = vertices.vertexOfCell[cellIndex];
+    const std::uint32_t k = vertices.findActive(cell);
+    if (k == kNone)
+        return kNone;
+    const std::uint32_t first = vertices.vertexOfCell[k];
     if (options.vertices == VertexMode::PerCell)
         return first;
-    const auto& entry = tables::CaseTable::getInstance().entry(vertices.cases[cellIndex].entry);
+    const auto& entry = tables::CaseTable::getInstance().entry(vertices.cases[k].entry);
     return first + std::uint32_t(entry.edgeLoop[getTableEdge(s - cell, axis)]);
 }
 
@@ -615,15 +641,17 @@ std::uint32_t findFaceVertex(const Grid& grid, const CellVertices& vertices, glm
         ++normalAxis;
     if (other[normalAxis] < cell[normalAxis])
         std::swap(cell, other);
-    const std::size_t cellIndex = grid.cellIndex(cell);
-    const CellCase& c = vertices.cases[cellIndex];
+    const std::uint32_t k = vertices.findActive(cell);
+    if (k == kNone)
+        return kNone;
+    const CellCase& c = vertices.cases[k];
     const int face = 2 * normalAxis + 1;
     if (((c.paired >> face) & 1u) == 0)
         return kNone;
     const int segment = tables::findFaceSegment(c.cube, face, ((c.joined >> face) & 1u) != 0,
                                                 getTableEdge(s - cell, axis));
     const unsigned before = unsigned(c.paired & kHighFaces) & ((1u << face) - 1u);
-    return vertices.vertexOfCell[cellIndex] + c.patches + 2u * std::popcount(before) +
+    return vertices.vertexOfCell[k] + c.patches + 2u * std::popcount(before) +
            std::uint32_t(segment);
 }
 
@@ -666,7 +694,7 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                     if (((vertices.edges[v] >> k) & 1u) == 0)
                         continue;
                     const CellEdgeOffset& e = cellEdges[k];
-                    const std::uint32_t id = table.find(grid.index(cell + e.offset), e.axis);
+                    const std::uint32_t id = table.find(cell + e.offset, e.axis);
                     if (id == kNone)
                         continue;
                     const Crossing& c = table.crossings[id];
@@ -851,9 +879,10 @@ public:
 
 private:
     //! Material of the quad around a crossed edge: the material of its inside sample.
-    std::uint32_t getEdgeMaterial(std::size_t sample, int axis) const
+    std::uint32_t getEdgeMaterial(const glm::ivec3& s, int axis) const
     {
-        const bool lowInside = (mTable.flags[sample] & kInsideBit) != 0;
+        const std::size_t sample = mGrid.index(s);
+        const bool lowInside = mTable.isInside(s);
         return mMaterials[lowInside ? sample : sample + mGrid.stride(axis)];
     }
 
@@ -867,10 +896,9 @@ private:
                 continue;
             const CellEdgeOffset& e = getCellEdgeOffsets()[k];
             const glm::ivec3 s = mVertices.cell[v] + e.offset;
-            const std::size_t sample = mGrid.index(s);
-            if (mTable.find(sample, e.axis) == kNone || !isInteriorEdge(mGrid, s, e.axis))
+            if (mTable.find(s, e.axis) == kNone || !isInteriorEdge(mGrid, s, e.axis))
                 continue;
-            const std::uint32_t m = getEdgeMaterial(sample, e.axis);
+            const std::uint32_t m = getEdgeMaterial(s, e.axis);
             if (any && m != material)
                 return true;
             any = true;
@@ -898,7 +926,7 @@ private:
                         e.offset[axis] != (side > 0 ? 1 : 0))
                         continue;
                     const glm::ivec3 s = cell + e.offset;
-                    if (mTable.find(mGrid.index(s), e.axis) == kNone ||
+                    if (mTable.find(s, e.axis) == kNone ||
                         !isInteriorEdge(mGrid, s, e.axis) ||
                         findFaceVertex(mGrid, mVertices, cell, other, s, e.axis) != kNone)
                         continue;
@@ -981,7 +1009,14 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
         return;
     }
 
-    EdgeTable table;
+    std::size_t firstNan = SignRows::kNoNan;
+    EdgeTable table(SignRows(field, input.isoValue, firstNan));
+    if (firstNan != SignRows::kNoNan) {
+        const glm::ivec3 s = grid.sampleOf(firstNan);
+        throw std::invalid_argument("dual_contouring: NaN sample at (" + std::to_string(s.x) +
+                                    ", " + std::to_string(s.y) + ", " + std::to_string(s.z) +
+                                    ")");
+    }
     buildEdgeTable(grid, table);
     const std::size_t edgeCount = table.edges.size();
     stats.crossedEdges = edgeCount;
@@ -1030,87 +1065,93 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     // A quad side between two cells whose patches both cross their shared face twice passes
     // through the face vertex of the edge's segment (see numberCells); such polygons are fanned
     // around their first face vertex.
-    std::vector<std::array<std::array<std::uint32_t, 3>, kMaxEdgeTriangles>> triangles(edgeCount);
-    std::vector<std::uint8_t> triangleCount(edgeCount, 0);
-    std::vector<std::uint8_t> hasQuad(edgeCount, 0);
-    std::vector<std::uint8_t> flipped(edgeCount, 0);
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, edgeCount),
-        [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                const std::size_t sample = std::size_t(table.edges[k] / 3u);
-                const int axis = int(table.edges[k] % 3u);
-                const glm::ivec3 s = grid.sampleOf(sample);
-                if (!isInteriorEdge(grid, s, axis))
-                    continue;
-                const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
-                const bool lowInside = (table.flags[sample] & kInsideBit) != 0;
-                std::array<glm::ivec3, 4> around;
-                std::array<std::uint32_t, 4> q;
-                std::array<glm::dvec3, 4> p;
-                for (int c = 0; c < 4; ++c) {
-                    around[c] = cells[lowInside ? c : (4 - c) % 4];
-                    q[c] = findEdgeVertex(grid, vertices, options, around[c], s, axis);
-                    p[c] = glm::dvec3(around[c] - s) + vertices.local[q[c]];
-                }
-                hasQuad[k] = 1;
-                std::array<std::uint32_t, 8> polygon;
-                int size = 0;
-                int firstFace = -1;
-                for (int c = 0; c < 4; ++c) {
-                    polygon[size++] = q[c];
-                    if (options.vertices == VertexMode::PerCell)
-                        continue;
-                    const std::uint32_t f =
-                        findFaceVertex(grid, vertices, around[c], around[(c + 1) % 4], s, axis);
-                    if (f == kNone)
-                        continue;
-                    if (firstFace < 0)
-                        firstFace = size;
-                    polygon[size++] = f;
-                }
-                auto& out = triangles[k];
-                if (firstFace >= 0) {
-                    for (int i = 1; i + 1 < size; ++i)
-                        out[triangleCount[k]++] = {polygon[firstFace],
-                                                   polygon[(firstFace + i) % size],
-                                                   polygon[(firstFace + i + 1) % size]};
-                } else if (chooseDiagonal13(q, p)) {
-                    flipped[k] = 1;
-                    out[0] = {q[0], q[1], q[3]};
-                    out[1] = {q[1], q[2], q[3]};
-                    triangleCount[k] = 2;
-                } else {
-                    out[0] = {q[0], q[1], q[2]};
-                    out[1] = {q[0], q[2], q[3]};
-                    triangleCount[k] = 2;
-                }
+    // Edges are cut into fixed chunks, each writing its triangles to a list of its own; the lists
+    // are concatenated in chunk order, so the triangle order is the edge order whatever the
+    // thread count.
+    constexpr std::size_t kChunk = 8192;
+    struct ChunkOutput {
+        std::vector<std::uint32_t> indices;
+        std::size_t quads = 0;
+        std::size_t flipped = 0;
+    };
+    std::vector<ChunkOutput> chunks((edgeCount + kChunk - 1) / kChunk);
+    tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t chunk) {
+        ChunkOutput& result = chunks[chunk];
+        result.indices.reserve(6 * kChunk);
+        const std::size_t end = std::min(edgeCount, (chunk + 1) * kChunk);
+        for (std::size_t k = chunk * kChunk; k != end; ++k) {
+            const std::size_t sample = std::size_t(table.edges[k] / 3u);
+            const int axis = int(table.edges[k] % 3u);
+            const glm::ivec3 s = grid.sampleOf(sample);
+            if (!isInteriorEdge(grid, s, axis))
+                continue;
+            const std::array<glm::ivec3, 4> cells = getCellsAroundEdge(s, axis);
+            const bool lowInside = table.isInside(s);
+            std::array<glm::ivec3, 4> around;
+            std::array<std::uint32_t, 4> q;
+            std::array<glm::dvec3, 4> p;
+            for (int c = 0; c < 4; ++c) {
+                around[c] = cells[lowInside ? c : (4 - c) % 4];
+                q[c] = findEdgeVertex(grid, vertices, options, around[c], s, axis);
+                p[c] = glm::dvec3(around[c] - s) + vertices.local[q[c]];
             }
-        });
+            ++result.quads;
+            std::array<std::uint32_t, 8> polygon;
+            int size = 0;
+            int firstFace = -1;
+            for (int c = 0; c < 4; ++c) {
+                polygon[size++] = q[c];
+                if (options.vertices == VertexMode::PerCell)
+                    continue;
+                const std::uint32_t f =
+                    findFaceVertex(grid, vertices, around[c], around[(c + 1) % 4], s, axis);
+                if (f == kNone)
+                    continue;
+                if (firstFace < 0)
+                    firstFace = size;
+                polygon[size++] = f;
+            }
+            auto& out = result.indices;
+            if (firstFace >= 0) {
+                for (int i = 1; i + 1 < size; ++i)
+                    out.insert(out.end(), {polygon[firstFace], polygon[(firstFace + i) % size],
+                                           polygon[(firstFace + i + 1) % size]});
+            } else if (chooseDiagonal13(q, p)) {
+                ++result.flipped;
+                out.insert(out.end(), {q[0], q[1], q[3], q[1], q[2], q[3]});
+            } else {
+                out.insert(out.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
+            }
+        }
+    });
 
-    TriangleMesh mesh;
+    // Nothing below throws std::invalid_argument, so the mesh is built in `out` itself, reusing
+    // its storage from the last call (as the vtk_flying_edges wrapper does).
+    out.clear();
     const std::size_t vertexCount = vertices.cell.size();
-    mesh.positions.resize(vertexCount);
+    out.positions.resize(vertexCount);
+    if (options.computeNormals)
+        out.normals.resize(vertexCount);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertexCount),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t v = range.begin(); v != range.end(); ++v)
-                              mesh.positions[v] = glm::vec3(
-                                  grid.toWorld(glm::dvec3(vertices.cell[v]) + vertices.local[v]));
+                          for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                              out.positions[v] = glm::vec3(grid.toWorld(
+                                  glm::dvec3(vertices.cell[v]) + vertices.local[v]));
+                              if (options.computeNormals)
+                                  out.normals[v] = glm::vec3(vertices.normal[v]);
+                          }
                       });
-    if (options.computeNormals) {
-        mesh.normals.resize(vertexCount);
-        for (std::size_t v = 0; v < vertexCount; ++v)
-            mesh.normals[v] = glm::vec3(vertices.normal[v]);
+    std::vector<std::size_t> firstIndex(chunks.size() + 1, 0);
+    for (std::size_t c = 0; c < chunks.size(); ++c) {
+        firstIndex[c + 1] = firstIndex[c] + chunks[c].indices.size();
+        stats.quads += chunks[c].quads;
+        stats.flippedSplits += chunks[c].flipped;
     }
-    for (std::size_t k = 0; k < edgeCount; ++k) {
-        if (!hasQuad[k])
-            continue;
-        ++stats.quads;
-        stats.flippedSplits += flipped[k];
-        for (int t = 0; t < triangleCount[k]; ++t)
-            mesh.indices.insert(mesh.indices.end(), triangles[k][t].begin(), triangles[k][t].end());
-    }
-    out = std::move(mesh);
+    out.indices.resize(firstIndex.back());
+    tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t c) {
+        std::copy(chunks[c].indices.begin(), chunks[c].indices.end(),
+                  out.indices.begin() + std::ptrdiff_t(firstIndex[c]));
+    });
 }
 
 } // namespace rtlab::isosurface::dc
