@@ -1,0 +1,123 @@
+#include "passes.h"
+
+#include "qef.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace rtlab::isosurface::dc::detail {
+
+//! Pass 3: one QEF vertex per cell or patch [Ju et al. 2002, sec. 2.2], from the crossings of its
+//! own edges only, in the cell's frame (its lowest sample at the origin, the box [0, 1]^3). A face
+//! vertex is the midpoint of its segment's two crossings, which lies on the face.
+void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOptions& options,
+                   bool keepQef, CellVertices& vertices, ExtractionStats& stats)
+{
+    const std::size_t count = vertices.cell.size();
+    vertices.local.assign(count, glm::dvec3(0.0));
+    vertices.normal.assign(count, glm::dvec3(0.0));
+    if (keepQef)
+        vertices.qef.assign(count, QefSystem{});
+    std::vector<std::uint8_t> rank(count, 0);
+    std::vector<std::uint8_t> left(count, 0);
+    std::vector<std::uint8_t> skipped(count, 0);
+    std::vector<std::uint8_t> noPlanes(count, 0);
+    const auto& cellEdges = getCellEdgeOffsets();
+
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, count),
+        [&](const tbb::blocked_range<std::size_t>& range) {
+            std::array<glm::dvec3, 12> points;
+            std::array<glm::dvec3, 12> normals;
+            for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                const glm::ivec3 cell = vertices.cell[v];
+                int n = 0;
+                glm::dvec3 normalSum(0.0);
+                for (int k = 0; k < 12; ++k) {
+                    if (((vertices.edges[v] >> k) & 1u) == 0)
+                        continue;
+                    const CellEdgeOffset& e = cellEdges[k];
+                    const std::uint32_t id = table.find(cell + e.offset, e.axis);
+                    if (id == kNone)
+                        continue;
+                    const Crossing& c = table.crossings[id];
+                    points[n] = c.point - glm::dvec3(cell);
+                    normals[n] = c.normal;
+                    normalSum += c.normal;
+                    ++n;
+                }
+                if (vertices.onFace[v]) {
+                    glm::dvec3 mid(0.0);
+                    for (int i = 0; i < n; ++i)
+                        mid += points[i];
+                    vertices.local[v] = mid / double(std::max(n, 1));
+                    glm::dvec3 normal = normalizeOrZero(normalSum);
+                    vertices.normal[v] =
+                        normal == glm::dvec3(0.0) ? glm::dvec3(0.0, 0.0, 1.0) : normal;
+                    continue;
+                }
+                int skippedHere = 0;
+                const QefSystem qef = buildQef(std::span(points.data(), n),
+                                               std::span(normals.data(), n), &skippedHere);
+                skipped[v] = std::uint8_t(skippedHere);
+                QefSolution solution;
+                if (options.solver == QefSolver::Svd) {
+                    solution = solveQefSvd(qef, options.svdThreshold);
+                } else {
+                    const glm::dvec3 start = options.schmitzStart == SchmitzStart::MassPoint
+                                                 ? qef.massPoint
+                                                 : glm::dvec3(0.5);
+                    solution =
+                        solveQefSchmitz(qef, start, options.schmitzIterations, options.schmitzStep);
+                }
+                glm::dvec3 p = solution.position;
+                if (qef.planeCount == 0) {
+                    noPlanes[v] = 1;
+                    p = qef.massPoint;
+                }
+                if (!isFinite(p))
+                    p = qef.massPoint;
+                if (!isInsideBox(p)) {
+                    left[v] = 1;
+                    switch (options.outsidePolicy) {
+                    case OutsidePolicy::Clamp:
+                        p = glm::clamp(p, glm::dvec3(0.0), glm::dvec3(1.0));
+                        break;
+                    case OutsidePolicy::MassPoint:
+                        p = qef.massPoint;
+                        break;
+                    case OutsidePolicy::Keep:
+                        break;
+                    }
+                }
+                vertices.local[v] = p;
+                rank[v] = std::uint8_t(solution.rank);
+                if (keepQef)
+                    vertices.qef[v] = qef;
+                if (options.computeNormals) {
+                    glm::dvec3 normal = normalizeOrZero(normalSum);
+                    if (normal == glm::dvec3(0.0)) {
+                        // No usable crossing normal: the sampled field's gradient over the cell.
+                        glm::dvec3 gradient(0.0);
+                        for (int k = 0; k < 8; ++k)
+                            gradient += grid.sampleGradient(
+                                cell + glm::ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1));
+                        normal = normalizeOrZero(gradient);
+                    }
+                    if (normal == glm::dvec3(0.0))
+                        normal = glm::dvec3(0.0, 0.0, 1.0);
+                    vertices.normal[v] = normal;
+                }
+            }
+        });
+    for (std::size_t v = 0; v < count; ++v) {
+        if (vertices.onFace[v])
+            continue;
+        ++stats.rank[std::min<int>(rank[v], 3)];
+        stats.leftCell += left[v];
+        stats.skippedNormals += skipped[v];
+        stats.cellsWithoutPlanes += noPlanes[v];
+    }
+}
+
+} // namespace rtlab::isosurface::dc::detail
