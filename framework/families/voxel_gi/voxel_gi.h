@@ -103,6 +103,15 @@ public:
     {
         return false;
     }
+    //! For the discontinuity metric: per pixel of input.gbuffer, the level of the structure its
+    //! lookup starts at (cascades: the floor of the start level; a tree: the level of the
+    //! interpolation), kNoLevel where there is none. Neighbouring pixels with different levels
+    //! straddle a level transition. False when the technique has no such level.
+    static constexpr std::uint8_t kNoLevel = 255;
+    virtual bool computeLookupLevels(const VoxelGiInput& input, Image<std::uint8_t>& levels)
+    {
+        return false;
+    }
 };
 
 } // namespace rtlab::plugin

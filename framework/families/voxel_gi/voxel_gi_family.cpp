@@ -28,6 +28,7 @@
 #include "experiment/family.h"
 #include "experiment/image_files.h"
 #include "experiment/runner.h"
+#include "metrics/gradient_error.h"
 #include "metrics/image_metrics.h"
 #include "metrics/temporal_metrics.h"
 #include "pipeline/compose.h"
@@ -37,6 +38,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 namespace rtlab::families {
 namespace {
@@ -307,6 +309,53 @@ private:
                                                   ctx.read(view).surface)
                           .flip);
         });
+        // Discontinuities (metrics/gradient_error.h): level transitions and interpolation seams
+        // are lines, which the per-pixel RMSE hardly sees; neighbour differences against the
+        // reference's, on smooth surface pairs, with the reference's noise taken out.
+        graph.addPass({.name = "metric.indirect_discontinuity",
+                       .reads = {indirect, truth, gbuffer},
+                       .writes = {"metric.indirect_discontinuity"},
+                       .measurement = true},
+                      [=, this](pipeline::PassContext& ctx) {
+                          const scene::GBuffer& g = ctx.read(gbuffer);
+                          const reference::ReferenceResult& t = ctx.read(truth);
+                          const auto pairs = metrics::makeSmoothPairMask(g.depth, g.normal);
+                          const auto e = metrics::computeGradientError(
+                              ctx.read(indirect), t.irradiance,
+                              t.irradianceStdErr.width == t.irradiance.width ? &t.irradianceStdErr
+                                                                             : nullptr,
+                              pairs);
+                          mRow->set("indirect.gradient_rmse", e.rmse)
+                              .set("indirect.gradient_noise_floor", e.noiseFloor)
+                              .set("indirect.gradient_excess", e.excess)
+                              .set("indirect.gradient_pairs", std::int64_t(e.pairs));
+                          // Across level transitions against within one level, where the
+                          // technique says which level each pixel's lookup used.
+                          plugin::VoxelGiInput input;
+                          input.gbuffer = &g;
+                          input.frameIndex = ctx.frame();
+                          Image<std::uint8_t> levels;
+                          if (!mTechnique->computeLookupLevels(input, levels))
+                              return pipeline::PassOutcome{};
+                          const auto split = metrics::splitPairsByLabel(
+                              pairs, levels, plugin::VoxelGiTechnique::kNoLevel);
+                          const auto* se = t.irradianceStdErr.width == t.irradiance.width
+                                               ? &t.irradianceStdErr
+                                               : nullptr;
+                          const auto across = metrics::computeGradientError(
+                              ctx.read(indirect), t.irradiance, se, split.across);
+                          const auto within = metrics::computeGradientError(
+                              ctx.read(indirect), t.irradiance, se, split.within);
+                          const double nan = std::numeric_limits<double>::quiet_NaN();
+                          const double a = across.pairs > 0 ? across.rmse : nan;
+                          const double w = within.pairs > 0 ? within.rmse : nan;
+                          mRow->set("indirect.transition_gradient_rmse", a)
+                              .set("indirect.transition_pairs", std::int64_t(across.pairs))
+                              .set("indirect.within_level_gradient_rmse", w)
+                              .set("indirect.within_level_pairs", std::int64_t(within.pairs))
+                              .set("indirect.transition_ratio", w > 0.0 ? a / w : nan);
+                          return pipeline::PassOutcome{};
+                      });
         // The split of the error: the technique's voxels gathered along rays instead of cones.
         const pipeline::Resource<Image<glm::vec3>> voxelRays{
             "voxel_rays", pipeline::ResourceType::cpuImage("vec3", w, h)};
@@ -470,6 +519,12 @@ plugin::FamilyInfo describeVoxelGiFamily()
         .metrics = {{"error", "RMSE, relative MSE, PSNR, mean signed error of the indirect "
                               "irradiance over surface pixels (indirect.*)"},
                     {"flip", "HDR-FLIP of the indirect irradiance (indirect.flip)"},
+                    {"discontinuity",
+                     "error of the differences between neighbouring pixels on smooth surfaces, "
+                     "the reference's noise taken out (indirect.gradient_*); where the "
+                     "technique reports its lookup levels, the same across level transitions "
+                     "and within one level, and their ratio (indirect.transition_*, "
+                     "indirect.within_level_*)"},
                     {"flicker", "frame-to-frame change of the indirect light's error along the "
                                 "camera path, at reprojected points (indirect_flicker.*)"},
                     {"split", "the error split: technique against its own voxels gathered "
@@ -487,10 +542,17 @@ plugin::FamilyInfo describeVoxelGiFamily()
                    .passTimeLabel = "time (ms, CPU)",
                    .extraErrors = {{"indirect.flip", "HDR-FLIP of indirect irradiance"},
                                    {"indirect.rel_mse", "relative MSE of indirect irradiance"},
+                                   {"indirect.gradient_excess",
+                                    "discontinuity: RMS error of neighbour differences above "
+                                    "the reference's noise"},
+                                   {"indirect.transition_gradient_rmse",
+                                    "level transitions: RMS error of neighbour differences "
+                                    "across a change of lookup level"},
                                    {"indirect_flicker.rms",
                                     "flicker: RMS frame-to-frame change of the indirect error"}},
                    .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse",
-                                    "indirect.flip", "split.cone_rmse", "split.voxel_rmse",
+                                    "indirect.flip", "indirect.transition_ratio",
+                                    "split.cone_rmse", "split.voxel_rmse",
                                     "split.voxel_mean_signed_error", "memory.payload_bytes",
                                     "counter.surface_voxels", "counter.steps_per_cone"},
                    .acrossScenes = {

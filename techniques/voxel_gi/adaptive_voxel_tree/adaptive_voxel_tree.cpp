@@ -201,6 +201,23 @@ public:
         });
     }
 
+    bool computeLookupLevels(const plugin::VoxelGiInput& input,
+                             Image<std::uint8_t>& levels) override
+    {
+        const scene::GBuffer& g = *input.gbuffer;
+        levels = Image<std::uint8_t>(g.width, g.height, kNoLevel);
+        if (!mTree || mPayload.empty())
+            return false;
+        tbb::parallel_for(0, g.height, [&](int y) {
+            for (int x = 0; x < g.width; ++x)
+                if (g.hasSurface(x, y))
+                    levels.at(x, y) = std::uint8_t(
+                        getStencil(glm::dvec3(g.position.at(x, y)), glm::dvec3(g.normal.at(x, y)))
+                            .level);
+        });
+        return true;
+    }
+
     plugin::VoxelGiMemory memory() const override
     {
         if (!mTree)
@@ -280,7 +297,7 @@ private:
         return mOrigin + (glm::dvec3(glm::ivec3(cell)) + 0.5) * size;
     }
 
-    glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const
+    voxelgi::TreeStencil getStencil(const glm::dvec3& p, const glm::dvec3& n) const
     {
         voxelgi::TreeQuery q;
         q.origin = mOrigin;
@@ -288,8 +305,12 @@ private:
         q.mode = mPlain ? voxelgi::TreeInterpolation::Plain : voxelgi::TreeInterpolation::Seamless;
         if (mAntiLeak)
             q.normal = n;
-        const voxelgi::TreeStencil st =
-            voxelgi::interpolate(*mTree, q, p + n * (mNormalOffset * mLeafSize));
+        return voxelgi::interpolate(*mTree, q, p + n * (mNormalOffset * mLeafSize));
+    }
+
+    glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const
+    {
+        const voxelgi::TreeStencil st = getStencil(p, n);
         const int m = payloadVectors();
         std::array<glm::dvec3, kAxes> v{};
         for (int i = 0; i < st.count; ++i) {

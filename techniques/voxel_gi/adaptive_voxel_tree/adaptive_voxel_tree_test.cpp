@@ -1,15 +1,22 @@
 // Unit tests of adaptive_voxel_tree as a voxel_gi technique: the tree and the bake are reused
 // until the geometry or the lights change; the bake's noise falls with its path count; the
 // normal-based anti-leak weight and the normal offset keep a closed room lit from outside dark.
-// (The leak against wall thickness is measured by experiments/voxel_gi.yaml's leak rooms.)
+// (The leak against wall thickness is measured by experiments/voxel_gi.yaml's leak rooms.) The
+// lookup levels it reports to the discontinuity metric show the seamless interpolation's point:
+// smaller jumps across level transitions than the plain per-level interpolation.
 
 #include "families/voxel_gi/voxel_gi.h"
 #include "families/voxel_gi/voxel_gi_test_scenes.h"
 
+#include "metrics/gradient_error.h"
 #include "metrics/image_metrics.h"
 #include "reference/reference.h"
 
 #include <gtest/gtest.h>
+
+#include <map>
+#include <set>
+#include <string>
 
 void rtlabRegisterTechnique_voxel_gi_adaptive_voxel_tree(rtlab::plugin::Registry&);
 
@@ -139,6 +146,52 @@ TEST(AdaptiveVoxelTree, AntiLeakKeepsAClosedRoomLitFromOutsideDark)
     // the walls), so the guard trims a small leak. Bound: 1 % of the open sky's irradiance.
     EXPECT_LT(guarded, leaked);
     EXPECT_LT(guarded, 0.01 * 3.14159) << leaked << " -> " << guarded;
+}
+
+TEST(AdaptiveVoxelTree, SeamlessInterpolationJumpsLessAcrossLevelsThanPlain)
+{
+    // The lit room seen from above. Surface points look up at the leaf level; with the lookup
+    // point 3 leaves off the surface (normal_offset) it lies in empty space, at a coarser level
+    // away from the box and the walls (measured: 4200 pixels at level 2, 1944 at level 3, 395
+    // smooth pairs across). Same tree and bake for both modes (the bake's seed is fixed); only
+    // the interpolation differs.
+    const scene::RenderScene s = makeLitRoom();
+    const scene::GBuffer g =
+        reference::castGBuffer(s, makeCamera({0.0f, 0.9f, 0.9f}, {-0.1f, -1.0f, 0.0f}), 96, 64);
+    const auto pairs = metrics::makeSmoothPairMask(g.depth, g.normal);
+    const Image<glm::vec3> zero(g.width, g.height, glm::vec3(0.0f));
+    std::map<std::string, double> jump;
+    for (const std::string mode : {"seamless", "plain"}) {
+        auto t = make({{"resolution", std::int64_t(32)},
+                       {"bake_samples", std::int64_t(16)},
+                       {"interpolation", mode}, {"normal_offset", 3.0}});
+        auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*t);
+        const Image<glm::vec3> e = run(gi, s, g);
+        plugin::VoxelGiInput input;
+        input.gbuffer = &g;
+        Image<std::uint8_t> levels;
+        ASSERT_TRUE(gi.computeLookupLevels(input, levels));
+        std::set<int> seen;
+        for (int y = 0; y < g.height; ++y)
+            for (int x = 0; x < g.width; ++x) {
+                EXPECT_EQ(levels.at(x, y) == plugin::VoxelGiTechnique::kNoLevel, !g.hasSurface(x, y));
+                if (g.hasSurface(x, y))
+                    seen.insert(levels.at(x, y));
+            }
+        ASSERT_GE(seen.size(), 2u) << "the view should cross a level transition";
+        const auto split =
+            metrics::splitPairsByLabel(pairs, levels, plugin::VoxelGiTechnique::kNoLevel);
+        // Against an all-zero image: the RMS of the estimate's own neighbour differences.
+        const metrics::GradientError across =
+            metrics::computeGradientError(e, zero, nullptr, split.across);
+        ASSERT_GT(across.pairs, 20u);
+        jump[mode] = across.rmse;
+    }
+    // Measured: 0.079 seamless, 0.227 plain (within one level: 0.060 and 0.181). The plain mode
+    // drops the corners missing at the finer level and renormalises, which jumps where the level
+    // changes; the seamless mode takes them from the parent level.
+    EXPECT_LT(jump["seamless"], 0.8 * jump["plain"])
+        << "seamless " << jump["seamless"] << ", plain " << jump["plain"];
 }
 
 } // namespace

@@ -35,6 +35,22 @@ bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, gl
     return true;
 }
 
+void CascadeVolume::computeStartLevels(const scene::GBuffer& gbuffer,
+                                       Image<std::uint8_t>& levels) const
+{
+    levels = Image<std::uint8_t>(gbuffer.width, gbuffer.height, 255);
+    tbb::parallel_for(0, gbuffer.height, [&](int y) {
+        for (int x = 0; x < gbuffer.width; ++x) {
+            glm::dvec3 p, n;
+            if (!readPixelSurface(gbuffer, x, y, p, n))
+                continue;
+            const double start = selectLevel(p, 0.0, true);
+            if (start >= 0.0)
+                levels.at(x, y) = std::uint8_t(std::floor(start));
+        }
+    });
+}
+
 void CascadeVolume::gather(const scene::GBuffer& gbuffer,
                            const std::vector<Image<float>>* coneVisibility, Image<glm::vec3>& out)
 {

@@ -145,6 +145,9 @@ public:
     int getFarDependency(int i) const;
     //! Indirect irradiance at every pixel of `gbuffer`: gatherCones combined per pixel
     //! (upsample.h combineCones), cones weighted by `coneVisibility` when given.
+    //! Per pixel, the floor of its cones' start level (the level noise included), 255 where the
+    //! pixel has no surface or lies outside every level: the discontinuity metric's level map.
+    void computeStartLevels(const scene::GBuffer& gbuffer, Image<std::uint8_t>& levels) const;
     void gather(const scene::GBuffer& gbuffer, const std::vector<Image<float>>* coneVisibility,
                 Image<glm::vec3>& out);
 

@@ -317,6 +317,15 @@ public:
         return true;
     }
 
+    bool computeLookupLevels(const plugin::VoxelGiInput& input,
+                             Image<std::uint8_t>& levels) override
+    {
+        if (!mVolume)
+            return false;
+        mVolume->computeStartLevels(*input.gbuffer, levels);
+        return true;
+    }
+
     plugin::VoxelGiMemory memory() const override
     {
         if (!mVolume)
