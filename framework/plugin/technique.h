@@ -97,6 +97,10 @@ struct FamilyReport {
     std::string passTimeLabel;       //!< y label of the stacked per-pass times
     //! More error columns, each with its own time-against-error plot when the study has it.
     std::vector<std::pair<std::string, std::string>> extraErrors; //!< (column, axis label)
+    //! More columns drawn against each swept parameter beside the main error (error-against-
+    //! parameter charts over matched runs), e.g. a ratio that time-against-error plots cannot
+    //! rank. (column, axis label)
+    std::vector<std::pair<std::string, std::string>> paramErrors;
     //! Further columns of the report's run tables (topology counts, masked errors, ...).
     std::vector<std::string> tableColumns;
     bool convergence = false; //!< error against cell size with fitted order (grid sweeps)

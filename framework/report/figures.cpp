@@ -276,38 +276,45 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
     //    Lines of one technique share its colour and differ in pattern and marker; at most
     //    kMaxLines per technique, those with the most values first.
     constexpr std::size_t kMaxLines = 5;
+    std::vector<std::pair<std::string, std::string>> paramErrors = {{columns.error, columns.errorLabel}};
+    paramErrors.insert(paramErrors.end(), columns.paramErrors.begin(), columns.paramErrors.end());
     for (const auto& param : group.varyingParams) {
-        const std::string name = param.rfind("param.", 0) == 0 ? param.substr(6) : param;
-        plot::LineSpec line;
-        line.title = group.title + ": error against " + name;
-        const auto unit = group.paramUnits.find(param);
-        line.xLabel = name == "grid" ? "grid (samples per axis)"
-                      : unit != group.paramUnits.end() ? name + " (" + unit->second + ")"
-                                                       : name;
-        line.yLabel = columns.errorLabel;
-        line.colors = colors;
-        const MatchedLines matched =
-            collectMatchedLines(group.runs, param, columns.error, group.varyingParams, kMaxLines);
-        const std::size_t leftOut = matched.leftOut;
-        for (const MatchedLine& m : matched.lines) {
-            plot::Series s{m.label};
-            s.variant = m.variant;
-            for (const auto& [x, y] : m.points) {
-                s.x.push_back(x);
-                s.y.push_back(y);
+        for (std::size_t e = 0; e < paramErrors.size(); ++e) {
+            const auto& [errorColumn, errorLabel] = paramErrors[e];
+            const std::string name = param.rfind("param.", 0) == 0 ? param.substr(6) : param;
+            // The main error keeps its file names; the others are named after their column.
+            const std::string what = e == 0 ? "error" : makeFileName(errorColumn);
+            plot::LineSpec line;
+            line.title = group.title + ": " + (e == 0 ? "error" : errorColumn) + " against " + name;
+            const auto unit = group.paramUnits.find(param);
+            line.xLabel = name == "grid" ? "grid (samples per axis)"
+                          : unit != group.paramUnits.end() ? name + " (" + unit->second + ")"
+                                                           : name;
+            line.yLabel = errorLabel;
+            line.colors = colors;
+            const MatchedLines matched =
+                collectMatchedLines(group.runs, param, errorColumn, group.varyingParams, kMaxLines);
+            const std::size_t leftOut = matched.leftOut;
+            for (const MatchedLine& m : matched.lines) {
+                plot::Series s{m.label};
+                s.variant = m.variant;
+                for (const auto& [x, y] : m.points) {
+                    s.x.push_back(x);
+                    s.y.push_back(y);
+                }
+                line.colors.setColor(s.label, line.colors.getColor(m.technique));
+                line.series.push_back(std::move(s));
             }
-            line.colors.setColor(s.label, line.colors.getColor(m.technique));
-            line.series.push_back(std::move(s));
+            if (line.series.empty())
+                continue; // not numeric, or no two runs that differ in this parameter alone
+            const std::string path = plots + "/" + what + "_vs_" + makeFileName(name) + "_" + stem;
+            plot::writeLineChart(line, path);
+            figures.plots.push_back(path);
+            figures.captions.push_back(
+                (e == 0 ? "Error" : errorLabel) + " against " + name + " on " + group.title +
+                ", over runs that differ in " + name + " alone (one line per setting of the other swept parameters" +
+                (leftOut > 0 ? "; " + std::to_string(leftOut) + " settings with fewer values not drawn" : "") + ").");
         }
-        if (line.series.empty())
-            continue; // not numeric, or no two runs that differ in this parameter alone
-        const std::string path = plots + "/error_vs_" + makeFileName(name) + "_" + stem;
-        plot::writeLineChart(line, path);
-        figures.plots.push_back(path);
-        figures.captions.push_back(
-            "Error against " + name + " on " + group.title +
-            ", over runs that differ in " + name + " alone (one line per setting of the other swept parameters" +
-            (leftOut > 0 ? "; " + std::to_string(leftOut) + " settings with fewer values not drawn" : "") + ").");
     }
 
     // 3. Per-pass time of each technique's Pareto-front runs, stacked.

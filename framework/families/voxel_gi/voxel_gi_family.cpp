@@ -550,6 +550,9 @@ plugin::FamilyInfo describeVoxelGiFamily()
                                     "across a change of lookup level"},
                                    {"indirect_flicker.rms",
                                     "flicker: RMS frame-to-frame change of the indirect error"}},
+                   .paramErrors = {{"indirect.transition_ratio",
+                                    "level transitions: neighbour-difference error across / "
+                                    "within a level (1: not visible)"}},
                    .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse",
                                     "indirect.flip", "indirect.transition_ratio",
                                     "split.cone_rmse", "split.voxel_rmse",
