@@ -11,6 +11,7 @@
 
 #include <fmt/core.h>
 
+#include <cstdio>
 #include <filesystem>
 
 namespace rtlab::cli {
@@ -41,6 +42,8 @@ int referenceCommand(const ReferenceOptions& options)
 
     try {
         const scene::Scene scene = scene::loadScene(options.scene);
+        for (const auto& w : scene.warnings)
+            std::fprintf(stderr, "warning: %s\n", w.c_str());
         if (options.frame < 0 || options.frame >= scene.frameCount) {
             fmt::print(stderr, "rtlab reference: --frame {} is outside the scene's frames 0..{}\n", options.frame,
                        scene.frameCount - 1);

@@ -18,9 +18,12 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <optional>
+#include <set>
 #include <thread>
 
 #include "core/strings.h"
@@ -40,6 +43,22 @@ gpu::Context& DriverContext::getGpu()
         mGpu = std::make_unique<gpu::Context>();
     return *mGpu;
 }
+
+namespace {
+
+//! Prints each of the scene's loading warnings once per process, on stderr (the rows carry them
+//! too, as scene.warnings).
+void reportSceneWarnings(const scene::Scene& scene)
+{
+    static std::mutex mutex;
+    static std::set<std::string> printed;
+    const std::lock_guard lock(mutex);
+    for (const auto& w : scene.warnings)
+        if (printed.insert(w).second)
+            std::fprintf(stderr, "warning: %s\n", w.c_str());
+}
+
+} // namespace
 
 void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& records)
 {
@@ -164,6 +183,7 @@ std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
                 "' is an analytic shape for isosurface studies; screen-space families need a scene "
                 "with geometry and a camera (e.g. ao_testbed, tomorrow_town, or a .yaml file)");
         scene = scene::loadScene(run.scene);
+        reportSceneWarnings(*scene);
         if (run.frames > scene->frameCount && (run.cameraPath.empty() || run.cameraPath == "scene"))
             throw Error(
                 "the run asks for " + std::to_string(run.frames) + " frames but scene '" +
@@ -196,6 +216,12 @@ std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
     }
 
     ResultRow base = common;
+    if (scene && !scene->warnings.empty()) {
+        std::string joined;
+        for (const auto& w : scene->warnings)
+            joined += (joined.empty() ? "" : "; ") + w;
+        base.set("scene.warnings", joined);
+    }
     for (const auto& family : familyRuns)
         family->describe(base);
     if (litFrame)

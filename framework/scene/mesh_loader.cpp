@@ -190,12 +190,13 @@ LoadedMesh finishMesh(const std::string& path, const RawMesh& raw)
     }
 
     mesh.nonManifold = hasNonManifoldEdge(mesh.positions, mesh.indices);
+    mesh.warnings = raw.warnings;
     return mesh;
 }
 
 } // namespace detail
 
-LoadedMesh loadMesh(const std::string& path)
+LoadedMesh loadMesh(const std::string& path, const MeshLoadOptions& options)
 {
     std::string extension = std::filesystem::path(path).extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
@@ -208,7 +209,7 @@ LoadedMesh loadMesh(const std::string& path)
 
     const std::string contents = detail::readWholeFile(path);
     const detail::RawMesh raw = extension == ".obj"
-                                    ? detail::readObj(path, contents)
+                                    ? detail::readObj(path, contents, options)
                                     : detail::readGltf(path, contents, extension == ".glb");
     return detail::finishMesh(path, raw);
 }

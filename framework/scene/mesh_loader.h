@@ -14,7 +14,10 @@
 // OBJ: `v`, `vn`, `vt`, `f`, `o`, `g`, `usemtl` and `mtllib` are read; other statements (`s`,
 // `l`, `p`, free-form geometry, ...) are ignored. Polygons are fan-triangulated from their first
 // corner. Indices may be negative (relative). Every `mtllib` must exist and every `usemtl` name
-// must be defined by one of them; an MTL gives Kd (albedo) and Ke (emission), RGB only.
+// must be defined by one of them; an MTL gives Kd (albedo) and Ke (emission), RGB only. With
+// MeshLoadOptions::materialsOptional (a scene file that assigns its own material to the mesh) a
+// missing or unreadable MTL and an undefined `usemtl` name are warnings (LoadedMesh::warnings,
+// naming the file, the line and the default used) instead of errors.
 //
 // glTF: every triangle primitive of every mesh instance in the default scene (scene 0 when the
 // file names none; the parentless nodes when it has no scenes) with the node transforms applied,
@@ -58,13 +61,22 @@ struct LoadedMesh {
     std::size_t degenerateTrianglesDropped = 0;
     //! Some edge (between bitwise-equal positions) is used by more than two kept triangles.
     bool nonManifold = false;
+    //! What was replaced by a default instead of refused (see MeshLoadOptions), one line each,
+    //! "file:line: what; default used".
+    std::vector<std::string> warnings;
 
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
 
+struct MeshLoadOptions {
+    //! The caller assigns its own material: a missing MTL or material definition is a warning,
+    //! and the triangles get the default material (albedo 0.8, no emission).
+    bool materialsOptional = false;
+};
+
 //! Loads the mesh at `path`, chosen by extension (case-insensitive): .obj, .gltf or .glb.
 //! Throws rtlab::InputError for another extension and for bad input (see the policy above).
-LoadedMesh loadMesh(const std::string& path);
+LoadedMesh loadMesh(const std::string& path, const MeshLoadOptions& options = {});
 
 namespace detail {
 
@@ -83,10 +95,12 @@ struct RawMesh {
     std::vector<std::int64_t> cornerNormal;      //!< three per triangle, into normals; -1 for none
     std::vector<std::uint32_t> triangleMaterial; //!< into materials
     std::vector<RawMaterial> materials;
+    std::vector<std::string> warnings; //!< see LoadedMesh::warnings
 };
 
 //! Reads OBJ text (the contents of `path`; MTL files are looked up next to it).
-RawMesh readObj(const std::string& path, const std::string& text);
+RawMesh readObj(const std::string& path, const std::string& text,
+                const MeshLoadOptions& options = {});
 //! Reads glTF JSON (`binary` false) or GLB (`binary` true) bytes (the contents of `path`).
 RawMesh readGltf(const std::string& path, const std::string& bytes, bool binary);
 //! Reads the whole file; InputError naming `path` when it is missing or unreadable.

@@ -185,7 +185,8 @@ void readMtl(const std::string& file, std::string_view text,
 //! Parses one OBJ file into a RawMesh.
 class ObjReader {
 public:
-    explicit ObjReader(const std::string& path) : mPath(path)
+    ObjReader(const std::string& path, const MeshLoadOptions& options)
+        : mPath(path), mOptions(options)
     {
         mRaw.materials.push_back({}); // kNoMaterial: faces before any usemtl
         mFirstUse.emplace_back();
@@ -395,6 +396,13 @@ private:
             try {
                 text = readWholeFile(library);
             } catch (const InputError& e) {
+                if (mOptions.materialsOptional) {
+                    mRaw.warnings.push_back(s.locate(mPath, i).toString() + ": material library " +
+                                            quote(s[i]) + ": " + e.message() +
+                                            "; its materials default to albedo 0.8, no emission "
+                                            "(the scene assigns the mesh's material anyway)");
+                    continue;
+                }
                 throw InputError(s.locate(mPath, i), "material library " + quote(s[i]) + ": " +
                                                          e.location().toString() + ": " +
                                                          e.message());
@@ -417,6 +425,15 @@ private:
             if (m == kNoMaterial)
                 continue;
             const auto it = mDefinitions.find(material.name);
+            if (it == mDefinitions.end() && mOptions.materialsOptional) {
+                mRaw.warnings.push_back(mFirstUse[m].toString() + ": material " +
+                                        quote(material.name) + " is not defined" +
+                                        (mLibraries.empty() ? std::string(" (the file has no mtllib)")
+                                                            : " in any mtllib") +
+                                        "; it defaults to albedo 0.8, no emission (the scene "
+                                        "assigns the mesh's material anyway)");
+                continue;
+            }
             if (it == mDefinitions.end())
                 throw InputError(mFirstUse[m],
                                  "material " + quote(material.name) + " is not defined" +
@@ -430,6 +447,7 @@ private:
     static constexpr std::uint32_t kNoMaterial = 0;
 
     const std::string& mPath;
+    const MeshLoadOptions& mOptions;
     RawMesh mRaw;
     std::uint32_t mMaterial = kNoMaterial;
     std::unordered_map<std::string, std::uint32_t> mMaterialIndex;
@@ -444,9 +462,9 @@ private:
 
 } // namespace
 
-RawMesh readObj(const std::string& path, const std::string& text)
+RawMesh readObj(const std::string& path, const std::string& text, const MeshLoadOptions& options)
 {
-    return ObjReader(path).read(text);
+    return ObjReader(path, options).read(text);
 }
 
 } // namespace rtlab::scene::detail

@@ -102,6 +102,9 @@ struct Scene {
     //! every row of a run on the scene carries them as columns scene.<name>.
     std::map<std::string, double> parameters;
     float frameRate = 30.0f;
+    //! What loading replaced by a default instead of refusing (a missing .mtl of a mesh whose
+    //! material the scene file assigns, ...), one line each naming the file.
+    std::vector<std::string> warnings;
 
     FeatureSet computeFeatures() const;
     float getFrameTime(int frame) const { return float(frame) / frameRate; }

@@ -103,11 +103,13 @@ struct Parser {
             const std::string path = (folder / rel).lexically_normal().string();
             LoadedMesh loaded;
             try {
-                loaded = loadMesh(path);
+                // A material assigned here makes the file's own materials optional.
+                loaded = loadMesh(path, {.materialsOptional = bool(m["material"])});
             } catch (const InputError& e) {
                 // Name both places: where the scene refers to the mesh, and the mesh's own error.
                 file.fail(m["file"], "mesh '" + rel + "': " + e.what());
             }
+            scene.warnings.insert(scene.warnings.end(), loaded.warnings.begin(), loaded.warnings.end());
             MeshInstance inst;
             inst.name = m["name"] ? config::readString(file, m["name"], "mesh name") : rel;
             inst.sourceFile = path;

@@ -467,6 +467,41 @@ TEST(MeshLoaderObj, MaterialProblemsAreErrors)
     EXPECT_THAT(nanColour.what(), HasSubstr("nan.mtl:3:"));
 }
 
+TEST(MeshLoaderObj, MaterialProblemsAreWarningsWhenTheCallerAssignsTheMaterial)
+{
+    // A scene file that gives the mesh its own material does not need the file's: a missing MTL
+    // and an undefined usemtl name are warnings naming the file, the line and the default.
+    TempDir dir("optional_materials");
+    const MeshLoadOptions optional{.materialsOptional = true};
+    const LoadedMesh missing = loadMesh(
+        dir.write("missing.obj", std::string("mtllib nowhere.mtl\n") + kQuadObj +
+                                     "usemtl red\nf 1 2 3\n"),
+        optional);
+    EXPECT_EQ(missing.triangleCount(), 1u);
+    ASSERT_EQ(missing.warnings.size(), 2u);
+    EXPECT_THAT(missing.warnings[0], HasSubstr("missing.obj:1:"));
+    EXPECT_THAT(missing.warnings[0], HasSubstr("nowhere.mtl"));
+    EXPECT_THAT(missing.warnings[0], HasSubstr("albedo 0.8"));
+    EXPECT_THAT(missing.warnings[1], HasSubstr("missing.obj:6:"));
+    EXPECT_THAT(missing.warnings[1], HasSubstr("'red' is not defined"));
+    ASSERT_EQ(missing.materialAlbedo.size(), 1u);
+    EXPECT_EQ(missing.materialAlbedo[0], glm::vec3(0.8f));
+    EXPECT_EQ(missing.materialEmission[0], glm::vec3(0.0f));
+
+    // A library that exists is still read, and a malformed one is still an error.
+    dir.write("lib.mtl", "newmtl red\nKd 1 0 0\n");
+    const LoadedMesh found = loadMesh(
+        dir.write("found.obj", std::string("mtllib lib.mtl\n") + kQuadObj + "usemtl red\nf 1 2 3\n"),
+        optional);
+    EXPECT_TRUE(found.warnings.empty());
+    EXPECT_EQ(found.materialAlbedo[0], glm::vec3(1, 0, 0));
+    dir.write("nan.mtl", "newmtl red\n\nKd 1 nan 0\n");
+    EXPECT_THROW(loadMesh(dir.write("nancolour.obj", std::string("mtllib nan.mtl\n") + kQuadObj +
+                                                         "usemtl red\nf 1 2 3\n"),
+                          optional),
+                 rtlab::InputError);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Files in general
 

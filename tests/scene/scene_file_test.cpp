@@ -149,6 +149,33 @@ TEST(SceneFile, LoadsMeshesRelativeToTheSceneFile)
     EXPECT_EQ(loadScene("cornell_box").name, "cornell_box");
 }
 
+TEST(SceneFile, AMeshWhoseMaterialTheSceneAssignsLoadsWithoutItsMtl)
+{
+    // Downloaded models often lack their .mtl. When the scene file assigns the material, the
+    // missing library is a warning on the scene (and on every run's row), not an error.
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_scene_file_mtl_test";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "model.obj") << "mtllib model.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
+                                        "usemtl paint\nf 1 2 3\n";
+    std::ofstream(dir / "assigned.yaml") << "scene: assigned\nmaterials: [{name: grey, albedo: 0.5}]\n"
+                                            "meshes: [{file: model.obj, material: grey}]\n";
+    const Scene s = loadScene((dir / "assigned.yaml").string());
+    ASSERT_EQ(s.meshes.size(), 1u);
+    EXPECT_EQ(s.meshes[0].triangleMaterial[0], 0u);
+    ASSERT_EQ(s.warnings.size(), 2u);
+    EXPECT_NE(s.warnings[0].find("model.obj:1:"), std::string::npos) << s.warnings[0];
+    EXPECT_NE(s.warnings[0].find("model.mtl"), std::string::npos) << s.warnings[0];
+    // Without a material of its own the mesh needs the file's: still an error, naming both files.
+    std::ofstream(dir / "unassigned.yaml") << "scene: unassigned\nmeshes: [{file: model.obj}]\n";
+    try {
+        loadScene((dir / "unassigned.yaml").string());
+        FAIL() << "expected an error";
+    } catch (const rtlab::Error& e) {
+        EXPECT_NE(std::string(e.what()).find("unassigned.yaml:2:"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("model.mtl"), std::string::npos) << e.what();
+    }
+}
+
 TEST(SceneFile, EveryShippedSceneFileLoadsAndBuilds)
 {
     // The scene files under scenes/ are part of the product: each must load and build every frame.
