@@ -48,6 +48,13 @@ struct NewFamilyOptions {
 //! experiments/<name>.yaml.
 int newFamily(const NewFamilyOptions& options);
 
+struct SceneOptions {
+    std::string scene; //!< procedural scene name or scene file
+    int frame = 0;
+};
+//! Prints what a scene holds, its loader warnings, the load time and the peak resident memory.
+int sceneCommand(const SceneOptions& options);
+
 struct GpuOptions {
     std::string device;  //!< device name substring; empty = automatic
     bool validation = false;

@@ -111,6 +111,15 @@ int main(int argc, char** argv)
     newFamilyCmd->add_option("--source-dir", family.sourceDirectory,
                              "Repository root (default: the one rtlab was built from)");
 
+    SceneOptions sceneOptions;
+    auto* sceneCmd = app.add_subcommand(
+        "scene", "What a scene holds (meshes, materials, frames), its loader warnings, load time and "
+                 "peak memory");
+    sceneCmd->add_option("scene", sceneOptions.scene, "Procedural scene name or scene file")
+        ->required();
+    sceneCmd->add_option("--frame", sceneOptions.frame, "Frame to build (default 0)")
+        ->check(CLI::NonNegativeNumber);
+
     GpuOptions gpu;
     auto* gpuCmd = app.add_subcommand("gpu", "Show the Vulkan device and time the smoke compute shader");
     gpuCmd->add_option("--device", gpu.device, "Device name substring (default: automatic)");
@@ -133,6 +142,8 @@ int main(int argc, char** argv)
         return newFamily(family);
     if (*gpuCmd)
         return gpuSmoke(gpu);
+    if (*sceneCmd)
+        return sceneCommand(sceneOptions);
     if (*reportCmd)
         return reportCommand(reportDirectory);
     if (*refCmd)
