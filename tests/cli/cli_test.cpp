@@ -53,7 +53,7 @@ std::string readFile(const fs::path& p)
 
 TEST(Cli, HelpOnEverySubcommand)
 {
-    for (const char* sub : {"", "list", "run", "new-technique", "gpu"}) {
+    for (const char* sub : {"", "list", "run", "new-technique", "gpu", "scene"}) {
         const auto r = runRtlab(std::string(sub) + " --help");
         EXPECT_EQ(r.exitCode, 0) << sub;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub << ": " << r.output;
@@ -83,6 +83,19 @@ TEST(Cli, ListShowsTheThreeFamiliesWithParameters)
     const auto bad = runRtlab("list --family isosurfac");
     EXPECT_EQ(bad.exitCode, 2);
     EXPECT_NE(bad.output.find("did you mean isosurface?"), std::string::npos) << bad.output;
+}
+
+TEST(Cli, SceneDescribesAModelAndItsLoaderWarnings)
+{
+    const auto ok = runRtlab("scene " + std::string(RTLAB_SOURCE_DIR) + "/scenes/imported_room.yaml");
+    EXPECT_EQ(ok.exitCode, 0) << ok.output;
+    EXPECT_NE(ok.output.find("assets/imported_room.obj: 20 triangles"), std::string::npos) << ok.output;
+    EXPECT_NE(ok.output.find("warning:     "), std::string::npos) << ok.output;
+    EXPECT_NE(ok.output.find("imported_room.mtl"), std::string::npos) << ok.output;
+    EXPECT_NE(ok.output.find("peak memory:"), std::string::npos) << ok.output;
+    const auto missing = runRtlab("scene no_such_scene.yaml");
+    EXPECT_EQ(missing.exitCode, 2) << missing.output;
+    EXPECT_NE(missing.output.find("no_such_scene.yaml"), std::string::npos) << missing.output;
 }
 
 TEST(Cli, RunReportsConfigErrorsWithLocationAndExitCode2)
