@@ -61,6 +61,20 @@ struct GpuOptions {
 };
 int gpuSmoke(const GpuOptions& options);
 
+struct StressCommandOptions {
+    std::vector<std::string> families;
+    std::vector<std::string> techniques;
+    std::vector<std::string> cases;
+    std::string outputDirectory = "results/stress";
+    std::uint64_t seed = 1;
+    bool cpuOnly = false;    //!< skip the Vulkan paths
+    std::string device;      //!< Vulkan device name substring; empty = automatic
+    std::string commandLine; //!< as typed, for the page
+};
+//! Every chosen technique through its family's stress cases: a table, heat maps and a page;
+//! exit 1 when a case failed.
+int stressCommand(const StressCommandOptions& options);
+
 struct MergeOptions {
     std::string outputDirectory;
     std::vector<std::string> shardDirectories;

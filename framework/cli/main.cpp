@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <string>
 
 int main(int argc, char** argv)
 {
@@ -125,6 +126,20 @@ int main(int argc, char** argv)
     gpuCmd->add_option("--device", gpu.device, "Device name substring (default: automatic)");
     gpuCmd->add_flag("--validation", gpu.validation, "Enable the Vulkan validation layer");
 
+    StressCommandOptions stress;
+    auto* stressCmd = app.add_subcommand(
+        "stress", "Every technique through its family's stress cases (hostile inputs, closed forms, random "
+                  "inputs): a pass/fail table, heat maps and a page; exit 1 when a case fails");
+    stressCmd->add_option("--family", stress.families, "Only this family (repeatable)");
+    stressCmd->add_option("--technique", stress.techniques, "Only this technique (repeatable)");
+    stressCmd->add_option("--case", stress.cases, "Only this case (repeatable)");
+    stressCmd->add_option("-o,--output", stress.outputDirectory,
+                          "Folder for results.csv, heatmap_<family>.png and stress.html")
+        ->capture_default_str();
+    stressCmd->add_option("--seed", stress.seed, "Seed of the randomised cases")->capture_default_str();
+    stressCmd->add_flag("--cpu-only", stress.cpuOnly, "Stress the C++ paths only (no Vulkan device)");
+    stressCmd->add_option("--device", stress.device, "Vulkan device name substring (default: automatic)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -134,6 +149,11 @@ int main(int argc, char** argv)
 
     if (*listCmd)
         return listTechniques(list);
+    if (*stressCmd) {
+        for (int i = 0; i < argc; ++i)
+            stress.commandLine += (i > 0 ? " " : "") + std::string(i == 0 ? "rtlab" : argv[i]);
+        return stressCommand(stress);
+    }
     if (*runCmd)
         return runExperimentCommand(run);
     if (*newCmd)

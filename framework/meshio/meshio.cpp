@@ -83,8 +83,9 @@ void writePly(const TriangleMesh& mesh, const std::string& path)
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "wb"), &std::fclose);
     if (!f)
         throw Error(path + ": cannot open for writing");
+    // An empty mesh has an empty body, whose data() may be null: fwrite must not be given it.
     if (std::fwrite(header.data(), 1, header.size(), f.get()) != header.size() ||
-        std::fwrite(body.data(), 1, body.size(), f.get()) != body.size() ||
+        (!body.empty() && std::fwrite(body.data(), 1, body.size(), f.get()) != body.size()) ||
         std::fflush(f.get()) != 0)
         throw Error(path + ": write failed");
 }

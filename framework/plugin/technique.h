@@ -8,6 +8,7 @@
 // static can be dropped by the linker.
 
 #include "config/param.h"
+#include "plugin/stress.h"
 
 #include <concepts>
 #include <functional>
@@ -129,6 +130,9 @@ struct FamilyInfo {
     //! Adds the family's passes to runs; null for a family that describes techniques only
     //! (registries built by hand in tests).
     std::shared_ptr<const experiment::Family> runtime;
+    //! The family's stress cases (plugin/stress.h), run by `rtlab stress` and the family suite
+    //! over every registered technique; empty for a family that declares none.
+    std::function<std::vector<StressCase>()> stressCases;
 };
 
 class Registry {

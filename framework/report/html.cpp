@@ -13,8 +13,6 @@
 
 namespace rtlab::report::detail {
 
-namespace {
-
 std::string escapeHtml(const std::string& s)
 {
     std::string out;
@@ -29,6 +27,20 @@ std::string escapeHtml(const std::string& s)
     }
     return out;
 }
+
+std::string getPageHead(const std::string& title)
+{
+    return "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" + escapeHtml(title) +
+           "</title>\n<style>\n"
+           "body{font-family:sans-serif;margin:2em auto;max-width:1200px;color:#222}\n"
+           "img{max-width:100%;border:1px solid #ddd}\nfigure{margin:1.5em 0}\n"
+           "figcaption{color:#555;font-size:0.9em}\n"
+           "table{border-collapse:collapse;font-size:0.85em}td,th{border:1px solid #ccc;padding:2px 6px;"
+           "text-align:right}th{background:#f3f3f3}\n.scroll{overflow-x:auto;max-height:30em}\n"
+           "pre{background:#f7f7f7;padding:1em;overflow-x:auto;font-size:0.8em}\n</style></head><body>\n";
+}
+
+namespace {
 
 std::string formatNumber(double v)
 {
@@ -52,14 +64,7 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
 {
     std::ostringstream h;
     std::string title = std::filesystem::path(directory).filename().string();
-    h << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n<title>" << escapeHtml(title)
-      << " - rtlab study</title>\n<style>\n"
-         "body{font-family:sans-serif;margin:2em auto;max-width:1200px;color:#222}\n"
-         "img{max-width:100%;border:1px solid #ddd}\nfigure{margin:1.5em 0}\n"
-         "figcaption{color:#555;font-size:0.9em}\n"
-         "table{border-collapse:collapse;font-size:0.85em}td,th{border:1px solid #ccc;padding:2px 6px;"
-         "text-align:right}th{background:#f3f3f3}\n.scroll{overflow-x:auto;max-height:30em}\n"
-         "pre{background:#f7f7f7;padding:1em;overflow-x:auto;font-size:0.8em}\n</style></head><body>\n";
+    h << getPageHead(title + " - rtlab study");
     h << "<h1>Study " << escapeHtml(title) << "</h1>\n";
     h << "<p>Results table: <a href=\"results.csv\">results.csv</a> (and <a href=\"results.jsonl\">results.jsonl</a>); "
          "what produced it: <a href=\"manifest.json\">manifest.json</a>. Every figure is also a vector PDF beside its "

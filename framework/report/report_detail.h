@@ -12,6 +12,11 @@
 
 namespace rtlab::report::detail {
 
+//! `s` with &, <, >, " escaped for HTML text and attributes.
+std::string escapeHtml(const std::string& s);
+//! The doctype, head (title, the reports' style sheet) and the opening body tag of a page.
+std::string getPageHead(const std::string& title);
+
 //! One run: its rows (one per frame) averaged column by column where numeric.
 struct RunSummary {
     std::string runId;

@@ -53,7 +53,7 @@ std::string readFile(const fs::path& p)
 
 TEST(Cli, HelpOnEverySubcommand)
 {
-    for (const char* sub : {"", "list", "run", "new-technique", "gpu", "scene"}) {
+    for (const char* sub : {"", "list", "run", "new-technique", "gpu", "scene", "stress"}) {
         const auto r = runRtlab(std::string(sub) + " --help");
         EXPECT_EQ(r.exitCode, 0) << sub;
         EXPECT_NE(r.output.find("Usage"), std::string::npos) << sub << ": " << r.output;
@@ -96,6 +96,22 @@ TEST(Cli, SceneDescribesAModelAndItsLoaderWarnings)
     const auto missing = runRtlab("scene no_such_scene.yaml");
     EXPECT_EQ(missing.exitCode, 2) << missing.output;
     EXPECT_NE(missing.output.find("no_such_scene.yaml"), std::string::npos) << missing.output;
+}
+
+TEST(Cli, StressWritesItsTableAndExitsWithWhetherEverythingPassed)
+{
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_cli_stress";
+    std::filesystem::remove_all(dir);
+    const auto ok = runRtlab("stress --family isosurface --technique marching_cubes --case sphere --case all_positive "
+                             "--cpu-only -o " + dir.string());
+    EXPECT_EQ(ok.exitCode, 0) << ok.output;
+    EXPECT_NE(ok.output.find("2 of 2 passed"), std::string::npos) << ok.output;
+    EXPECT_TRUE(std::filesystem::exists(dir / "results.csv"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "heatmap_isosurface.png"));
+    EXPECT_TRUE(std::filesystem::exists(dir / "stress.html"));
+    const auto bad = runRtlab("stress --technique no_such_technique --cpu-only -o " + dir.string());
+    EXPECT_EQ(bad.exitCode, 2);
+    EXPECT_NE(bad.output.find("marching_cubes"), std::string::npos) << "lists the choices: " << bad.output;
 }
 
 TEST(Cli, RunReportsConfigErrorsWithLocationAndExitCode2)

@@ -33,5 +33,16 @@ echo "$listing"
 grep -q "flow_check_ao: describe flow_check_ao in one line" <<<"$listing"
 grep -qE "radius +float +1 +\[0, inf\) +world units" <<<"$listing"
 "$work/tree/build/techniques/occlusion/flow_check_ao/occlusion_flow_check_ao_test"
+# The new technique is stressed with no code of its own: the template answers "no occlusion", so
+# it passes the range cases and fails the crease's closed form (exit code 1, not 2 or 3).
+set +e
+stress=$("$work/tree/build/rtlab" stress --technique flow_check_ao --cpu-only -o "$work/stress")
+code=$?
+set -e
+echo "$stress" | tail -n 4
+[ "$code" -eq 1 ] || { echo "rtlab stress exit code $code, expected 1"; exit 1; }
+grep -qE "FAIL +occlusion/flow_check_ao on crease_closed_form" <<<"$stress"
+grep -qE "ok +occlusion/flow_check_ao on floor_and_wall_64x48" <<<"$stress"
+[ -s "$work/stress/results.csv" ] && [ -s "$work/stress/heatmap_occlusion.png" ] && [ -s "$work/stress/stress.html" ]
 rm -rf "$work"
 echo "scaffold flow: ok"

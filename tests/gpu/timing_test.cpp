@@ -86,8 +86,8 @@ TEST_F(TimingTest, EveryCommandGetsAPositiveFiniteGpuTime)
     // The commands run one after another, so their intervals do not overlap.
     ASSERT_TRUE(run.gpuTotalMs.has_value());
     EXPECT_GE(*run.gpuTotalMs, sum * (1 - 1e-9));
-    // 16 times the work (256 vs 16 rounds) takes longer; 2x leaves room for fixed overheads.
-    EXPECT_GT(*run.commands[1].gpuMs, 2.0 * *run.commands[2].gpuMs);
+    // No comparison of the heavy and light dispatches' times: on a loaded machine any ratio can
+    // fail, and tests check what was computed, not how fast (the benchmarks measure cost).
     // GPU time fits inside the wall time of the submission (units check: ms vs us vs ns).
     EXPECT_TRUE(std::isfinite(run.cpuSubmitMs));
     EXPECT_GT(run.cpuSubmitMs, 0.0);

@@ -21,6 +21,7 @@
 #include "metrics/mesh_metrics.h"
 #include "pipeline/frame_graph.h"
 #include "families/isosurface/isosurface.h"
+#include "families/isosurface/stress_cases.h"
 #include "scene/procedural.h"
 #include "scene/sdf_shapes.h"
 #include "sdf/evaluator.h"
@@ -396,6 +397,7 @@ plugin::FamilyInfo describeIsosurfaceFamily()
                             "Slivers pile up near 0 and 180."}},
     };
     info.runtime = std::make_shared<IsosurfaceFamily>();
+    info.stressCases = isosurface::makeIsosurfaceStressCases;
     return info;
 }
 

@@ -11,6 +11,7 @@
 // and one row per frame, with each pass recorded as run or skipped and why.
 
 #include "families/occlusion/occlusion.h"
+#include "families/occlusion/stress_cases.h"
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -688,6 +689,7 @@ plugin::FamilyInfo describeOcclusionFamily()
                          "ao_vs_screen_truth.rmse", "flicker.rms"},
     };
     info.runtime = std::make_shared<OcclusionFamily>();
+    info.stressCases = occlusion::makeOcclusionStressCases;
     return info;
 }
 

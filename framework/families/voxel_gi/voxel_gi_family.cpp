@@ -22,6 +22,7 @@
 // (names of their own, so that the family runs beside the occlusion family in one frame)
 
 #include "families/voxel_gi/voxel_gi.h"
+#include "families/voxel_gi/stress_cases.h"
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -320,11 +321,11 @@ private:
                           const scene::GBuffer& g = ctx.read(gbuffer);
                           const reference::ReferenceResult& t = ctx.read(truth);
                           const auto pairs = metrics::makeSmoothPairMask(g.depth, g.normal);
-                          const auto e = metrics::computeGradientError(
-                              ctx.read(indirect), t.irradiance,
-                              t.irradianceStdErr.width == t.irradiance.width ? &t.irradianceStdErr
-                                                                             : nullptr,
-                              pairs);
+                          const auto* se = t.irradianceStdErr.width == t.irradiance.width
+                                               ? &t.irradianceStdErr
+                                               : nullptr;
+                          const auto e = metrics::computeGradientError(ctx.read(indirect),
+                                                                       t.irradiance, se, pairs);
                           mRow->set("indirect.gradient_rmse", e.rmse)
                               .set("indirect.gradient_noise_floor", e.noiseFloor)
                               .set("indirect.gradient_excess", e.excess)
@@ -339,9 +340,6 @@ private:
                               return pipeline::PassOutcome{};
                           const auto split = metrics::splitPairsByLabel(
                               pairs, levels, plugin::VoxelGiTechnique::kNoLevel);
-                          const auto* se = t.irradianceStdErr.width == t.irradiance.width
-                                               ? &t.irradianceStdErr
-                                               : nullptr;
                           const auto across = metrics::computeGradientError(
                               ctx.read(indirect), t.irradiance, se, split.across);
                           const auto within = metrics::computeGradientError(
@@ -581,6 +579,7 @@ plugin::FamilyInfo describeVoxelGiFamily()
                                    "G-buffer, light and pre-combined buffers; the tree's: its "
                                    "probes) against its resolution, every scene."}}};
     info.runtime = std::make_shared<VoxelGiFamily>();
+    info.stressCases = voxelgi::makeVoxelGiStressCases;
     return info;
 }
 

@@ -1,0 +1,291 @@
+// The voxel_gi family's stress cases (plugin/stress.h): small hostile scenes (empty, a single
+// voxel's worth of geometry, a fully solid region, a room 1e5 from the origin, geometry on voxel
+// boundaries, a light inside a wall, random boxes from the seed), each seen through a 16 x 12
+// Embree G-buffer, and three closed forms: a closed dark room (exactly 0), a white furnace (pi
+// (a + a^2) for two bounces) and the same bits for 1 and 2 threads. Every output must be finite,
+// non-negative, and exactly 0 where a pixel has no surface.
+
+#include "families/voxel_gi/stress_cases.h"
+
+#include "families/voxel_gi/voxel_gi.h"
+#include "families/voxel_gi/voxel_gi_test_scenes.h"
+#include "reference/reference.h"
+
+#include <glm/gtc/constants.hpp>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+
+namespace rtlab::voxelgi {
+namespace {
+
+using namespace rtlab::voxelgi::testing;
+using plugin::StressCase;
+using plugin::StressOutcome;
+using plugin::StressSettings;
+using plugin::TechniqueEntry;
+
+scene::Camera lookAt(glm::vec3 position, glm::vec3 target)
+{
+    scene::Camera c;
+    c.position = position;
+    c.target = target;
+    c.verticalFovDegrees = 70.0f;
+    c.nearPlane = 1e-3f;
+    c.farPlane = 1e3f;
+    return c;
+}
+
+//! A 16 x 12 G-buffer seen from `camera` (Embree primary rays); all sky when the scene is empty.
+scene::GBuffer makeGBuffer(const scene::RenderScene& s, const scene::Camera& camera)
+{
+    if (!s.indices.empty())
+        return reference::castGBuffer(s, camera, 16, 12);
+    scene::GBuffer g;
+    g.width = 16;
+    g.height = 12;
+    g.camera = camera;
+    g.depth = Image<float>(16, 12, INFINITY);
+    g.position = Image<glm::vec3>(16, 12, glm::vec3(0.0f));
+    g.normal = Image<glm::vec3>(16, 12, glm::vec3(0.0f));
+    g.albedo = Image<glm::vec3>(16, 12, glm::vec3(0.0f));
+    g.emission = Image<glm::vec3>(16, 12, glm::vec3(0.0f));
+    g.materialId = Image<std::uint32_t>(16, 12, scene::kNoMaterial);
+    return g;
+}
+
+//! A fresh instance at its defaults: voxelize, inject, gather.
+Image<glm::vec3> runTechnique(const TechniqueEntry& entry, const scene::RenderScene& s, const scene::GBuffer& g)
+{
+    auto t = entry.create(config::ParamSet::defaultsOf(entry.schema));
+    auto* gi = dynamic_cast<plugin::VoxelGiTechnique*>(t.get());
+    if (gi == nullptr)
+        throw Error(entry.info.name + " is not a voxel_gi technique");
+    plugin::VoxelGiFrame frame;
+    frame.geometry = &s;
+    frame.geometryKey = s.computeContentHash();
+    frame.cameraPosition = glm::dvec3(g.camera.position);
+    gi->voxelize(frame);
+    gi->injectLight(frame);
+    plugin::VoxelGiInput input;
+    input.gbuffer = &g;
+    input.scene = &s;
+    input.cameraPosition = frame.cameraPosition;
+    Image<glm::vec3> e;
+    gi->gather(input, e);
+    return e;
+}
+
+//! Finite, non-negative, zero off the surface, of the G-buffer's size.
+void checkIrradiance(const Image<glm::vec3>& e, const scene::GBuffer& g, StressOutcome& o)
+{
+    if (e.width != g.width || e.height != g.height) {
+        o.fail("irradiance is " + std::to_string(e.width) + "x" + std::to_string(e.height) +
+               ", not the G-buffer's size");
+        return;
+    }
+    std::size_t bad = 0, range = 0;
+    for (int y = 0; y < g.height; ++y)
+        for (int x = 0; x < g.width; ++x) {
+            const glm::vec3 v = e.at(x, y);
+            if (!(std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z))) {
+                ++bad;
+                continue;
+            }
+            const bool nonNegative = v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f;
+            const bool zeroOffSurface = g.hasSurface(x, y) || v == glm::vec3(0.0f);
+            range += nonNegative && zeroOffSurface ? 0 : 1;
+        }
+    o.countValues(3 * e.pixels.size(), bad, range, "irradiance (negative or off the surface counts as out of range)");
+}
+
+StressCase makeSceneCase(std::string name, std::string group, std::string description,
+                         std::function<scene::RenderScene()> make, scene::Camera camera)
+{
+    return {std::move(name), std::move(group), std::move(description) + "; finite, >= 0, 0 off the surface",
+            [make, camera](const TechniqueEntry& e, const StressSettings&) {
+                const scene::RenderScene s = make();
+                const scene::GBuffer g = makeGBuffer(s, camera);
+                StressOutcome o;
+                checkIrradiance(runTechnique(e, s, g), g, o);
+                return o;
+            }};
+}
+
+scene::RenderScene makeLightInsideAWall()
+{
+    scene::RenderScene s;
+    addRoom(s, glm::vec3(-1.0f), glm::vec3(1.0f), 0.4f, addMaterial(s, glm::vec3(0.7f)));
+    s.pointLights.push_back({glm::vec3(1.2f, 0.0f, 0.0f), glm::vec3(5.0f)});
+    s.pointLights.push_back({glm::vec3(0.0f, 0.5f, 0.0f), glm::vec3(1.0f)});
+    return s;
+}
+
+} // namespace
+
+std::vector<plugin::StressCase> makeVoxelGiStressCases()
+{
+    std::vector<StressCase> cases;
+    cases.push_back(makeSceneCase("empty", "degenerate", "no geometry at all", [] { return scene::RenderScene{}; },
+                                  lookAt({0, 1, 3}, {0, 0, 0})));
+    cases.push_back(makeSceneCase(
+        "single_voxel", "degenerate", "a 1 cm box under a point light",
+        [] {
+            scene::RenderScene s;
+            addBox(s, glm::vec3(-0.005f), glm::vec3(0.005f), addMaterial(s, glm::vec3(0.8f)));
+            s.pointLights.push_back({glm::vec3(0.1f, 0.2f, 0.1f), glm::vec3(1.0f)});
+            return s;
+        },
+        lookAt({0.0f, 0.02f, 0.03f}, {0, 0, 0})));
+    cases.push_back(makeSceneCase(
+        "solid_region", "degenerate", "a 100 x 10 x 100 m solid slab under a constant sky",
+        [] {
+            scene::RenderScene s;
+            addBox(s, glm::vec3(-50, -10, -50), glm::vec3(50, 0, 50), addMaterial(s, glm::vec3(0.5f)));
+            addBox(s, glm::vec3(-0.5f, 0.0f, -0.5f), glm::vec3(0.5f, 1.0f, 0.5f), addMaterial(s, glm::vec3(0.9f, 0.2f, 0.2f)));
+            s.sky.kind = scene::Sky::Kind::Constant;
+            s.sky.constant = glm::vec3(1.0f);
+            return s;
+        },
+        lookAt({2, 1.5, 2}, {0, 0.3f, 0})));
+    cases.push_back(makeSceneCase(
+        "far_from_origin", "scale", "a lit room 1e5 from the origin",
+        [] {
+            scene::RenderScene s;
+            const glm::vec3 o(1e5f, 0.0f, -1e5f);
+            addRoom(s, o - 1.0f, o + 1.0f, 0.2f, addMaterial(s, glm::vec3(0.6f)));
+            s.pointLights.push_back({o + glm::vec3(0.3f, 0.5f, 0.0f), glm::vec3(2.0f)});
+            return s;
+        },
+        lookAt({1e5f, 0.2f, -1e5f + 0.8f}, {1e5f, -0.5f, -1e5f})));
+    cases.push_back(makeSceneCase(
+        "on_voxel_boundaries", "degenerate", "walls and a box exactly on voxel boundaries",
+        [] {
+            scene::RenderScene s;
+            const auto m = addMaterial(s, glm::vec3(0.7f));
+            addRoom(s, glm::vec3(-2.0f), glm::vec3(2.0f), 1.0f, m);
+            addBox(s, glm::vec3(-1.0f, -2.0f, -1.0f), glm::vec3(0.0f, 0.0f, 0.0f), m);
+            s.pointLights.push_back({glm::vec3(1.0f, 1.0f, 1.0f), glm::vec3(4.0f)});
+            return s;
+        },
+        lookAt({1.0f, 1.0f, 1.5f}, {-0.5f, -1.0f, -0.5f})));
+    cases.push_back(makeSceneCase("light_inside_a_wall", "degenerate", "a point light inside a wall of a lit room",
+                                  makeLightInsideAWall, lookAt({-0.5f, 0.3f, 0.6f}, {0.5f, -0.5f, -0.5f})));
+
+    cases.push_back({"closed_dark_room", "closed_form", "a closed room without light: exactly 0 everywhere",
+                     [](const TechniqueEntry& e, const StressSettings&) {
+                         scene::RenderScene s;
+                         addRoom(s, glm::vec3(-1.0f), glm::vec3(1.0f), 0.3f, addMaterial(s, glm::vec3(0.9f)));
+                         const scene::GBuffer g = makeGBuffer(s, lookAt({0.0f, 0.2f, 0.5f}, {0.0f, -1.0f, -0.5f}));
+                         const Image<glm::vec3> irradiance = runTechnique(e, s, g);
+                         StressOutcome o;
+                         checkIrradiance(irradiance, g, o);
+                         double worst = 0.0;
+                         for (const auto& v : irradiance.pixels)
+                             worst = std::max(worst, double(std::max(v.x, std::max(v.y, v.z))));
+                         o.compare(worst, 0.0, "largest irradiance in the dark room");
+                         return o;
+                     }});
+
+    cases.push_back(
+        {"white_furnace", "closed_form",
+         "a closed room of emission 1 and albedo 0.5: mean irradiance pi (a + a^2) within 3.5 % (surfaces-only "
+         "structures: -20 % to +3.5 %)",
+         [](const TechniqueEntry& e, const StressSettings&) {
+             // The light reflected k times arrives with irradiance pi a^k, so 2 bounces give
+             // pi (a + a^2) at every point. 3.5 %: a cone tracer loses up to 1 % of the light at
+             // each of its three gathers (cascades stop at 99 % opacity) and 0.5 % goes to float
+             // accumulation; path_traced at 4 paths per pixel over the ~190 surface pixels and
+             // adaptive_voxel_tree's probes (32 paths per axis, averaged by the interpolation)
+             // have standard errors of the mean well below that (measured: cascades -0.7 %,
+             // path_traced -0.02 %, adaptive_voxel_tree +0.2 %). A structure that declares
+             // surfacesOnly (svo, adaptive_voxel_tree_cones) keeps the walls' surfaces and a few
+             // layers inside them, not their solid interior: its cones, once coarser than those
+             // layers, see through the walls and out of the scene, so it must lose light, never
+             // gain it, and lose less than a fifth (measured at the defaults: svo -13.2 %,
+             // adaptive_voxel_tree_cones -14.4 %).
+             scene::RenderScene s;
+             addRoom(s, glm::vec3(-0.5f), glm::vec3(0.5f), 0.5f, addMaterial(s, glm::vec3(0.5f), glm::vec3(1.0f)));
+             const scene::GBuffer g = makeGBuffer(s, lookAt({0.0f, 0.1f, 0.3f}, {0.0f, -0.5f, -0.3f}));
+             const Image<glm::vec3> irradiance = runTechnique(e, s, g);
+             StressOutcome o;
+             checkIrradiance(irradiance, g, o);
+             double sum = 0.0;
+             int n = 0;
+             for (int y = 0; y < g.height; ++y)
+                 for (int x = 0; x < g.width; ++x)
+                     if (g.hasSurface(x, y)) {
+                         sum += irradiance.at(x, y).x;
+                         ++n;
+                     }
+             o.check(n > 0, "the camera sees no surface");
+             const double expected = glm::pi<double>() * 0.75;
+             const double relative = n > 0 ? sum / n / expected - 1.0 : NAN;
+             const auto technique = e.create(config::ParamSet::defaultsOf(e.schema));
+             const auto& gi = dynamic_cast<const plugin::VoxelGiTechnique&>(*technique);
+             if (gi.definition().surfacesOnly) {
+                 // Losing up to a fifth is allowed, gaining no more than the 3.5 % of the others.
+                 o.compare(std::abs(relative), relative < 0.0 ? 0.2 : 0.035,
+                           "|mean irradiance / pi (a + a^2) - 1| (surfaces only: -20 % .. +3.5 %)");
+             } else {
+                 o.compare(std::abs(relative), 0.035, "|mean irradiance / pi (a + a^2) - 1|");
+             }
+             return o;
+         }});
+
+    cases.push_back({"deterministic_threads", "closed_form",
+                     "the light-inside-a-wall room with 1 and with 2 threads: the same bits",
+                     [](const TechniqueEntry& e, const StressSettings&) {
+                         const scene::RenderScene s = makeLightInsideAWall();
+                         const scene::GBuffer g = makeGBuffer(s, lookAt({-0.5f, 0.3f, 0.6f}, {0.5f, -0.5f, -0.5f}));
+                         Image<glm::vec3> one, two;
+                         {
+                             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+                             one = runTechnique(e, s, g);
+                         }
+                         {
+                             tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+                             two = runTechnique(e, s, g);
+                         }
+                         StressOutcome o;
+                         checkIrradiance(one, g, o);
+                         std::size_t differ = 0;
+                         for (std::size_t i = 0; i < one.pixels.size() && i < two.pixels.size(); ++i)
+                             differ += one.pixels[i] == two.pixels[i] ? 0 : 1;
+                         o.check(one.pixels.size() == two.pixels.size() && differ == 0,
+                                 std::to_string(differ) + " pixel(s) differ between 1 and 2 threads");
+                         return o;
+                     }});
+
+    for (int index = 0; index < 2; ++index)
+        cases.push_back({"random_boxes_" + std::to_string(index), "random",
+                         "1-8 random boxes (0.01-3 m) and 0-2 point lights under the sky from the seed; finite, "
+                         ">= 0, 0 off the surface",
+                         [index](const TechniqueEntry& e, const StressSettings& st) {
+                             std::mt19937_64 rng(st.seed * 1000003u + 31u * std::uint64_t(index + 1));
+                             std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+                             scene::RenderScene s;
+                             const auto m = addMaterial(s, glm::vec3(unit(rng), unit(rng), unit(rng)));
+                             addBox(s, glm::vec3(-4.0f, -1.0f, -4.0f), glm::vec3(4.0f, 0.0f, 4.0f), m);
+                             const int boxes = 1 + int(unit(rng) * 8.0f);
+                             for (int i = 0; i < boxes; ++i) {
+                                 const glm::vec3 c(4.0f * unit(rng) - 2.0f, 2.0f * unit(rng), 4.0f * unit(rng) - 2.0f);
+                                 const glm::vec3 half = 0.5f * glm::vec3(std::exp(std::log(0.01f) + unit(rng) * std::log(300.0f)));
+                                 addBox(s, c - half, c + half, m);
+                             }
+                             const int lights = int(unit(rng) * 3.0f);
+                             for (int i = 0; i < lights; ++i)
+                                 s.pointLights.push_back({glm::vec3(4.0f * unit(rng) - 2.0f, 3.0f * unit(rng), 4.0f * unit(rng) - 2.0f),
+                                                          glm::vec3(5.0f * unit(rng))});
+                             const scene::GBuffer g = makeGBuffer(s, lookAt({3.0f, 2.5f, 3.0f}, {0.0f, 0.0f, 0.0f}));
+                             StressOutcome o;
+                             checkIrradiance(runTechnique(e, s, g), g, o);
+                             return o;
+                         }});
+    return cases;
+}
+
+} // namespace rtlab::voxelgi
