@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs missing Debian packages, configures (CMake + Ninja + ccache) and builds rtlab in build/.
+# Installs missing Debian packages, configures (CMake + Ninja + ccache) and builds rtlab in build/
+# (or $RTLAB_BUILD_DIR).
 # Idempotent: a second run installs nothing and rebuilds only what changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -29,7 +30,11 @@ export CCACHE_DIR=${CCACHE_DIR:-$PWD/.cache/ccache}
 # Paths under the checkout are hashed relative to it, so copies of the tree (the scaffold test)
 # share the cache.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
-if [ ! -f build/build.ninja ]; then
-    cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+# RTLAB_BUILD_DIR and RTLAB_CMAKE_ARGS choose another build (./rtlab.sh sanitize: build-sanitize/
+# with -DRTLAB_SANITIZE=ON).
+build_dir=${RTLAB_BUILD_DIR:-build}
+if [ ! -f "$build_dir/build.ninja" ]; then
+    # shellcheck disable=SC2086
+    cmake -S . -B "$build_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release ${RTLAB_CMAKE_ARGS:-}
 fi
-cmake --build build
+cmake --build "$build_dir"

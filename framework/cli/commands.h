@@ -26,7 +26,19 @@ struct RunOptions {
     bool dryRun = false;
     std::string shard;  //!< "i/N" or empty
     bool report = true; //!< write plots and report.html after the runs
+    // --slurm: submit the sweep as an sbatch array of `arraySize` shards instead of running it
+    bool slurm = false;
+    int arraySize = 4;
+    std::string partition;
+    std::string timeLimit;
+    std::vector<int> tasks; //!< resubmit only these array tasks (1-based)
 };
+
+//! Submits a sweep as a Slurm array (experiment/slurm.h); prints the job id.
+int submitSlurmCommand(const RunOptions& options);
+
+//! Per-shard progress of a results folder from its shards' results tables.
+int statusCommand(const std::string& resultsDirectory);
 
 //! Writes the plots and report.html of a results folder.
 int reportCommand(const std::string& resultsDirectory);

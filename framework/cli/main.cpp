@@ -30,6 +30,21 @@ int main(int argc, char** argv)
                        "default output results/<name>/shard-i-of-N");
 
     runCmd->add_flag("!--no-report", run.report, "Do not write plots and report.html after the runs");
+    runCmd->add_flag("--slurm", run.slurm,
+                     "Submit the sweep to Slurm as an sbatch array (one shard per task) instead of running it");
+    runCmd->add_option("--array-size", run.arraySize, "--slurm: array tasks = shards")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100000));
+    runCmd->add_option("--partition", run.partition, "--slurm: the partition (default: the cluster's)");
+    runCmd->add_option("--time", run.timeLimit, "--slurm: time limit per task, e.g. 2:00:00");
+    runCmd->add_option("--tasks", run.tasks, "--slurm: submit only these array tasks again, e.g. 2,3")
+        ->delimiter(',');
+
+    std::string statusDirectory;
+    auto* statusCmd = app.add_subcommand("status", "Progress of each shard of a (Slurm) sweep from its results");
+    statusCmd->add_option("results", statusDirectory, "The sweep's results folder (holding shard-i-of-N)")
+        ->required()
+        ->check(CLI::ExistingDirectory);
 
     std::string reportDirectory;
     auto* reportCmd = app.add_subcommand("report", "Write the plots and report.html of a results folder");
@@ -155,7 +170,9 @@ int main(int argc, char** argv)
         return stressCommand(stress);
     }
     if (*runCmd)
-        return runExperimentCommand(run);
+        return run.slurm ? submitSlurmCommand(run) : runExperimentCommand(run);
+    if (*statusCmd)
+        return statusCommand(statusDirectory);
     if (*newCmd)
         return newTechnique(scaffold);
     if (*newFamilyCmd)

@@ -24,7 +24,7 @@ export CCACHE_BASEDIR="$work/tree"
 if [ -d "$src/.cache/ccache" ]; then
     export CCACHE_DIR="$src/.cache/ccache"
 fi
-cmake -S "$work/tree" -B "$work/tree/build" -G Ninja -DCMAKE_BUILD_TYPE=Release >"$work/configure.log"
+cmake -S "$work/tree" -B "$work/tree/build" -G Ninja -DCMAKE_BUILD_TYPE=Release "-DRTLAB_SANITIZE=${4:-OFF}" >"$work/configure.log"
 cmake --build "$work/tree/build" --target rtlab occlusion_flow_check_ao_test >"$work/build.log" 2>&1 \
     || { tail -n 40 "$work/build.log"; exit 1; }
 
