@@ -1,6 +1,7 @@
 #include "experiment/image_files.h"
 
 #include "core/error.h"
+#include "core/image_file_size.h"
 
 #include <OpenImageIO/imageio.h>
 
@@ -57,10 +58,12 @@ void writePng(const Image<glm::vec3>& display, const std::string& path)
 
 Image<glm::vec3> readExrRgb(const std::string& path)
 {
+    checkExrHeader(path); // before the decoder sees a size it would allocate for
     auto in = OIIO::ImageInput::open(path);
     if (!in)
         throw Error(path + ": cannot open: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
+    checkImageFileSize(path, spec.width, spec.height, spec.nchannels);
     if (spec.nchannels < 3)
         throw Error(path + ": expected 3 channels, found " + std::to_string(spec.nchannels));
     Image<glm::vec3> image(spec.width, spec.height);
@@ -71,10 +74,12 @@ Image<glm::vec3> readExrRgb(const std::string& path)
 
 Image<float> readExrScalar(const std::string& path)
 {
+    checkExrHeader(path); // before the decoder sees a size it would allocate for
     auto in = OIIO::ImageInput::open(path);
     if (!in)
         throw Error(path + ": cannot open: " + OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
+    checkImageFileSize(path, spec.width, spec.height, spec.nchannels);
     Image<float> image(spec.width, spec.height);
     if (!in->read_image(0, 0, 0, 1, OIIO::TypeDesc::FLOAT, image.pixels.data()))
         throw Error(path + ": cannot read: " + in->geterror());

@@ -7,6 +7,7 @@
 #include <vtkBrush.h>
 #include <vtkChartLegend.h>
 #include <vtkChartXY.h>
+#include <vtkContext2D.h>
 #include <vtkContextActor.h>
 #include <vtkContextScene.h>
 #include <vtkDoubleArray.h>
@@ -255,6 +256,23 @@ void setLineColor(vtkPlot* plot, Color color)
 {
     plot->GetPen()->SetColor(color.r, color.g, color.b, 255);
     plot->GetBrush()->SetColor(color.r, color.g, color.b, 0);
+}
+
+void drawPixelTexts(vtkContext2D* painter, const std::vector<PixelText>& texts, int height)
+{
+    for (const PixelText& t : texts) {
+        vtkTextProperty* prop = painter->GetTextProp();
+        prop->SetFontFamilyToArial();
+        prop->SetFontSize(int(std::lround(t.size)));
+        prop->SetBold(t.bold);
+        prop->SetItalic(false);
+        prop->SetShadow(false);
+        prop->SetColor(0.1, 0.1, 0.1);
+        prop->SetJustification(t.justification);
+        prop->SetVerticalJustificationToCentered();
+        prop->SetOrientation(t.orientation);
+        painter->DrawString(t.x, float(height) - t.y, t.text.c_str()); // within a pixel
+    }
 }
 
 } // namespace rtlab::plot::detail

@@ -10,6 +10,7 @@
 #include <vector>
 
 class vtkChartXY;
+class vtkContext2D;
 class vtkContextItem;
 class vtkPlot;
 
@@ -95,5 +96,19 @@ struct DataLabel {
 //! would overlap a marker, an earlier label or leave the plot area are left out unless `always`.
 void addChartOverlay(Figure& figure, vtkChartXY* chart, std::vector<DataMarker> markers,
                      float markerSize, std::vector<DataLabel> labels, float fontSize);
+
+//! Text anchored at a pixel of a figure (row 0 at the top), for items that lay out in pixels.
+struct PixelText {
+    float x = 0.0f;
+    float y = 0.0f;
+    std::string text;
+    float size = 12.0f; //!< font size
+    bool bold = false;
+    int justification = 0; //!< VTK_TEXT_LEFT / CENTERED / RIGHT
+    double orientation = 0.0; //!< degrees, counter-clockwise
+};
+//! Draws `texts` (dark grey Arial, vertically centred on their anchors) on a figure `height`
+//! pixels tall.
+void drawPixelTexts(vtkContext2D* painter, const std::vector<PixelText>& texts, int height);
 
 } // namespace rtlab::plot::detail

@@ -36,14 +36,7 @@ public:
         int x, y, w, h; //!< PNG pixels, row 0 at the top
         HeatColor color;
     };
-    struct Text {
-        float x, y; //!< anchor, PNG pixels
-        std::string text;
-        float size;
-        bool bold;
-        int justification;
-        double orientation;
-    };
+    using Text = detail::PixelText;
     int mHeight = 0;
     std::vector<Rect> mRects;
     std::vector<Text> mTexts;
@@ -56,19 +49,7 @@ public:
             painter->GetBrush()->SetColor(r.color.r, r.color.g, r.color.b, 255);
             painter->DrawRect(float(r.x), float(mHeight - r.y - r.h), float(r.w), float(r.h));
         }
-        for (const Text& t : mTexts) {
-            vtkTextProperty* prop = painter->GetTextProp();
-            prop->SetFontFamilyToArial();
-            prop->SetFontSize(int(std::lround(t.size)));
-            prop->SetBold(t.bold);
-            prop->SetItalic(false);
-            prop->SetShadow(false);
-            prop->SetColor(0.1, 0.1, 0.1);
-            prop->SetJustification(t.justification);
-            prop->SetVerticalJustificationToCentered();
-            prop->SetOrientation(t.orientation);
-            painter->DrawString(t.x, float(mHeight) - t.y, t.text.c_str());
-        }
+        detail::drawPixelTexts(painter, mTexts, mHeight);
         return true;
     }
 };

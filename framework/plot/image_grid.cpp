@@ -96,14 +96,7 @@ public:
         vtkSmartPointer<vtkImageData> data;
         int outline = -1; //!< crop colour index framing the picture, -1 for none
     };
-    struct Text {
-        float x, y; //!< anchor in PNG pixels (row 0 at the top)
-        std::string text;
-        float size;
-        bool bold;
-        int justification; //!< VTK_TEXT_LEFT / CENTERED / RIGHT
-        double orientation;
-    };
+    using Text = detail::PixelText;
 
     int mWidth = 0;
     int mHeight = 0;
@@ -123,19 +116,7 @@ public:
             drawFrame(painter, rect, getCropColor(colour), 2);
         if (mColorBar.width > 0)
             drawFrame(painter, mColorBar, Color{40, 40, 40}, 1);
-        for (const Text& t : mTexts) {
-            vtkTextProperty* prop = painter->GetTextProp();
-            prop->SetFontFamilyToArial();
-            prop->SetFontSize(int(std::lround(t.size)));
-            prop->SetBold(t.bold);
-            prop->SetItalic(false);
-            prop->SetShadow(false);
-            prop->SetColor(0.1, 0.1, 0.1);
-            prop->SetJustification(t.justification);
-            prop->SetVerticalJustificationToCentered();
-            prop->SetOrientation(t.orientation);
-            painter->DrawString(t.x, float(mHeight) - t.y, t.text.c_str()); // within a pixel
-        }
+        detail::drawPixelTexts(painter, mTexts, mHeight);
         return true;
     }
 

@@ -1,6 +1,7 @@
 #include "reference/exr_io.h"
 
 #include "core/error.h"
+#include "core/image_file_size.h"
 #include "core/json.h"
 
 #include <OpenImageIO/imageio.h>
@@ -192,11 +193,13 @@ struct ExrFile {
 
 ExrFile readExr(const std::string& path)
 {
+    checkExrHeader(path); // before the decoder sees a size it would allocate for
     auto in = OIIO::ImageInput::open(path);
     if (!in)
         throw Error("reference: cannot read '" + path + "': " + OIIO::geterror());
     ExrFile file;
     file.spec = in->spec();
+    checkImageFileSize(path, file.spec.width, file.spec.height, file.spec.nchannels);
     file.data.resize(std::size_t(file.spec.width) * std::size_t(file.spec.height) *
                      std::size_t(file.spec.nchannels));
     if (!in->read_image(0, 0, 0, file.spec.nchannels, OIIO::TypeDesc::FLOAT, file.data.data()))

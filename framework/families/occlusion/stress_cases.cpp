@@ -45,14 +45,8 @@ std::unique_ptr<plugin::OcclusionTechnique> createTechnique(const TechniqueEntry
 plugin::OcclusionOutput compute(plugin::OcclusionTechnique& t, const SyntheticGBuffer& g,
                                 gpu::Context* gpu)
 {
-    plugin::OcclusionInput in;
-    in.linearDepth = &g.depth;
-    in.normal = &g.normal;
-    in.projection = g.projection;
-    in.view = g.view;
-    in.gpu = gpu;
     plugin::OcclusionOutput out;
-    t.compute(in, out);
+    t.compute(makeOcclusionInput(g, gpu), out);
     return out;
 }
 

@@ -39,6 +39,17 @@ SyntheticGBuffer makeSyntheticGBuffer(int w, int h, float fovDegrees, const HitF
     return g;
 }
 
+plugin::OcclusionInput makeOcclusionInput(const SyntheticGBuffer& g, gpu::Context* gpu)
+{
+    plugin::OcclusionInput in;
+    in.linearDepth = &g.depth;
+    in.normal = &g.normal;
+    in.projection = g.projection;
+    in.view = g.view;
+    in.gpu = gpu;
+    return in;
+}
+
 std::pair<float, glm::vec3> hitPlanes(const glm::vec3& direction, const std::vector<Plane>& planes)
 {
     std::pair<float, glm::vec3> best{-1.0f, glm::vec3(0.0f)};

@@ -23,6 +23,9 @@ struct SyntheticGBuffer {
     glm::mat4 view{1.0f};
 };
 
+//! The technique input viewing `g` (valid while g lives), on `gpu` or, when null, the C++ path.
+plugin::OcclusionInput makeOcclusionInput(const SyntheticGBuffer& g, gpu::Context* gpu);
+
 //! An infinite plane through `point` with unit normal `normal`.
 struct Plane {
     glm::dvec3 point{0.0};

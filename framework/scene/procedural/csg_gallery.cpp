@@ -117,8 +117,11 @@ Scene makeCsgGallery()
             return std::abs(p.x) <= h.x + 1e-12 && std::abs(p.y) <= h.y + 1e-12 && std::abs(p.z) <= h.z + 1e-12;
         };
         std::vector<Segment> features;
-        for (const auto& [a, b] : makeBoxEdges(h, kNoRotation))
+        for (const auto& edge : makeBoxEdges(h, kNoRotation)) {
+            // Not a structured binding: lambdas may not capture those before clang 16.
+            const glm::dvec3 a = edge.first, b = edge.second;
             appendPolyline(features, [&](double u) { return a + u * (b - a); }, 1, outsideSphere);
+        }
         for (int axis = 0; axis < 3; ++axis) {
             const int u = (axis + 1) % 3, v = (axis + 2) % 3;
             const double rho = std::sqrt(r * r - (h[axis] - sc[axis]) * (h[axis] - sc[axis]));
