@@ -122,6 +122,7 @@ ResultRow makeStressRow(const StressRecord& r)
         .set("tolerance", r.outcome.tolerance)
         .set("ms", r.milliseconds)
         .set("failures", join(r.outcome.failures, "; "))
+        .set("note", r.outcome.note)
         .set("description", r.description);
     return row;
 }

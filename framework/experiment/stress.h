@@ -58,7 +58,7 @@ std::vector<StressRecord> runStress(const StressPlan& plan, const StressOptions&
                                     const std::function<void(const StressRecord&)>& onRecord = {});
 
 //! One tidy row: family, technique, case, group, passed, values, non_finite, out_of_range,
-//! deviation, tolerance, ms, failures (joined with "; "), description.
+//! deviation, tolerance, ms, failures (joined with "; "), note, description.
 ResultRow makeStressRow(const StressRecord& record);
 
 } // namespace rtlab::experiment

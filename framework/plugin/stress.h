@@ -6,11 +6,14 @@
 // the family suites (tests/families/*_suite_test.cpp) assert that every case passes, so a new
 // technique is stressed by registering and a stub technique fails (tests/families/stress_test.cpp).
 
+#include "core/error.h"
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -42,6 +45,9 @@ struct StressOutcome {
     double deviation = std::numeric_limits<double>::quiet_NaN();
     double tolerance = std::numeric_limits<double>::quiet_NaN();
     std::vector<std::string> failures; //!< one line per failed check; empty: the case passed
+    //! What a passing case wants said: e.g. that the technique refused the input with a clear
+    //! error, which cases of invalid input accept in place of an output.
+    std::string note;
 
     bool passed() const { return failures.empty(); }
 
@@ -79,6 +85,21 @@ struct StressOutcome {
     }
     void fail(const std::string& what) { failures.push_back(what); }
 };
+
+//! For cases of invalid input (NaN samples, NaN depths, NaN vertices), where refusing the input
+//! with a clear error is as good as a valid output: runs `f` and records a refusal by
+//! rtlab::Error or std::invalid_argument (what the family interfaces throw for bad arguments) in
+//! the outcome's note. Other exceptions propagate: a technique that fails in another way fails.
+template <class F> void runOrRefuse(StressOutcome& outcome, F&& f)
+{
+    try {
+        f();
+    } catch (const Error& e) {
+        outcome.note = std::string("refused: ") + e.what();
+    } catch (const std::invalid_argument& e) {
+        outcome.note = std::string("refused: ") + e.what();
+    }
+}
 
 //! One hostile input of a family, applied to any technique of it.
 struct StressCase {

@@ -8,8 +8,11 @@
 
 #include <glm/vec3.hpp>
 
+#include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <functional>
+#include <string>
 #include <vector>
 
 namespace rtlab::plugin {
@@ -35,6 +38,21 @@ struct IsosurfaceInput {
     //! empty. Dual contouring's elastic relaxation uses it to find material boundaries.
     std::vector<std::uint32_t> const* materials = nullptr;
 };
+
+//! Throws std::invalid_argument naming `technique`, the value and its sample index (x, y, z) at
+//! the first NaN or infinite sample of `field`: for techniques whose library needs finite samples
+//! (marching_cubes and dual_contouring read +-inf as signs and refuse NaN themselves).
+inline void requireFiniteSamples(const SampledField& field, const std::string& technique)
+{
+    for (std::size_t i = 0; i < field.values.size(); ++i)
+        if (!std::isfinite(field.values[i])) {
+            const std::size_t nx = std::size_t(field.samples.x > 0 ? field.samples.x : 1);
+            const std::size_t ny = std::size_t(field.samples.y > 0 ? field.samples.y : 1);
+            throw std::invalid_argument(technique + ": sample (" + std::to_string(i % nx) + ", " +
+                                        std::to_string(i / nx % ny) + ", " + std::to_string(i / (nx * ny)) +
+                                        ") is " + std::to_string(field.values[i]) + "; the field must be finite");
+        }
+}
 
 class IsosurfaceTechnique : public Technique {
 public:

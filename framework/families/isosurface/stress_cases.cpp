@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <random>
 #include <string>
@@ -355,6 +356,26 @@ std::vector<plugin::StressCase> makeIsosurfaceStressCases()
                              [](int x, int y, int z) { return (x % 2 == 1 && y % 2 == 1 && z % 2 == 1) ? -0.5 : 0.5; });
     }));
 
+    cases.push_back(
+        {"non_finite_samples", "degenerate",
+         "a sphere on 24^3 with NaN (every 13th sample), +inf (every 17th) and -inf (every 19th) samples: a "
+         "valid mesh, or a clear error (rtlab::Error, std::invalid_argument)",
+         [](const TechniqueEntry& e, const StressSettings&) {
+             Input in = sample(24, glm::dvec3(-1.0), 2.0 / 23.0,
+                               [](const glm::dvec3& p) { return computeSphereSdf(p, glm::dvec3(0.0), 0.6); });
+             in.sdf = {}; // the samples no longer are the SDF's
+             for (std::size_t i = 0; i < in.field.values.size(); ++i) {
+                 if (i % 13 == 0)
+                     in.field.values[i] = std::numeric_limits<float>::quiet_NaN();
+                 else if (i % 17 == 0)
+                     in.field.values[i] = std::numeric_limits<float>::infinity();
+                 else if (i % 19 == 0)
+                     in.field.values[i] = -std::numeric_limits<float>::infinity();
+             }
+             StressOutcome o;
+             plugin::runOrRefuse(o, [&] { checkMesh(extract(e, in), in.field, o); });
+             return o;
+         }});
     cases.push_back(makeCase(
         "all_positive", "degenerate", "a field positive everywhere: an empty mesh",
         [] { return sampleIndices(glm::ivec3(7, 6, 5), 0.5, [](int x, int y, int z) { return 0.25 + 0.1 * (x + y + z); }); },

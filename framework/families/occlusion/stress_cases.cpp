@@ -7,6 +7,8 @@
 
 #include "families/occlusion/stress_cases.h"
 
+#include "core/error.h"
+
 #include "families/occlusion/occlusion.h"
 #include "families/occlusion/synthetic_gbuffer.h"
 
@@ -14,6 +16,7 @@
 #include <glm/gtc/constants.hpp>
 
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <random>
@@ -108,19 +111,28 @@ void checkOutput(const plugin::OcclusionOutput& out, const SyntheticGBuffer& g, 
     o.countValues(count, bad, range, what);
 }
 
-//! A case that checks the range of every output at radii 0, 0.5 and 1e6 on every device.
+//! A case that checks the range of every output at radii 0, 0.5 and 1e6 on every device. With
+//! `invalidInput`, refusing the input with rtlab::Error (a clear error) also passes.
 StressCase makeRangeCase(std::string name, std::string group, std::string description,
-                         std::function<SyntheticGBuffer()> make)
+                         std::function<SyntheticGBuffer()> make, bool invalidInput = false)
 {
-    return {std::move(name), std::move(group), std::move(description) + "; every output in range at radius 0, 0.5, 1e6",
-            [make](const TechniqueEntry& e, const StressSettings& s) {
+    return {std::move(name), std::move(group),
+            std::move(description) + "; every output in range at radius 0, 0.5, 1e6" +
+                (invalidInput ? " (or a clear error: rtlab::Error, std::invalid_argument)" : ""),
+            [make, invalidInput](const TechniqueEntry& e, const StressSettings& s) {
                 StressOutcome o;
                 const SyntheticGBuffer g = make();
                 for (double radius : {0.0, 0.5, 1e6})
                     for (const auto& [gpu, device] : getDevices(s)) {
                         auto t = createTechnique(e, radius);
-                        checkOutput(compute(*t, g, gpu), g,
-                                    std::string(device) + " radius " + std::to_string(radius), o);
+                        const auto run = [&] {
+                            checkOutput(compute(*t, g, gpu), g,
+                                        std::string(device) + " radius " + std::to_string(radius), o);
+                        };
+                        if (invalidInput)
+                            plugin::runOrRefuse(o, run);
+                        else
+                            run();
                     }
                 return o;
             }};
@@ -222,6 +234,23 @@ std::vector<plugin::StressCase> makeOcclusionStressCases()
             g.normal.pixels[i] = glm::vec3(0.0f);
         return g;
     }));
+    cases.push_back(makeRangeCase(
+        "non_finite_inputs", "degenerate",
+        "the crease with NaN depths (every 5th pixel), -inf depths (every 11th) and NaN normals (every 7th)",
+        [] {
+            SyntheticGBuffer g = makeFloorAndWallGBuffer(32, 24);
+            const float nan = std::numeric_limits<float>::quiet_NaN();
+            for (std::size_t i = 0; i < g.depth.pixels.size(); ++i) {
+                if (i % 5 == 0)
+                    g.depth.pixels[i] = nan;
+                else if (i % 11 == 1)
+                    g.depth.pixels[i] = -std::numeric_limits<float>::infinity();
+                if (i % 7 == 3)
+                    g.normal.pixels[i] = glm::vec3(nan);
+            }
+            return g;
+        },
+        true));
     cases.push_back(makeRangeCase("all_sky", "degenerate", "no surface at all", [] {
         return makeSyntheticGBuffer(16, 12, 60.0f,
                                     [](const glm::vec3&) { return std::pair{-1.0f, glm::vec3(0)}; });

@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -175,6 +176,32 @@ std::vector<plugin::StressCase> makeVoxelGiStressCases()
     cases.push_back(makeSceneCase("light_inside_a_wall", "degenerate", "a point light inside a wall of a lit room",
                                   makeLightInsideAWall, lookAt({-0.5f, 0.3f, 0.6f}, {0.5f, -0.5f, -0.5f})));
 
+    cases.push_back({"non_finite_vertices", "degenerate",
+                     "a lit room plus triangles with NaN and infinite vertices: finite, >= 0, 0 off the surface, or "
+                     "a clear error (rtlab::Error, std::invalid_argument)",
+                     [](const TechniqueEntry& e, const StressSettings&) {
+                         scene::RenderScene s;
+                         const auto m = addMaterial(s, glm::vec3(0.7f));
+                         addRoom(s, glm::vec3(-1.0f), glm::vec3(1.0f), 0.2f, m);
+                         s.pointLights.push_back({glm::vec3(0.2f, 0.5f, 0.1f), glm::vec3(2.0f)});
+                         // The G-buffer is cast before the bad triangles join the scene.
+                         const scene::GBuffer g = makeGBuffer(s, lookAt({0.0f, 0.2f, 0.6f}, {0.0f, -0.6f, -0.5f}));
+                         const float nan = std::numeric_limits<float>::quiet_NaN();
+                         const float inf = std::numeric_limits<float>::infinity();
+                         for (const glm::vec3& bad : {glm::vec3(nan, 0.0f, 0.0f), glm::vec3(0.0f, inf, 0.0f)}) {
+                             const auto base = std::uint32_t(s.positions.size());
+                             for (const glm::vec3& p : {bad, glm::vec3(0.1f, -0.5f, 0.0f), glm::vec3(0.0f, -0.5f, 0.1f)}) {
+                                 s.positions.push_back(p);
+                                 s.normals.push_back(glm::vec3(0.0f, 1.0f, 0.0f));
+                             }
+                             s.indices.insert(s.indices.end(), {base, base + 1, base + 2});
+                             s.triangleMaterial.push_back(m);
+                         }
+                         s.updateBounds();
+                         StressOutcome o;
+                         plugin::runOrRefuse(o, [&] { checkIrradiance(runTechnique(e, s, g), g, o); });
+                         return o;
+                     }});
     cases.push_back({"closed_dark_room", "closed_form", "a closed room without light: exactly 0 everywhere",
                      [](const TechniqueEntry& e, const StressSettings&) {
                          scene::RenderScene s;

@@ -115,6 +115,8 @@ void checkInput(const plugin::IsosurfaceInput& input)
     if (std::abs(input.isoValue) >= kMaxIsoValue)
         throw std::invalid_argument("openvdb_volume_to_mesh: |iso-value| must be below 1e15 (the "
                                     "grid's background is 1e18)");
+    // volumeToMesh refuses non-finite samples with openvdb::ValueError, which is not ours.
+    plugin::requireFiniteSamples(*input.field, "openvdb_volume_to_mesh");
 }
 
 //! World positions and triangles from OpenVDB's index-space points and polygons.

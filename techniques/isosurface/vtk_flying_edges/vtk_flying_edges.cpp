@@ -173,6 +173,8 @@ void checkInput(const plugin::IsosurfaceInput& input)
         !std::isfinite(field.origin.z))
         throw std::invalid_argument(
             "vtk_flying_edges: iso-value, spacing and origin must be finite");
+    // Flying Edges turns non-finite samples into NaN vertices.
+    plugin::requireFiniteSamples(*input.field, "vtk_flying_edges");
 }
 
 } // namespace
