@@ -46,6 +46,8 @@ grep -qE "scale +float +1 +\[0, 1\]" <<<"$listing"
 
 # A study of the new family: rows with its metric, and a report.
 (cd "$work/tree" && build/rtlab run experiments/toy_family.yaml --output "$work/results")
+# The family's stress cases come with the scaffold: its example technique passes them.
+"$work/tree/build/rtlab" stress --family toy_family --cpu-only -o "$work/stress"
 test -s "$work/results/results.csv"
 head -n 1 "$work/results/results.csv" | tr ',' '\n' | grep -qx "toy_family.rmse"
 grep -q '"status":"ok"' "$work/results/results.jsonl"
