@@ -6,8 +6,9 @@
 // This walkthrough reads an occlusion study's results folder (by default the smoke study
 // `./rtlab.sh run` writes: GTAO, LSAO, bent-cone SSDO and ray-traced AO on ao_testbed) and makes,
 // for each scene:
-//   <out>/bias_<scene>.png|pdf   the absolute mean signed error against the RMSE, one colour per technique; a
-//                                run on the diagonal is all bias, one near the x axis all noise
+//   <out>/bias_<scene>.png|pdf   the absolute mean signed error against the RMSE, one colour
+//                                per technique; a run on the diagonal is all bias, one near the
+//                                x axis all noise
 // and prints, per technique, the share of its mean squared error that bias explains
 // (bias^2 / RMSE^2, averaged over its runs) as a Markdown table.
 //
