@@ -1,0 +1,32 @@
+# Runs notebook 06 on a table whose answer is known: run g (gtao) has two frames: gbuffer 2 ms GPU
+# in both, gtao 4 and 6 ms GPU, compose 1 ms CPU only in the first (culled in the second): means
+# 2, 5 and 0.5 ms, frame time (7 + 8) / 2 = 7.5, RMSE (0.1 + 0.2) / 2; run l (lsao) has one frame
+# where lsao costs 9 ms. A measurement pass (reference) is not in frame_passes and is not counted.
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+file(WRITE "${WORK}/results.jsonl"
+"{\"run_id\":\"g\",\"status\":\"ok\",\"technique\":\"gtao\",\"frame_passes\":\"gbuffer;gtao;compose\",\"gbuffer.gpu_ms\":2,\"gtao.gpu_ms\":4,\"compose.cpu_ms\":1,\"reference.cpu_ms\":500,\"frame.gpu_ms\":7,\"frame.rmse\":0.1}
+{\"run_id\":\"g\",\"status\":\"ok\",\"technique\":\"gtao\",\"frame_passes\":\"gbuffer;gtao;compose\",\"gbuffer.gpu_ms\":2,\"gtao.gpu_ms\":6,\"frame.gpu_ms\":8,\"frame.rmse\":0.2}
+{\"run_id\":\"l\",\"status\":\"ok\",\"technique\":\"lsao\",\"frame_passes\":\"gbuffer;lsao\",\"gbuffer.gpu_ms\":2,\"lsao.gpu_ms\":9,\"frame.gpu_ms\":11,\"frame.rmse\":0.3}
+{\"run_id\":\"x\",\"status\":\"failed\",\"technique\":\"lsao\"}
+")
+execute_process(COMMAND "${NOTEBOOK}" "${WORK}" "${WORK}/out" OUTPUT_VARIABLE out RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "notebook exited with ${rc}:\n${out}")
+endif()
+set(expected "| g | gtao | 2 | 7.5 | 0.15 | gtao (5 ms) |
+| l | lsao | 1 | 11 | 0.3 | lsao (9 ms) |
+")
+string(FIND "${out}" "${expected}" at)
+if(at EQUAL -1)
+    message(FATAL_ERROR "unexpected notebook output:\n${out}\nexpected to contain:\n${expected}")
+endif()
+foreach(f budget.png budget.pdf)
+    if(NOT EXISTS "${WORK}/out/${f}")
+        message(FATAL_ERROR "the notebook did not write ${f}")
+    endif()
+    file(SIZE "${WORK}/out/${f}" size)
+    if(size LESS 1000)
+        message(FATAL_ERROR "${f} is only ${size} bytes")
+    endif()
+endforeach()
