@@ -24,10 +24,7 @@ file(WRITE "${WORK}/results.jsonl"
 {\"run_id\":\"c\",\"status\":\"ok\",\"scene\":\"room\",\"technique\":\"u\",\"extract.cpu_ms\":2,\"rms_deviation\":0.1,\"image.technique\":\"${i}/c_out.exr\",\"image.reference\":\"${i}/ref.exr\",\"image.error\":\"${i}/c_err.exr\"}
 {\"run_id\":\"d\",\"status\":\"failed\",\"scene\":\"room\",\"technique\":\"t\"}
 ")
-execute_process(COMMAND "${NOTEBOOK}" "${WORK}" "${WORK}/out" OUTPUT_VARIABLE out RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "notebook exited with ${rc}:\n${out}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/notebook_check.cmake)
 set(expected "### room: 2 of 3 runs on the front
 
 | run | technique | extract.cpu_ms | rms_deviation |
@@ -35,17 +32,4 @@ set(expected "### room: 2 of 3 runs on the front
 | a | t | 1 | 0.4 |
 | c | u | 2 | 0.1 |
 ")
-string(FIND "${out}" "${expected}" at)
-if(at EQUAL -1)
-    message(FATAL_ERROR "unexpected notebook output:\n${out}\nexpected to contain:\n${expected}")
-endif()
-foreach(f pareto_room.png pareto_room.pdf strip_room.png strip_room.pdf)
-    if(NOT EXISTS "${WORK}/out/${f}")
-        message(FATAL_ERROR "the notebook did not write ${f}")
-    endif()
-    file(SIZE "${WORK}/out/${f}" size)
-    if(size LESS 1000)
-        message(FATAL_ERROR "${f} is only ${size} bytes")
-    endif()
-endforeach()
-message(STATUS "notebook 01 output as expected")
+check_notebook("${expected}" pareto_room.png pareto_room.pdf strip_room.png strip_room.pdf)

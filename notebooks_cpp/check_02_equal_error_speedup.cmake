@@ -16,21 +16,10 @@ file(WRITE "${WORK}/results.jsonl"
 {\"run_id\":\"z\",\"status\":\"ok\",\"scene\":\"town\",\"technique\":\"svo\",\"technique_ms\":1,\"indirect.rmse\":0.05}
 {\"run_id\":\"f\",\"status\":\"failed\",\"scene\":\"town\",\"technique\":\"svo\"}
 ")
-execute_process(COMMAND "${NOTEBOOK}" "${WORK}" "${WORK}/out" OUTPUT_VARIABLE out RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "notebook exited with ${rc}:\n${out}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/notebook_check.cmake)
 set(expected "| w | cascades | 0.3 | 10 | p2 (0.2) | 40 | 4 |
 | x | cascades | 0.15 | 4 | p3 (0.1) | 160 | 40 |
 | y | cascades | 0.3 | 20 | p2 (0.2) | 40 | 2 |
 | z | svo | 0.05 | 1 | none as accurate (best p3: 0.1) | > 160 | > 160 |
 ")
-string(FIND "${out}" "${expected}" at)
-if(at EQUAL -1)
-    message(FATAL_ERROR "unexpected notebook output:\n${out}\nexpected to contain:\n${expected}")
-endif()
-foreach(ext png pdf)
-    if(NOT EXISTS "${WORK}/out/speedup_town.${ext}")
-        message(FATAL_ERROR "notebook 02 did not write speedup_town.${ext}")
-    endif()
-endforeach()
+check_notebook("${expected}" speedup_town.png speedup_town.pdf)

@@ -17,25 +17,10 @@ file(WRITE "${WORK}/results.jsonl"
 {\"run_id\":\"f\",\"status\":\"failed\",\"scene\":\"ball\",\"technique\":\"b\",\"cell_size\":0.0125}
 {\"run_id\":\"ao\",\"status\":\"ok\",\"scene\":\"room\",\"technique\":\"gtao\",\"ao.rmse\":0.1}
 ")
-execute_process(COMMAND "${NOTEBOOK}" "${WORK}" "${WORK}/out" OUTPUT_VARIABLE out RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "notebook exited with ${rc}:\n${out}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/notebook_check.cmake)
 set(expected "| ball | a | 3 | 2.00 |
 | ball | a vertex_placement=midpoint | 2 | 1.00 |
 | ball | b | 3 | 1.00 |
 | ball | c | 1 | one grid: none |
 ")
-string(FIND "${out}" "${expected}" at)
-if(at EQUAL -1)
-    message(FATAL_ERROR "unexpected notebook output:\n${out}\nexpected to contain:\n${expected}")
-endif()
-foreach(f convergence_ball.png convergence_ball.pdf)
-    if(NOT EXISTS "${WORK}/out/${f}")
-        message(FATAL_ERROR "the notebook did not write ${f}")
-    endif()
-    file(SIZE "${WORK}/out/${f}" size)
-    if(size LESS 1000)
-        message(FATAL_ERROR "${f} is only ${size} bytes")
-    endif()
-endforeach()
+check_notebook("${expected}" convergence_ball.png convergence_ball.pdf)

@@ -12,27 +12,12 @@ file(WRITE "${WORK}/results.jsonl"
 {\"run_id\":\"f\",\"status\":\"failed\",\"scene\":\"room\",\"technique\":\"c\"}
 {\"run_id\":\"m\",\"status\":\"ok\",\"scene\":\"ball\",\"technique\":\"marching_cubes\",\"chamfer.mean\":0.01}
 ")
-execute_process(COMMAND "${NOTEBOOK}" "${WORK}" "${WORK}/out" OUTPUT_VARIABLE out RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "notebook exited with ${rc}:\n${out}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/notebook_check.cmake)
 set(expected "| a | 2 | +0.1000 | 0.1000 | 1.00 | biased bright (misses occlusion) |
 | b | 1 | -0.0500 | 0.2000 | 0.06 | mostly noise or local error |
 | c | 1 | -0.3000 | 0.4000 | 0.56 | biased dark (over-occludes) |
 ")
-string(FIND "${out}" "${expected}" at)
-if(at EQUAL -1)
-    message(FATAL_ERROR "unexpected notebook output:\n${out}\nexpected to contain:\n${expected}")
+check_notebook("${expected}" bias_room.png bias_room.pdf)
+if(NOTEBOOK_OUTPUT MATCHES "### ball")
+    message(FATAL_ERROR "the isosurface scene was not left out:\n${NOTEBOOK_OUTPUT}")
 endif()
-if(out MATCHES "### ball")
-    message(FATAL_ERROR "the isosurface scene was not left out:\n${out}")
-endif()
-foreach(f bias_room.png bias_room.pdf)
-    if(NOT EXISTS "${WORK}/out/${f}")
-        message(FATAL_ERROR "the notebook did not write ${f}")
-    endif()
-    file(SIZE "${WORK}/out/${f}" size)
-    if(size LESS 1000)
-        message(FATAL_ERROR "${f} is only ${size} bytes")
-    endif()
-endforeach()

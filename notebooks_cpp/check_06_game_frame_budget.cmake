@@ -10,23 +10,8 @@ file(WRITE "${WORK}/results.jsonl"
 {\"run_id\":\"l\",\"status\":\"ok\",\"technique\":\"lsao\",\"frame_passes\":\"gbuffer;lsao\",\"gbuffer.gpu_ms\":2,\"lsao.gpu_ms\":9,\"frame.gpu_ms\":11,\"frame.rmse\":0.3}
 {\"run_id\":\"x\",\"status\":\"failed\",\"technique\":\"lsao\"}
 ")
-execute_process(COMMAND "${NOTEBOOK}" "${WORK}" "${WORK}/out" OUTPUT_VARIABLE out RESULT_VARIABLE rc)
-if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "notebook exited with ${rc}:\n${out}")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/notebook_check.cmake)
 set(expected "| g | gtao | 2 | 7.5 | 0.15 | gtao (5 ms) |
 | l | lsao | 1 | 11 | 0.3 | lsao (9 ms) |
 ")
-string(FIND "${out}" "${expected}" at)
-if(at EQUAL -1)
-    message(FATAL_ERROR "unexpected notebook output:\n${out}\nexpected to contain:\n${expected}")
-endif()
-foreach(f budget.png budget.pdf)
-    if(NOT EXISTS "${WORK}/out/${f}")
-        message(FATAL_ERROR "the notebook did not write ${f}")
-    endif()
-    file(SIZE "${WORK}/out/${f}" size)
-    if(size LESS 1000)
-        message(FATAL_ERROR "${f} is only ${size} bytes")
-    endif()
-endforeach()
+check_notebook("${expected}" budget.png budget.pdf)
