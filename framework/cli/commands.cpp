@@ -146,6 +146,8 @@ int runExperimentCommand(const RunOptions& options)
         fmt::print(stderr, "{}\n", error.what());
         return kExitBadInput;
     }
+    if (options.slurm)
+        return submitSlurmCommand(options, e);
     if (options.dryRun) {
         fmt::print("{}: {} run(s){}\n", e.name, e.runs.size(),
                    e.sweepKeys.empty() ? "" : " over " + joinList(e.sweepKeys));

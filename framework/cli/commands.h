@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+namespace rtlab::experiment {
+struct Experiment;
+}
+
 namespace rtlab::cli {
 
 constexpr int kExitOk = 0;
@@ -34,8 +38,9 @@ struct RunOptions {
     std::vector<int> tasks; //!< resubmit only these array tasks (1-based)
 };
 
-//! Submits a sweep as a Slurm array (experiment/slurm.h); prints the job id.
-int submitSlurmCommand(const RunOptions& options);
+//! Submits the loaded (validated) sweep `e` as a Slurm array (experiment/slurm.h); prints the job
+//! id. runExperimentCommand calls it for --slurm.
+int submitSlurmCommand(const RunOptions& options, const experiment::Experiment& e);
 
 //! Per-shard progress of a results folder from its shards' results tables.
 int statusCommand(const std::string& resultsDirectory);

@@ -170,7 +170,7 @@ int main(int argc, char** argv)
         return stressCommand(stress);
     }
     if (*runCmd)
-        return run.slurm ? submitSlurmCommand(run) : runExperimentCommand(run);
+        return runExperimentCommand(run);
     if (*statusCmd)
         return statusCommand(statusDirectory);
     if (*newCmd)

@@ -5,7 +5,6 @@
 #include "core/error.h"
 #include "experiment/experiment.h"
 #include "experiment/slurm.h"
-#include "plugin/technique.h"
 
 #include <fmt/core.h>
 
@@ -37,17 +36,8 @@ std::pair<int, std::string> runShell(const std::string& command)
 
 } // namespace
 
-int submitSlurmCommand(const RunOptions& options)
+int submitSlurmCommand(const RunOptions& options, const experiment::Experiment& e)
 {
-    const auto& registry = plugin::builtinRegistry();
-    experiment::Experiment e;
-    try {
-        // The sweep is validated here, before anything is queued.
-        e = experiment::loadExperiment(options.experimentPath, registry);
-    } catch (const InputError& error) {
-        fmt::print(stderr, "{}\n", error.what());
-        return kExitBadInput;
-    }
     if (!options.shard.empty()) {
         fmt::print(stderr, "--shard and --slurm: the Slurm array runs every shard; leave --shard out\n");
         return kExitBadInput;
