@@ -57,13 +57,22 @@
 //   the distance of the occluder that defines it (the dominant occluder's above the near samples'
 //   horizons). Cosine-weighted measures are closed-form, GTAO's slice integral:
 //   F(h) = Int_0^h dot(n, w) sin(theta) dtheta = nv sin^2(h)/2 + nt (h - sin h cos h)/2.
+// - Interleaving [Quantum Break seed: "We cycle through the 36 directions on 9 pixel
+//   neighborhoods"]: pixel (x, y) gathers only the directions k = (x mod n) + n (y mod n) mod n^2
+//   (n = interleave; 36 directions, n = 3: 4 directions 90 degrees apart per pixel). Pass 3
+//   "lsao.resolve" averages the sums over the n x n window around each pixel (one pixel of each
+//   class), each scaled from its share of the directions to all N and weighted by how well the
+//   neighbour lies on the receiver's tangent plane and shares its normal, so each pixel ends
+//   with all N directions for 1/n^2 of the gather. n is lowered until every class has a
+//   direction (n^2 <= N); n = 1 is the plain per-pixel gather.
 // - Visibility (bent normal, aperture) uses rho = step at r: an occluder counts if d < r.
 //   A = 1 - (2/N) sum_k V_k, aperture = asin(sqrt(A)) (sin^2 = A, cosine convention); bent normal
 //   = normalize((2 pi/3) n - (2 pi/N) sum_k M_k), M_k = Int_occluded w dot(n, w) sin dtheta, the
 //   occluded first moment of the half-slice (the unoccluded hemisphere gives (2 pi/3) n); n where
 //   nothing is visible.
 // - Deviations from the reference integral: one depth layer, thin objects occlude as if infinitely
-//   thick, off-screen geometry is missing (as every screen-space method); per half-slice only
+//   thick, off-screen geometry is missing (as every screen-space method); with interleaving, a
+//   pixel's directions come from receivers up to floor(n/2) px away; per half-slice only
 //   horizons are known, so every ray below one counts as blocked at that occluder's distance (a
 //   tall wall next to the receiver is weighted by the distance of its top where no nearer sample
 //   rises above the tangent plane); the dominant occluder is the largest horizon over the whole
@@ -80,6 +89,7 @@
 // | jitter          | bool  | true    |                        |             |
 // | near_field      | bool  | true    |                        |             |
 // | direction_sets  | int   | 4       | [1, 64]                |             |
+// | interleave      | int   | 3       | [1, 4]                 | px          |
 // | radius          | float | 1       | [0, inf)               | world units |
 // | falloff         | enum  | linear  | {linear, smoothstep}   |             |
 //
@@ -140,6 +150,10 @@ config::ParamSchema Lsao::declareParams()
                    "the nearest upstream sweep sample");
     schema.addInt("direction_sets", 4, 1, 64, "",
                   "rotated direction sets, frameIndex modulo this picks the set");
+    schema.addInt("interleave", 3, 1, 4, "px",
+                  "tiles of interleave x interleave pixels share the directions out (each "
+                  "pixel gathers 1/interleave^2 of them), then a geometry-aware average over "
+                  "the tile window restores all of them; 1: every pixel gathers every direction");
     schema.addFloat("radius", 1.0, 0.0, std::numeric_limits<double>::infinity(), "world units",
                     "obscurance falloff radius: occluders at or beyond it do not count");
     schema.addEnum("falloff", "linear", kFalloffChoices,
@@ -153,6 +167,7 @@ Lsao::Lsao(const config::ParamSet& params)
     checkRange("line_spacing", params.getFloat("line_spacing"), 0.5, 64.0);
     checkRange("step", params.getFloat("step"), 1.0, 256.0);
     checkRange("direction_sets", double(params.getInt("direction_sets")), 1, 64);
+    checkRange("interleave", double(params.getInt("interleave")), 1, 4);
     checkRange("radius", params.getFloat("radius"), 0.0, std::numeric_limits<double>::infinity());
     mParams.directions = int(params.getInt("directions"));
     mParams.lineSpacing = float(params.getFloat("line_spacing"));
@@ -160,6 +175,7 @@ Lsao::Lsao(const config::ParamSet& params)
     mParams.jitter = params.getBool("jitter");
     mParams.nearField = params.getBool("near_field");
     mParams.directionSets = int(params.getInt("direction_sets"));
+    mParams.interleave = int(params.getInt("interleave"));
     mParams.radius = params.getFloat("radius");
     const std::string& falloff = params.getString("falloff");
     if (falloff == kFalloffChoices[0])
@@ -182,6 +198,7 @@ config::ParamSet Lsao::effectiveParams() const
     p.set("jitter", mParams.jitter);
     p.set("near_field", mParams.nearField);
     p.set("direction_sets", std::int64_t(mParams.directionSets));
+    p.set("interleave", std::int64_t(mParams.interleave));
     p.set("radius", mParams.radius);
     p.set("falloff", kFalloffChoices[mParams.falloff == Falloff::Linear ? 0 : 1]);
     return p;

@@ -13,6 +13,7 @@ Layout buildLayout(int width, int height, const plugin::ScreenProjection& projec
     const int sets = std::max(1, params.directionSets);
     layout.setIndex = std::uint32_t(((frameIndex % sets) + sets) % sets);
     layout.jitter = params.jitter;
+    layout.interleave = computeEffectiveInterleave(params.interleave, params.directions);
     layout.spacing = params.lineSpacing;
     layout.invSpacing = 1.0f / params.lineSpacing;
     layout.step = params.step;
@@ -102,6 +103,7 @@ Constants makeConstants(const Layout& layout, const plugin::ScreenProjection& pr
               (batch == 0 ? kFlagFirstBatch : 0u) |
               (batch + 1 == layout.batches.size() ? kFlagLastBatch : 0u);
     c.setIndex = layout.setIndex;
+    c.interleave = std::uint32_t(layout.interleave);
     return c;
 }
 
@@ -232,7 +234,11 @@ PixelResult resolvePixel(const glm::vec3& n, float sumObscurance, float sumVisib
     // Int_H w cos dw = (2 pi / 3) n; subtract the occluded moment (2 pi / N) sum, divide by 2pi/3.
     const glm::vec3 b = n - (3.0f / float(directionCount)) * sumMoment;
     const float bl = glm::length(b);
-    r.bentNormal = visible > 0.0f && bl > 1e-6f ? b / bl : n;
+    // The direction of b is only as good as its length against the rounding of the sums (up to
+    // 128 directions x 7 occluders of O(1) terms, ~1e-5; more where interleaving scales a
+    // pixel's share up): below |b| = 1e-3 (visible fraction < 1e-3, since |b| <= 1.5 A) it is
+    // noise, and the bent normal is the normal, as where nothing is visible.
+    r.bentNormal = visible > 0.0f && bl > 1e-3f ? b / bl : n;
     // sin^2(aperture) = visible: aperture = asin(sqrt(visible)).
     r.aperture = computeAtan2(std::sqrt(visible), std::sqrt(1.0f - visible));
     return r;

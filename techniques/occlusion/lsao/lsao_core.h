@@ -42,6 +42,7 @@ struct Params {
     bool jitter = true;       //!< jittered step positions instead of regular ones
     bool nearField = true;    //!< one extra sample per pixel and direction near the receiver
     int directionSets = 4;    //!< rotated direction sets, one per frame in turn
+    int interleave = 3;       //!< tiles of interleave^2 pixels share the directions out
     double radius = 1.0;      //!< world units: falloff radius
     Falloff falloff = Falloff::Linear;
 };
@@ -84,6 +85,9 @@ struct Layout {
     std::vector<Batch> batches;
     std::uint32_t maxLineCount = 0;
     std::size_t maxBatchEntries = 0;
+    //! Side of the pixel tiles that share the directions out (1: every pixel takes every
+    //! direction); Params::interleave limited so that every pixel of a tile gets one.
+    int interleave = 1;
 };
 
 //! Push constants of both shaders (std430 push-constant block, 96 bytes).
@@ -106,7 +110,7 @@ struct Constants {
     std::uint32_t dirCount = 0; //!< all directions of the frame (normalisation)
     std::uint32_t flags = 0;
     std::uint32_t setIndex = 0;
-    std::uint32_t pad = 0;
+    std::uint32_t interleave = 1; //!< Layout::interleave
 };
 static_assert(sizeof(Constants) == 96, "must match lsao_common.glsl");
 
@@ -125,6 +129,72 @@ Layout buildLayout(int width, int height, const plugin::ScreenProjection& projec
 //! The push constants of batch `batch` of `layout`.
 Constants makeConstants(const Layout& layout, const plugin::ScreenProjection& projection,
                         const Params& params, std::size_t batch);
+
+// ---- Interleaved directions [Quantum Break seed: "We cycle through the 36 directions on 9 pixel
+// neighborhoods"] -------------------------------------------------------------------------------
+// Pixel (x, y) of a tile of n x n pixels has the class (x mod n) + n (y mod n) and gathers the
+// directions k with k mod n^2 = class (36 directions, n = 3: 4 per pixel, 90 degrees apart and
+// rotated by 10 degrees from class to class). The resolve pass then averages the per-direction
+// sums over the n x n window around each pixel, which holds one pixel of every class, over the
+// neighbours on the receiver's surface (isSameSurface), so every pixel ends with all N
+// directions at 1/n^2 of the gather cost.
+
+//! The largest tile side not above `requested` whose n^2 classes each get one direction.
+inline int computeEffectiveInterleave(int requested, int directions)
+{
+    int n = std::max(requested, 1);
+    while (n > 1 && n * n > directions)
+        --n;
+    return n;
+}
+
+//! The class of pixel (x, y) in tiles of side n.
+inline std::uint32_t computePixelClass(int x, int y, int n)
+{
+    return std::uint32_t(x % n + n * (y % n));
+}
+
+//! How many of the directions [0, directionCount) class `pixelClass` gathers (tiles of side n).
+inline std::uint32_t countClassDirections(std::uint32_t pixelClass, std::uint32_t directionCount,
+                                          int n)
+{
+    const std::uint32_t classes = std::uint32_t(n * n);
+    return directionCount / classes + (pixelClass < directionCount % classes ? 1u : 0u);
+}
+
+//! First offset of the n x n resolve window around a pixel along each axis (-1 for n = 3).
+inline int computeWindowBegin(int n)
+{
+    return -((n - 1) / 2);
+}
+
+//! Whether neighbour pixel j counts in receiver i's resolve: its normal within 25.8 degrees of
+//! the receiver's (cos^2 >= 0.81) and its point within 7.1 degrees of the receiver's tangent
+//! plane seen from the receiver (plane distance <= separation / 8), so edges, creases and depth
+//! jumps keep their own directions. A discrete decision: written with the same float operations
+//! as lsaoIsSameSurface (no division, raw normals, positions scaled by projScale.x * projScale.y),
+//! so both paths keep the same neighbours.
+inline bool isSameSurface(glm::vec2 pixelI, float zi, const glm::vec3& ni, glm::vec2 pixelJ,
+                          float zj, const glm::vec3& nj, glm::vec2 projScale, glm::vec2 projOffset,
+                          glm::vec2 invSize)
+{
+    const float dn = ni.x * nj.x + ni.y * nj.y + ni.z * nj.z;
+    const float lenI = ni.x * ni.x + ni.y * ni.y + ni.z * ni.z;
+    const float lenJ = nj.x * nj.x + nj.y * nj.y + nj.z * nj.z;
+    if (!(dn > 0.0f) || !(dn * dn >= 0.81f * (lenI * lenJ)))
+        return false;
+    // View x = z (ndc.x + offset.x) / scale.x: differences times scale.x * scale.y.
+    const float uxi = zi * ((pixelI.x * invSize.x * 2.0f - 1.0f) + projOffset.x);
+    const float uyi = zi * ((pixelI.y * invSize.y * 2.0f - 1.0f) + projOffset.y);
+    const float uxj = zj * ((pixelJ.x * invSize.x * 2.0f - 1.0f) + projOffset.x);
+    const float uyj = zj * ((pixelJ.y * invSize.y * 2.0f - 1.0f) + projOffset.y);
+    const float dx = (uxj - uxi) * projScale.y;
+    const float dy = (uyj - uyi) * projScale.x;
+    const float dz = (zi - zj) * (projScale.x * projScale.y);
+    const float plane = ni.x * dx + ni.y * dy + ni.z * dz;
+    const float separation2 = dx * dx + dy * dy + dz * dz;
+    return plane * plane <= 0.015625f * (separation2 * lenI);
+}
 
 // ---- Line layout and jitter --------------------------------------------------------------
 

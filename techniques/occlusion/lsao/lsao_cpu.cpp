@@ -227,6 +227,7 @@ void runGatherCpu(const Layout& layout, std::size_t batchIndex,
                           params.radius > 0.0 ? float(1.0 / params.radius)
                                               : std::numeric_limits<float>::infinity()};
     const int w = layout.width;
+    const int interleave = layout.interleave;
     tbb::parallel_for(
         tbb::blocked_range<int>(0, layout.height), [&](const tbb::blocked_range<int>& rows) {
             for (int py = rows.begin(); py != rows.end(); ++py) {
@@ -239,7 +240,12 @@ void runGatherCpu(const Layout& layout, std::size_t batchIndex,
                     const glm::vec2 p(float(px) + 0.5f, float(py) + 0.5f);
                     const glm::vec3 x = projection.toView(p, z);
                     const std::size_t i = std::size_t(py) * std::size_t(w) + std::size_t(px);
-                    for (std::uint32_t k = batch.begin; k < batch.end; ++k) {
+                    // [Quantum Break seed] this pixel's share of the directions: k = class mod n^2.
+                    const std::uint32_t classes = std::uint32_t(interleave * interleave);
+                    const std::uint32_t pixelClass = computePixelClass(px, py, interleave);
+                    const std::uint32_t first =
+                        batch.begin + (pixelClass + classes - batch.begin % classes) % classes;
+                    for (std::uint32_t k = first; k < batch.end; k += classes) {
                         const Contribution c = gatherDirection(g, k, p, x, n);
                         sums.obscurance[i] += c.obscurance;
                         sums.visibility[i] += c.visibility;
@@ -266,17 +272,49 @@ void computeOnCpu(const Layout& layout, const plugin::ScreenProjection& projecti
     out.bentNormal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
     out.coneAperture = Image<float>(w, h, 0.0f);
     out.coneVisibility.clear();
-    const int directionCount = int(layout.directions.size());
+    const std::uint32_t directionCount = std::uint32_t(layout.directions.size());
+    const int n = layout.interleave;
+    const int begin = computeWindowBegin(n);
     tbb::parallel_for(tbb::blocked_range<int>(0, h), [&](const tbb::blocked_range<int>& rows) {
         for (int py = rows.begin(); py != rows.end(); ++py) {
             for (int px = 0; px < w; ++px) {
                 const glm::vec3 nRaw = normal.at(px, py);
-                if (!hasSurface(depth.at(px, py), nRaw))
+                const float z = depth.at(px, py);
+                if (!hasSurface(z, nRaw))
                     continue;
-                const std::size_t i = std::size_t(py) * std::size_t(w) + std::size_t(px);
-                const PixelResult r =
-                    resolvePixel(glm::normalize(nRaw), sums.obscurance[i], sums.visibility[i],
-                                 sums.moment[i], directionCount);
+                const glm::vec2 pi = glm::vec2(px, py) + 0.5f;
+                // [Quantum Break seed] the n x n window holds one pixel of every class: the sums
+                // of the neighbours on the receiver's surface (the receiver always), each scaled
+                // from its share of the directions to all of them, are averaged.
+                float obscurance = 0.0f, visibility = 0.0f, count = 0.0f;
+                glm::vec3 moment(0.0f);
+                for (int dy = begin; dy < begin + n; ++dy) {
+                    for (int dx = begin; dx < begin + n; ++dx) {
+                        const int qx = px + dx, qy = py + dy;
+                        if (qx < 0 || qy < 0 || qx >= w || qy >= h)
+                            continue;
+                        const glm::vec3 nq = normal.at(qx, qy);
+                        const float zq = depth.at(qx, qy);
+                        if (!hasSurface(zq, nq))
+                            continue;
+                        if ((dx != 0 || dy != 0) &&
+                            !isSameSurface(pi, z, nRaw, glm::vec2(qx, qy) + 0.5f, zq, nq,
+                                           projection.scale, projection.offset, layout.invSize))
+                            continue;
+                        const float share =
+                            float(directionCount) /
+                            float(countClassDirections(computePixelClass(qx, qy, n),
+                                                       directionCount, n));
+                        const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
+                        obscurance += share * sums.obscurance[q];
+                        visibility += share * sums.visibility[q];
+                        moment += share * sums.moment[q];
+                        count += 1.0f;
+                    }
+                }
+                const float inv = 1.0f / count;
+                const PixelResult r = resolvePixel(glm::normalize(nRaw), inv * obscurance, inv * visibility,
+                                                   inv * moment, int(directionCount));
                 out.ambient.at(px, py) = r.ambient;
                 out.bentNormal.at(px, py) = r.bentNormal;
                 out.coneAperture.at(px, py) = r.aperture;

@@ -52,6 +52,13 @@ GpuRunner::GpuRunner(gpu::Context& context) : mContext(&context)
                               {3, BindingType::StorageImage},
                               {4, BindingType::StorageImage},
                               {5, BindingType::StorageImage}});
+    mResolve = createPipeline(context, compiler, "lsao_resolve.comp", "lsao.resolve",
+                              {{0, BindingType::StorageImage},
+                               {3, BindingType::StorageImage},
+                               {4, BindingType::StorageImage},
+                               {5, BindingType::StorageImage},
+                               {6, BindingType::StorageImage},
+                               {7, BindingType::StorageImage}});
 }
 
 void GpuRunner::prepare(const Layout& layout)
@@ -69,6 +76,10 @@ void GpuRunner::prepare(const Layout& layout)
                                          ImageUsage::Storage, "lsao.accum_a"});
         mAccumB = mContext->createImage({ImageDimension::Image2D, Format::R32Float, w, h, 1,
                                          ImageUsage::Storage, "lsao.accum_b"});
+        mOutA = mContext->createImage({ImageDimension::Image2D, Format::RGBA32Float, w, h, 1,
+                                       ImageUsage::Storage, "lsao.bent_aperture"});
+        mOutB = mContext->createImage({ImageDimension::Image2D, Format::R32Float, w, h, 1,
+                                       ImageUsage::Storage, "lsao.ambient"});
         mWidth = layout.width;
         mHeight = layout.height;
     }
@@ -138,10 +149,18 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                                 gpu::computeGroupCount(std::uint64_t(h), kGatherGroupSize), 1},
                 "lsao.gather");
         }
+        cmd.dispatch(mResolve,
+                     {gpu::Binding::storageImage(0, depth), gpu::Binding::storageImage(3, normal),
+                      gpu::Binding::storageImage(4, mAccumA), gpu::Binding::storageImage(5, mAccumB),
+                      gpu::Binding::storageImage(6, mOutA), gpu::Binding::storageImage(7, mOutB)},
+                     gpu::PushConstants(constants.back()),
+                     gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), kGatherGroupSize),
+                                     gpu::computeGroupCount(std::uint64_t(h), kGatherGroupSize), 1},
+                     "lsao.resolve");
     });
 
     out = plugin::OcclusionOutput();
-    out.gpu.ambient = &mAccumB;
+    out.gpu.ambient = &mOutB;
     mRunWidth = w;
     mRunHeight = h;
     if (readBack)
@@ -154,8 +173,8 @@ void GpuRunner::readBack(plugin::OcclusionOutput& out)
         throw Error("lsao: nothing computed on the GPU to read back");
     const int w = mRunWidth, h = mRunHeight;
     const std::size_t count = std::size_t(w) * std::size_t(h);
-    const std::vector<float> a = mAccumA.downloadVector<float>();
-    const std::vector<float> b = mAccumB.downloadVector<float>();
+    const std::vector<float> a = mOutA.downloadVector<float>();
+    const std::vector<float> b = mOutB.downloadVector<float>();
     out.ambient = Image<float>(w, h, 1.0f);
     out.bentNormal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
     out.coneAperture = Image<float>(w, h, 0.0f);
@@ -165,7 +184,7 @@ void GpuRunner::readBack(plugin::OcclusionOutput& out)
         out.bentNormal.pixels[i] = glm::vec3(a[4 * i + 0], a[4 * i + 1], a[4 * i + 2]);
         out.coneAperture.pixels[i] = a[4 * i + 3];
     }
-    out.gpu.ambient = &mAccumB;
+    out.gpu.ambient = &mOutB;
 }
 
 std::vector<std::uint32_t> GpuRunner::downloadSweep(std::size_t entryCount) const

@@ -1,7 +1,7 @@
 #pragma once
 // The Vulkan version: shaders/lsao_sweep.comp ("lsao.sweep") and shaders/lsao_gather.comp
 // ("lsao.gather"), one pair of dispatches per batch of directions (one batch at the default
-// settings). Pipelines are built on first use; images and buffers are kept across frames and
+// settings), then shaders/lsao_resolve.comp ("lsao.resolve"). Pipelines are built on first use; images and buffers are kept across frames and
 // rebuilt when the image size or the layout grows.
 
 #include "lsao_core.h"
@@ -49,10 +49,13 @@ private:
     gpu::Context* mContext = nullptr;
     gpu::ComputePipeline mSweep;
     gpu::ComputePipeline mGather;
+    gpu::ComputePipeline mResolve;
     gpu::Image mDepth;
     gpu::Image mNormal;
     gpu::Image mAccumA;
     gpu::Image mAccumB;
+    gpu::Image mOutA; //!< bent normal, aperture
+    gpu::Image mOutB; //!< ambient
     gpu::Buffer mDirections;
     gpu::Buffer mSweepBuffer;
     int mWidth = 0;

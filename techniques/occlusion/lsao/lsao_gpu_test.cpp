@@ -105,6 +105,9 @@ TEST_F(LsaoGpu, MatchesTheCpuPathAndTheSweepBuffersAreIdentical)
          {"step", 3.5},
          {"line_spacing", 1.5},
          {"radius", 1e6}},
+        {{"interleave", std::int64_t(1)}},
+        // 20 directions over 16 classes: shares of 2 and 1 directions.
+        {{"interleave", std::int64_t(4)}, {"directions", std::int64_t(20)}},
     };
     for (int frame : {0, 3}) {
         for (const Overrides& o : configs) {
@@ -317,7 +320,7 @@ TEST_F(LsaoGpu, OutputIsValidOnTheFamilyStabilityCases)
     }
 }
 
-TEST_F(LsaoGpu, ReportsTheTimesOfBothPassesAt720p)
+TEST_F(LsaoGpu, ReportsTheTimesOfItsThreePassesAt720p)
 {
     const GBuffer g = renderScene(makeFloorBoxScene(), 1280, 720);
     Lsao lsao = makeLsao();
@@ -326,9 +329,10 @@ TEST_F(LsaoGpu, ReportsTheTimesOfBothPassesAt720p)
     for (int frame = 0; frame < 2; ++frame)
         lsao.compute(g.makeInput(frame, &getContext()), out);
     const std::vector<gpu::CommandTime> log = getContext().takeRunLog();
-    ASSERT_EQ(log.size(), 4u);
+    ASSERT_EQ(log.size(), 6u);
+    const char* passes[] = {"lsao.sweep", "lsao.gather", "lsao.resolve"};
     for (std::size_t i = 0; i < log.size(); ++i) {
-        EXPECT_EQ(log[i].label, i % 2 == 0 ? "lsao.sweep" : "lsao.gather");
+        EXPECT_EQ(log[i].label, passes[i % 3]);
         if (log[i].gpuMs)
             std::printf("%s: %.2f ms\n", log[i].label.c_str(), *log[i].gpuMs);
     }

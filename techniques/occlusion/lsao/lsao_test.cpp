@@ -410,6 +410,46 @@ TEST(Lsao, MoreDirectionsLowerTheErrorAgainstADenseEvaluation)
     EXPECT_LT(previous, 1e-3);
 }
 
+TEST(Lsao, InterleavingSharesTheDirectionsOutAndTheResolveRestoresThem)
+{
+    // Tile sides are lowered until every class has a direction; the classes partition them.
+    EXPECT_EQ(computeEffectiveInterleave(3, 36), 3);
+    EXPECT_EQ(computeEffectiveInterleave(3, 7), 2);
+    EXPECT_EQ(computeEffectiveInterleave(4, 20), 4);
+    EXPECT_EQ(computeEffectiveInterleave(4, 15), 3);
+    EXPECT_EQ(computeEffectiveInterleave(3, 1), 1);
+    for (const int n : {1, 2, 3, 4}) {
+        for (const std::uint32_t directions : {16u, 20u, 36u, 128u}) {
+            std::uint32_t total = 0;
+            for (std::uint32_t c = 0; c < std::uint32_t(n * n); ++c)
+                total += countClassDirections(c, directions, n);
+            EXPECT_EQ(total, directions) << n;
+        }
+        // The resolve window holds one pixel of every class.
+        std::vector<int> seen(std::size_t(n * n), 0);
+        for (int dy = computeWindowBegin(n); dy < computeWindowBegin(n) + n; ++dy)
+            for (int dx = computeWindowBegin(n); dx < computeWindowBegin(n) + n; ++dx)
+                ++seen[computePixelClass(10 + dx, 7 + dy, n)];
+        EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), n * n);
+    }
+    // Against a dense evaluation (128 directions, 1-px steps and lines) on the floor-box scene,
+    // the defaults with 4 directions per pixel (interleave 3) against all 36 per pixel.
+    const GBuffer g = renderScene(makeFloorBoxScene(), 160, 120);
+    const auto reference = runCpu(
+        {{"directions", std::int64_t(128)}, {"step", 1.0}, {"line_spacing", 1.0}, {"jitter", false},
+         {"interleave", std::int64_t(1)}},
+        g);
+    std::map<std::int64_t, double> error;
+    for (const std::int64_t n : {1, 2, 3}) {
+        error[n] = computeMeanError(runCpu({{"interleave", n}}, g), reference, g);
+        std::printf("interleave %lld: mean |W - W_dense| = %.5f\n", static_cast<long long>(n),
+                    error[n]);
+    }
+    // Interleaving may add at most the per-pixel gather's own discretisation error again
+    // (measured: 0.00216 against 0.00193, 1.12x).
+    EXPECT_LT(error[3], 2.0 * error[1]);
+}
+
 TEST(Lsao, JitteredAndRegularStepsBothConverge)
 {
     const GBuffer g = renderScene(makeFloorBoxScene(), 160, 120);

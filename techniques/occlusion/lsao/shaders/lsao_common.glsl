@@ -36,7 +36,7 @@ layout(push_constant) uniform Constants
     uint dirCount;
     uint flags;
     uint setIndex;
-    uint pad;
+    uint interleave;
 } pc;
 
 // lsao::Direction (std430, 64 bytes).
@@ -59,6 +59,43 @@ layout(std430, set = 0, binding = 1) readonly buffer Directions { Direction dire
 layout(set = 0, binding = 3, rgba32f) uniform readonly image2D normalImage;
 
 #define LSAO_INF uintBitsToFloat(0x7f800000u)
+
+// ---- Interleaved directions (lsao::computePixelClass and the rest) --------------------------
+
+uint lsaoPixelClass(ivec2 pixel, int n)
+{
+    return uint(pixel.x % n + n * (pixel.y % n));
+}
+
+uint lsaoClassDirections(uint pixelClass, uint directionCount, int n)
+{
+    uint classes = uint(n * n);
+    return directionCount / classes + (pixelClass < directionCount % classes ? 1u : 0u);
+}
+
+// lsao::isSameSurface, operation for operation.
+bool lsaoIsSameSurface(vec2 pixelI, float zi, vec3 ni, vec2 pixelJ, float zj, vec3 nj)
+{
+    precise float dn = ni.x * nj.x + ni.y * nj.y + ni.z * nj.z;
+    precise float lenI = ni.x * ni.x + ni.y * ni.y + ni.z * ni.z;
+    precise float lenJ = nj.x * nj.x + nj.y * nj.y + nj.z * nj.z;
+    precise float cosBound = 0.81 * (lenI * lenJ);
+    precise float dn2 = dn * dn;
+    if (!(dn > 0.0) || !(dn2 >= cosBound))
+        return false;
+    precise float uxi = zi * ((pixelI.x * pc.invSize.x * 2.0 - 1.0) + pc.projOffset.x);
+    precise float uyi = zi * ((pixelI.y * pc.invSize.y * 2.0 - 1.0) + pc.projOffset.y);
+    precise float uxj = zj * ((pixelJ.x * pc.invSize.x * 2.0 - 1.0) + pc.projOffset.x);
+    precise float uyj = zj * ((pixelJ.y * pc.invSize.y * 2.0 - 1.0) + pc.projOffset.y);
+    precise float dx = (uxj - uxi) * pc.projScale.y;
+    precise float dy = (uyj - uyi) * pc.projScale.x;
+    precise float dz = (zi - zj) * (pc.projScale.x * pc.projScale.y);
+    precise float plane = ni.x * dx + ni.y * dy + ni.z * dz;
+    precise float separation2 = dx * dx + dy * dy + dz * dz;
+    precise float plane2 = plane * plane;
+    precise float bound = 0.015625 * (separation2 * lenI);
+    return plane2 <= bound;
+}
 
 // ---- Line layout and jitter -----------------------------------------------------------------
 
@@ -387,7 +424,7 @@ PixelResult lsaoResolvePixel(vec3 n, float sumObscurance, float sumVisibility, v
     float visible = clamp(1.0 - scale * sumVisibility, 0.0, 1.0);
     vec3 b = n - (3.0 / float(pc.dirCount)) * sumMoment;
     float bl = length(b);
-    r.bentNormal = visible > 0.0 && bl > 1e-6 ? b / bl : n;
+    r.bentNormal = visible > 0.0 && bl > 1e-3 ? b / bl : n; // see lsao::resolvePixel
     r.aperture = lsaoAtan2(sqrt(visible), sqrt(1.0 - visible));
     return r;
 }

@@ -3,8 +3,8 @@
 // two lines that bracket the pixel and the two samples that bracket it along each line, each
 // sample's dominant occluder seen from the pixel itself with its normal, plus one near-field
 // sample [Quantum Break seed], and adds the half-slice contributions to the accumulators.
-// The last batch turns the sums into the outputs: accumA = (bent normal, aperture), accumB =
-// ambient. The twin of lsao::runGatherCpu and the resolve of lsao::computeOnCpu.
+// Each pixel takes the directions of its class (k mod interleave^2, [Quantum Break seed]);
+// lsao_resolve.comp turns the sums into the outputs. The twin of lsao::runGatherCpu.
 #version 450
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
@@ -149,32 +149,25 @@ void main()
         return;
     float z = imageLoad(depthImage, pixel).r;
     vec3 nRaw = imageLoad(normalImage, pixel).xyz;
-    bool surface = lsaoHasSurface(z, nRaw);
     bool first = (pc.flags & LSAO_FLAG_FIRST_BATCH) != 0u;
-    bool last = (pc.flags & LSAO_FLAG_LAST_BATCH) != 0u;
     vec4 sumA = first ? vec4(0.0) : imageLoad(accumA, pixel);
     float sumB = first ? 0.0 : imageLoad(accumB, pixel).r;
-    vec3 n = vec3(0.0);
-    if (surface) {
-        n = normalize(nRaw);
+    if (lsaoHasSurface(z, nRaw)) {
+        vec3 n = normalize(nRaw);
         vec2 p = vec2(pixel) + 0.5;
         vec3 x = screenToView(p, z, pc.projScale, pc.projOffset, pc.size);
-        for (uint k = pc.dirBegin; k < pc.dirEnd; ++k) {
+        // [Quantum Break seed] this pixel's share of the directions: k = class mod n^2.
+        int il = int(pc.interleave);
+        uint classes = uint(il * il);
+        uint pixelClass = lsaoPixelClass(pixel, il);
+        uint firstK = pc.dirBegin + (pixelClass + classes - pc.dirBegin % classes) % classes;
+        for (uint k = firstK; k < pc.dirEnd; k += classes) {
             Contribution c = lsaoGatherDirection(k, p, x, n);
             sumA.w += c.obscurance;
             sumB += c.visibility;
             sumA.xyz += c.moment;
         }
     }
-    if (!last) {
-        imageStore(accumA, pixel, sumA);
-        imageStore(accumB, pixel, vec4(sumB));
-    } else if (surface) {
-        PixelResult r = lsaoResolvePixel(n, sumA.w, sumB, sumA.xyz);
-        imageStore(accumA, pixel, vec4(r.bentNormal, r.aperture));
-        imageStore(accumB, pixel, vec4(r.ambient));
-    } else {
-        imageStore(accumA, pixel, vec4(0.0));
-        imageStore(accumB, pixel, vec4(1.0));
-    }
+    imageStore(accumA, pixel, sumA);
+    imageStore(accumB, pixel, vec4(sumB));
 }
