@@ -144,20 +144,29 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
         } else {
             wNear = 1.0f;
         }
+        // Occluders are loaded once per stratum: the downstream sample's dominant occluder is
+        // often the upstream sample itself or the upstream sample's dominant occluder (one hull
+        // vertex seen from consecutive samples), and loading is a function of the stratum.
+        const std::uint32_t lowerId =
+            wLower > 0.0f ? g.sweep[row + std::uint32_t(lower[j].stratum)] : kNoOccluder;
+        Occluder lowerDominant, self;
         if (wLower > 0.0f) {
             // The upstream sample itself and its dominant occluder.
-            const Occluder dominant =
-                loadDominant(g, d, k, line, c, row, lower[j], slice, x, minDistance);
-            const Occluder self = loadLineSample(layout, g.projection, g.depth, g.normal, d, c,
-                                                 lower[j], slice, x, minDistance);
+            lowerDominant = loadDominant(g, d, k, line, c, row, lower[j], slice, x, minDistance);
+            self = loadLineSample(layout, g.projection, g.depth, g.normal, d, c, lower[j], slice,
+                                  x, minDistance);
             addScaled(total, lineWeight * wLower,
-                      evaluateOccluders(slice, dominant, self, near, g.radius, g.invRadius,
+                      evaluateOccluders(slice, lowerDominant, self, near, g.radius, g.invRadius,
                                         g.smoothstep));
         }
         if (wUpper > 0.0f) {
             // The downstream sample's dominant occluder lies at or before the upstream sample.
+            const std::uint32_t id = g.sweep[row + std::uint32_t(upper[j].stratum)];
             const Occluder dominant =
-                loadDominant(g, d, k, line, c, row, upper[j], slice, x, minDistance);
+                wLower > 0.0f && id == std::uint32_t(lower[j].stratum) ? self
+                : wLower > 0.0f && id == lowerId
+                    ? lowerDominant
+                    : loadDominant(g, d, k, line, c, row, upper[j], slice, x, minDistance);
             addScaled(total, lineWeight * wUpper,
                       evaluateOccluders(slice, dominant, near, Occluder{}, g.radius, g.invRadius,
                                         g.smoothstep));

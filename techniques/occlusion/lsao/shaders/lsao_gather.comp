@@ -120,16 +120,25 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         } else {
             wNear = 1.0;
         }
+        // Occluders are loaded once per stratum (see lsao::runGatherCpu's gatherDirection).
+        uint lowerId = wLower > 0.0 ? sweep[row + uint(lower[j].stratum)] : LSAO_NO_OCCLUDER;
+        Occluder lowerDominant = lsaoNoOccluder();
+        Occluder self = lsaoNoOccluder();
         if (wLower > 0.0) {
-            Occluder dominant =
-                lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, minDistance);
-            Occluder self = lsaoLoadLineSample(d, c, lower[j], sl, x, minDistance);
+            lowerDominant = lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, minDistance);
+            self = lsaoLoadLineSample(d, c, lower[j], sl, x, minDistance);
             lsaoAddScaled(total, lineWeight * wLower,
-                          lsaoEvaluateOccluders(sl, dominant, self, nearSample));
+                          lsaoEvaluateOccluders(sl, lowerDominant, self, nearSample));
         }
         if (wUpper > 0.0) {
-            Occluder dominant =
-                lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, minDistance);
+            uint id = sweep[row + uint(upper[j].stratum)];
+            Occluder dominant;
+            if (wLower > 0.0 && id == uint(lower[j].stratum))
+                dominant = self;
+            else if (wLower > 0.0 && id == lowerId)
+                dominant = lowerDominant;
+            else
+                dominant = lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, minDistance);
             lsaoAddScaled(total, lineWeight * wUpper,
                           lsaoEvaluateOccluders(sl, dominant, nearSample, lsaoNoOccluder()));
         }
