@@ -101,10 +101,11 @@ double toUnitInterval(std::uint32_t x)
     return (double(x) + 0.5) * (1.0 / 4294967296.0);
 }
 
-glm::dvec2 sampleScrambledSobol2D(std::uint32_t index, std::uint64_t streamSeed)
+namespace {
+
+//! sampleScrambledSobol2D with the stream's two hashes computed once by the caller.
+glm::dvec2 sampleScrambledSobol2DHashed(std::uint32_t index, std::uint64_t h0, std::uint64_t h1)
 {
-    const std::uint64_t h0 = mixBits64(streamSeed);
-    const std::uint64_t h1 = mixBits64(h0 ^ 0x9e3779b97f4a7c15ull);
     // Shuffle: nested uniform scrambling of the index maps every aligned block of 2^m indices
     // onto an aligned block of 2^m indices, so prefixes of 2^m samples stay (0,m,2)-nets.
     const std::uint32_t shuffled = scrambleNestedUniform(index, std::uint32_t(h0));
@@ -114,6 +115,14 @@ glm::dvec2 sampleScrambledSobol2D(std::uint32_t index, std::uint64_t streamSeed)
     const std::uint32_t y =
         reverseBits32(permuteLaineKarras(computeReversedSobol32Dimension1(shuffled), std::uint32_t(h1)));
     return {toUnitInterval(x), toUnitInterval(y)};
+}
+
+} // namespace
+
+glm::dvec2 sampleScrambledSobol2D(std::uint32_t index, std::uint64_t streamSeed)
+{
+    const std::uint64_t h0 = mixBits64(streamSeed);
+    return sampleScrambledSobol2DHashed(index, h0, mixBits64(h0 ^ 0x9e3779b97f4a7c15ull));
 }
 
 PixelSequence::PixelSequence(std::uint64_t seed, std::uint64_t pixelIndex)
@@ -130,9 +139,10 @@ glm::dvec2 PixelSequence::get2D(std::uint32_t sampleIndex, std::uint32_t dimensi
 void PixelSequence::get2D(std::uint32_t first, std::uint32_t count, std::uint32_t dimensionPair,
                           glm::dvec2* out) const
 {
-    const std::uint64_t stream = mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1);
+    const std::uint64_t h0 = mixBits64(mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
+    const std::uint64_t h1 = mixBits64(h0 ^ 0x9e3779b97f4a7c15ull);
     for (std::uint32_t i = 0; i < count; ++i)
-        out[i] = sampleScrambledSobol2D(first + i, stream);
+        out[i] = sampleScrambledSobol2DHashed(first + i, h0, h1);
 }
 
 } // namespace rtlab::reference
