@@ -7,7 +7,10 @@
 // (VTK's SMP backend is TBB; OpenVDB uses TBB), after one warm-up call; the time is the median of
 // the repeats' wall time around extract().
 //
-//   isosurface_throughput_benchmark [--grid 256] [--threads N] [--repeats 5] [--quick]
+//   isosurface_throughput_benchmark [--grid 256] [--threads N] [--repeats 5] [--technique NAME]...
+//                                   [--quick]
+// --technique (repeatable) times only the named techniques (a ratio column is 0 when its
+// baseline was not timed), e.g. to profile one of them with perf.
 // --threads 0 (the default) runs at 1 thread and at all hardware threads. --quick: grid 32, one
 // repeat (the ctest that keeps it compiling and running).
 
@@ -23,6 +26,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
@@ -35,6 +39,7 @@ struct Options {
     int grid = 256;
     int threads = 0;
     int repeats = 5;
+    std::vector<std::string> only; //!< --technique: time only these (empty: every one)
 };
 
 scene::SdfModel findModel(const std::string& name)
@@ -99,13 +104,20 @@ int main(int argc, char** argv)
             options.threads = next();
         else if (a == "--repeats")
             options.repeats = next();
-        else if (a == "--quick") {
+        else if (a == "--technique") {
+            if (i + 1 >= argc) {
+                std::fprintf(stderr, "--technique needs a value\n");
+                return 2;
+            }
+            options.only.push_back(argv[++i]);
+        } else if (a == "--quick") {
             options.grid = 32;
             options.repeats = 1;
         } else {
             std::fprintf(
                 stderr,
-                "unknown argument %s; usage: %s [--grid N] [--threads N] [--repeats N] [--quick]\n",
+                "unknown argument %s; usage: %s [--grid N] [--threads N] [--repeats N] "
+                "[--technique NAME]... [--quick]\n",
                 a.c_str(), argv[0]);
             return 2;
         }
@@ -117,7 +129,15 @@ int main(int argc, char** argv)
     std::vector<int> threadCounts = {options.threads};
     if (options.threads == 0)
         threadCounts = {1, tbb::info::default_concurrency()};
-    const auto techniques = plugin::builtinRegistry().techniques("isosurface");
+    std::vector<const plugin::TechniqueEntry*> techniques;
+    for (const auto* entry : plugin::builtinRegistry().techniques("isosurface"))
+        if (options.only.empty() || std::find(options.only.begin(), options.only.end(),
+                                              entry->info.name) != options.only.end())
+            techniques.push_back(entry);
+    if (techniques.size() != (options.only.empty() ? techniques.size() : options.only.size())) {
+        std::fprintf(stderr, "--technique: not every name is a registered isosurface technique\n");
+        return 2;
+    }
 
     std::printf(
         "| field | threads | technique | triangles | median ms | Mcells/s | / vtk_flying_edges | "

@@ -18,8 +18,10 @@
 //   nanovdb              NanoVDB converted from that grid (openToNanoVDB), same two lookups
 // The voxels: the cells of a lattice over the static scene (no characters, frame 0) that a
 // triangle meets (families/voxel_gi/voxelize.h listCellsMeetingTriangles), at 128, 256 and 512
-// cells along the box's longest side, for cornell_box and tomorrow_town. Payload: one RGB float
-// value (12 bytes) per voxel in every structure.
+// cells along the box's longest side, for cornell_box and tomorrow_town; and the narrow-band
+// level set of a sphere of radius 230 voxels (half-width 3 voxels, 4.0 M voxels: a band 6 voxels
+// thick instead of a surface shell one voxel thick). Payload: one RGB float value (12 bytes) per
+// voxel in every structure.
 //
 //   build/tests/families/voxel_structure_benchmark [--benchmark_filter=<regex>]
 //   build/tests/families/voxel_structure_benchmark --quick   # cornell_box at 32 and 64 (ctest)
@@ -59,12 +61,40 @@ struct Voxels {
 
 glm::vec3 payloadOf(const glm::ivec3& c) { return glm::vec3(c) * 1e-3f + 0.5f; }
 
+//! The narrow-band level set of a sphere of radius r voxels (the active voxels of OpenVDB's
+//! createLevelSetSphere at its default half-width of 3 voxels: centres within 3 voxels of the
+//! sphere): the data set on which the topology target of 0.4 B/voxel was estimated (a band 6
+//! voxels thick, about 36 voxels per 4^3 node against about 15 for a voxelized surface).
+Voxels makeNarrowBandSphere(int radius)
+{
+    Voxels v;
+    const int n = 2 * radius + 8;
+    v.cells = glm::ivec3(n);
+    const double centre = 0.5 * double(n);
+    for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const glm::dvec3 p = glm::dvec3(x, y, z) + 0.5 - centre;
+                if (std::abs(std::sqrt(glm::dot(p, p)) - double(radius)) < 3.0)
+                    v.active.emplace_back(x, y, z);
+            }
+    return v;
+}
+
 const Voxels& getVoxels(const std::string& sceneName, int resolution)
 {
     static std::map<std::pair<std::string, int>, Voxels> cache;
     auto it = cache.find({sceneName, resolution});
     if (it != cache.end())
         return it->second;
+    if (sceneName == "narrow_band_sphere") {
+        Voxels v = makeNarrowBandSphere(resolution);
+        v.randomOrder = v.active;
+        std::shuffle(v.randomOrder.begin(), v.randomOrder.end(), std::mt19937(1));
+        if (v.randomOrder.size() > (1u << 18))
+            v.randomOrder.resize(1u << 18);
+        return cache.emplace(std::make_pair(sceneName, resolution), std::move(v)).first->second;
+    }
     const scene::Scene s = scene::loadScene(sceneName);
     const scene::RenderScene g = s.assembleRenderScene(s.meshSdfModels(0), {}, 0);
     const glm::dvec3 lo(g.boundsMin), hi(g.boundsMax);
@@ -378,11 +408,19 @@ int main(int argc, char** argv)
     const std::vector<std::string> scenes =
         quick ? std::vector<std::string>{"cornell_box"} : std::vector<std::string>{"cornell_box", "tomorrow_town"};
     const std::vector<int> resolutions = quick ? std::vector<int>{32, 64} : std::vector<int>{128, 256, 512};
+    std::vector<std::pair<std::string, int>> sets;
     for (const std::string& sceneName : scenes)
         for (int r : resolutions)
+            sets.emplace_back(sceneName, r);
+    if (!quick)
+        sets.emplace_back("narrow_band_sphere", 230); // r = 230 voxels: 4.0 M active voxels
+    for (const auto& [sceneName, r] : sets)
             for (const std::string name :
                  {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
                   "svo", "openvdb", "nanovdb"}) {
+                // A dense grid over the band's box would take 468^3 x 12 bytes (1.2 GB).
+                if (sceneName == "narrow_band_sphere" && name == "dense_grid")
+                    continue;
                 const std::string prefix = sceneName + "/" + std::to_string(r) + "/" + name;
                 benchmark::RegisterBenchmark((prefix + "/build").c_str(), [=](benchmark::State& s) {
                     runBuild(s, sceneName, r, name);

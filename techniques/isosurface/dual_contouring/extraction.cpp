@@ -92,12 +92,16 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, edgeCount),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           std::size_t missingHere = 0;
+                          // The table's edge numbers (sample * 3 + axis) are the Hermite keys,
+                          // both ascending: one binary search per range, then a merge.
+                          std::size_t cursor =
+                              source.findHermiteLowerBound(table.edges[range.begin()]);
                           for (std::size_t k = range.begin(); k != range.end(); ++k) {
                               const std::size_t sample = std::size_t(table.edges[k] / 3u);
                               const int axis = int(table.edges[k] % 3u);
                               bool edgeMissing = false;
-                              table.crossings[k] =
-                                  source.compute(grid.sampleOf(sample), axis, edgeMissing);
+                              table.crossings[k] = source.computeInOrder(
+                                  grid.sampleOf(sample), axis, edgeMissing, cursor);
                               missingHere += edgeMissing;
                           }
                           missing += missingHere;

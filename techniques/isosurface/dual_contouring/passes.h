@@ -180,9 +180,46 @@ public:
     //! The crossing on edge (sample, axis); `missing` is set when input.hermite lacked it.
     Crossing compute(const glm::ivec3& s, int axis, bool& missing) const
     {
+        return compute(s, axis, missing, mUseHermite ? mInput.hermite->find(s, axis) : nullptr);
+    }
+
+    //! The same for edges visited in increasing key order (scan order): `cursor` is the index
+    //! into input.hermite->edges of the first entry not below the previous edge's key (start: 0
+    //! or a lower bound), and walks forward with the edges instead of a binary search per edge.
+    Crossing computeInOrder(const glm::ivec3& s, int axis, bool& missing,
+                            std::size_t& cursor) const
+    {
+        if (!mUseHermite)
+            return compute(s, axis, missing, nullptr);
+        const std::vector<plugin::HermiteEdge>& edges = mInput.hermite->edges;
+        const std::uint64_t wanted = mInput.hermite->key(s, axis);
+        while (cursor < edges.size() &&
+               mInput.hermite->key(edges[cursor].sample, edges[cursor].axis) < wanted)
+            ++cursor;
+        const bool found = cursor < edges.size() &&
+                           mInput.hermite->key(edges[cursor].sample, edges[cursor].axis) == wanted;
+        return compute(s, axis, missing, found ? &edges[cursor] : nullptr);
+    }
+
+    //! Index of the first Hermite edge whose key is not below `key` (0 without Hermite data).
+    std::size_t findHermiteLowerBound(std::uint64_t key) const
+    {
+        if (!mUseHermite)
+            return 0;
+        const std::vector<plugin::HermiteEdge>& edges = mInput.hermite->edges;
+        const auto it = std::lower_bound(
+            edges.begin(), edges.end(), key, [&](const plugin::HermiteEdge& e, std::uint64_t k) {
+                return mInput.hermite->key(e.sample, e.axis) < k;
+            });
+        return std::size_t(it - edges.begin());
+    }
+
+private:
+    Crossing compute(const glm::ivec3& s, int axis, bool& missing,
+                     const plugin::HermiteEdge* edge) const
+    {
         missing = false;
         if (mUseHermite) {
-            const plugin::HermiteEdge* edge = mInput.hermite->find(s, axis);
             if (edge != nullptr && std::isfinite(edge->t)) {
                 Crossing c;
                 c.point = glm::dvec3(s) + std::clamp(edge->t, 0.0, 1.0) * axisVector(axis);
@@ -213,7 +250,6 @@ public:
         return c;
     }
 
-private:
     //! Zero of the linear interpolant; an infinite end puts the crossing on the finite end.
     static double interpolateLinear(double a, double b)
     {
