@@ -150,6 +150,9 @@ public:
         // The box: the geometry's bounds padded by half a leaf, so that no surface lies on the
         // box's faces; root cells of 4^depth leaves cover it.
         const glm::dvec3 lo(g.boundsMin), hi(g.boundsMax);
+        if (!std::isfinite(lo.x + lo.y + lo.z + hi.x + hi.y + hi.z))
+            throw Error("adaptive_voxel_tree: the scene's bounds are not finite (a vertex is "
+                        "NaN or infinite)");
         const double extent = std::max({hi.x - lo.x, hi.y - lo.y, hi.z - lo.z});
         const double minExtent =
             1e-6 * std::max(1.0, glm::length(glm::max(glm::abs(lo), glm::abs(hi))));
