@@ -148,6 +148,7 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                         const int x = int(64 * w) + std::countr_zero(bits);
                         vertices.activeCell[next] = glm::ivec3(x, y, z);
                         CellCase& c = vertices.cases[next++];
+                        c = CellCase{}; // the array may hold the last call's cases
                         const unsigned cube = rows.getCube(x, y, z);
                         c.cube = std::uint8_t(cube);
                         if (!perComponent) {

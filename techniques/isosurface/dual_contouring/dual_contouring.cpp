@@ -198,7 +198,7 @@ std::vector<std::pair<std::string, double>> DualContouring::counters() const
 void DualContouring::extract(const plugin::IsosurfaceInput& input, TriangleMesh& out)
 {
     dc::ExtractionStats stats;
-    dc::extractDualContour(input, mOptions, out, stats);
+    dc::extractDualContour(input, mOptions, out, stats, &mWorkspace);
     mStats = stats;
 }
 

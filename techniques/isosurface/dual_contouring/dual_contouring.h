@@ -151,6 +151,7 @@ public:
 private:
     dc::ExtractionOptions mOptions;
     dc::ExtractionStats mStats;
+    dc::Workspace mWorkspace; //!< scratch arrays kept between extract() calls
 };
 
 } // namespace rtlab::isosurface

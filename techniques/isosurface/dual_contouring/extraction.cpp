@@ -58,11 +58,59 @@ bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<gl
     return smallest % 2 == 1;
 }
 
+struct ChunkOutput {
+    std::vector<std::uint32_t> indices;
+    std::size_t quads = 0;
+    std::size_t flipped = 0;
+};
+
+} // namespace
+
+struct Workspace::Arrays {
+    std::vector<std::uint32_t> wordBase;
+    std::vector<std::uint64_t> edges;
+    std::vector<Crossing> crossings;
+    CellVertices vertices;
+    std::vector<ChunkOutput> chunks;
+};
+
+Workspace::Workspace() : mArrays(std::make_unique<Arrays>()) {}
+Workspace::~Workspace() = default;
+Workspace::Workspace(Workspace&&) noexcept = default;
+Workspace& Workspace::operator=(Workspace&&) noexcept = default;
+
+namespace {
+
+//! Lends the workspace's arrays to the edge table for one call and takes them back at its end
+//! (also when a pass throws), with whatever capacity they grew to.
+class LentArrays {
+public:
+    LentArrays(Workspace::Arrays& arrays, EdgeTable& table) : mArrays(arrays), mTable(table)
+    {
+        swapAll();
+    }
+    ~LentArrays() { swapAll(); }
+    LentArrays(const LentArrays&) = delete;
+    LentArrays& operator=(const LentArrays&) = delete;
+
+private:
+    void swapAll()
+    {
+        mTable.wordBase.swap(mArrays.wordBase);
+        mTable.edges.swap(mArrays.edges);
+        mTable.crossings.swap(mArrays.crossings);
+    }
+    Workspace::Arrays& mArrays;
+    EdgeTable& mTable;
+};
+
 } // namespace
 
 void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOptions& options,
-                        TriangleMesh& out, ExtractionStats& stats)
+                        TriangleMesh& out, ExtractionStats& stats, Workspace* workspace)
 {
+    Workspace local;
+    Workspace::Arrays& arrays = (workspace != nullptr ? *workspace : local).arrays();
     validate(input);
     stats = ExtractionStats{};
     const plugin::SampledField& field = *input.field;
@@ -82,6 +130,7 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
                                     ", " + std::to_string(s.y) + ", " + std::to_string(s.z) +
                                     ")");
     }
+    const LentArrays lent(arrays, table);
     buildEdgeTable(grid, table);
     const std::size_t edgeCount = table.edges.size();
     stats.crossedEdges = edgeCount;
@@ -108,7 +157,7 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
                       });
     stats.hermiteMissing = missing.load();
 
-    CellVertices vertices;
+    CellVertices& vertices = arrays.vertices;
     numberCells(grid, table, options, vertices);
     const bool relaxing = input.materials != nullptr && options.materialRelaxationIterations > 0;
     placeVertices(grid, table, options, relaxing && !source.hasExactProjection(), vertices, stats);
@@ -134,14 +183,13 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     // are concatenated in chunk order, so the triangle order is the edge order whatever the
     // thread count.
     constexpr std::size_t kChunk = 8192;
-    struct ChunkOutput {
-        std::vector<std::uint32_t> indices;
-        std::size_t quads = 0;
-        std::size_t flipped = 0;
-    };
-    std::vector<ChunkOutput> chunks((edgeCount + kChunk - 1) / kChunk);
+    std::vector<ChunkOutput>& chunks = arrays.chunks;
+    chunks.resize((edgeCount + kChunk - 1) / kChunk);
     tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t chunk) {
         ChunkOutput& result = chunks[chunk];
+        result.indices.clear();
+        result.quads = 0;
+        result.flipped = 0;
         result.indices.reserve(6 * kChunk);
         const std::size_t end = std::min(edgeCount, (chunk + 1) * kChunk);
         for (std::size_t k = chunk * kChunk; k != end; ++k) {

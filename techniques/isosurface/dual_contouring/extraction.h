@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 namespace rtlab::isosurface::dc {
 
@@ -79,11 +80,28 @@ struct ExtractionStats {
     double maxRelaxationShift = 0.0;    //!< largest relaxation displacement, cells
 };
 
+//! The passes' scratch arrays (crossed edges, crossings, cell vertices, triangle lists), kept
+//! between calls so that re-meshing a grid of the same size allocates, and faults in, nothing
+//! new. Not shared between threads.
+class Workspace {
+public:
+    Workspace();
+    ~Workspace();
+    Workspace(Workspace&&) noexcept;
+    Workspace& operator=(Workspace&&) noexcept;
+    struct Arrays;
+    Arrays& arrays() { return *mArrays; }
+
+private:
+    std::unique_ptr<Arrays> mArrays;
+};
+
 //! Replaces `out` with the dual contour of {f = isoValue}; f < isoValue is inside. Throws
 //! std::invalid_argument (leaving `out` untouched) on a NaN sample, a non-finite iso-value,
 //! spacing or origin, a value or material count that does not match the samples, or Hermite data
-//! for another grid. Fewer than 2 samples along an axis give an empty mesh.
+//! for another grid. Fewer than 2 samples along an axis give an empty mesh. The output does not
+//! depend on `workspace` (null: a fresh one for this call).
 void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOptions& options,
-                        TriangleMesh& out, ExtractionStats& stats);
+                        TriangleMesh& out, ExtractionStats& stats, Workspace* workspace = nullptr);
 
 } // namespace rtlab::isosurface::dc
