@@ -5,8 +5,9 @@
 // results/game_frame: tomorrow_town's 8 frames with each occlusion technique) and makes:
 //   <out>/budget.png|pdf   one stacked bar per run: the mean over its frames of each pass that
 //                          makes the frame (its GPU time where it ran GPU work, else its CPU time)
-// and prints a Markdown table: frame time, final-frame RMSE against Embree `full`, and the most
-// expensive pass of each run.
+// and prints a Markdown table: the frame's wall time, the sum of its passes (the bar), the
+// final-frame RMSE against Embree `full`, and the most expensive pass of each run. Bars are named
+// by technique and the frame settings in which the runs differ (frame.culling here).
 //
 //   build/notebooks_cpp/06_game_frame_budget [results/game_frame] [out folder]
 
@@ -42,6 +43,7 @@ int main(int argc, char** argv)
     //    mean frame time and the mean final-frame error.
     struct RunBudget {
         std::string technique;
+        std::map<std::string, std::string> settings; //!< the run's frame.* and param.* values
         std::map<std::string, double> passMs;
         double frameMs = 0.0, rmse = 0.0;
         int frames = 0;
@@ -53,6 +55,14 @@ int main(int argc, char** argv)
             continue;
         RunBudget& run = runs[row.at("run_id")];
         run.technique = row.count("technique") ? row.at("technique") : "?";
+        // The settings a frame study sweeps: the frame's own and the technique's parameters.
+        for (const char* key : {"frame.culling", "frame.indirect", "frame.gbuffer_on_gpu",
+                                "frame.shadow_map_size", "frame.lighting", "frame.tonemapper"})
+            if (row.count(key))
+                run.settings[key] = row.at(key);
+        for (const auto& [key, value] : row)
+            if (key.rfind("param.", 0) == 0 && !value.empty())
+                run.settings[key] = value;
         std::istringstream passes(row.at("frame_passes"));
         for (std::string pass; std::getline(passes, pass, ';');) {
             if (pass.empty())
@@ -66,8 +76,7 @@ int main(int argc, char** argv)
             if (std::find(passOrder.begin(), passOrder.end(), pass) == passOrder.end())
                 passOrder.push_back(pass);
         }
-        const double frameGpu = experiment::getNumber(row, "frame.gpu_ms");
-        run.frameMs += frameGpu > 0.0 ? frameGpu : experiment::getNumber(row, "frame.cpu_ms");
+        run.frameMs += experiment::getNumber(row, "frame.cpu_ms"); // the frame's wall time
         run.rmse += experiment::getNumber(row, "frame.rmse");
         ++run.frames;
     }
@@ -76,30 +85,58 @@ int main(int argc, char** argv)
         return 1;
     }
 
-    // 3. The table and the bars.
+    // 3. The table and the bars. A bar is named by its technique and the settings in which the
+    //    runs differ (e.g. frame.culling); names too long to fit under the bars become numbers
+    //    with a key.
+    // (A parameter counts where it differs between runs of the same technique.)
+    std::vector<std::string> varying;
+    for (const auto& [id, run] : runs)
+        for (const auto& [key, value] : run.settings)
+            for (const auto& [otherId, other] : runs) {
+                const bool comparable =
+                    key.rfind("param.", 0) != 0 || other.technique == run.technique;
+                if (comparable && other.settings.count(key) && other.settings.at(key) != value &&
+                    std::find(varying.begin(), varying.end(), key) == varying.end())
+                    varying.push_back(key);
+            }
     plot::StackedBarSpec bars;
     bars.title = "frame budget: time of each pass per frame (mean over the frames)";
     bars.xLabel = "run";
     bars.yLabel = "time per frame (ms; GPU where the pass ran GPU work)";
     bars.passes = passOrder;
-    std::printf("| run | technique | frames | frame time (ms) | frame RMSE | most expensive pass |\n"
-                "|---|---|---|---|---|---|\n");
+    std::printf("| run | technique | frames | frame wall time (ms) | sum of its passes (ms) | frame RMSE "
+                "| most expensive pass |\n|---|---|---|---|---|---|---|\n");
     for (auto& [id, run] : runs) {
         std::vector<double> values;
         std::string top;
-        double topMs = -1.0;
+        double topMs = -1.0, sumMs = 0.0;
         for (const std::string& pass : passOrder) {
             const double ms = run.passMs.count(pass) ? run.passMs.at(pass) / run.frames : 0.0;
             values.push_back(ms);
+            sumMs += ms;
             if (ms > topMs) {
                 topMs = ms;
                 top = pass;
             }
         }
-        std::printf("| %s | %s | %d | %.3g | %.4g | %s (%.3g ms) |\n", id.c_str(), run.technique.c_str(), run.frames,
-                    run.frameMs / run.frames, run.rmse / run.frames, top.c_str(), topMs);
-        bars.bars.push_back(run.technique + " (" + id + ")");
+        std::printf("| %s | %s | %d | %.3g | %.3g | %.4g | %s (%.3g ms) |\n", id.c_str(), run.technique.c_str(),
+                    run.frames, run.frameMs / run.frames, sumMs, run.rmse / run.frames, top.c_str(), topMs);
+        std::string label = run.technique;
+        for (const std::string& key : varying)
+            if (run.settings.count(key))
+                label += "\n" + key.substr(key.find('.') + 1) + "=" + run.settings.at(key);
+        bars.bars.push_back(label);
         bars.values.push_back(std::move(values));
+    }
+    if (!plot::barLabelsFit(bars)) {
+        std::printf("\nbars:");
+        for (std::size_t b = 0; b < bars.bars.size(); ++b) {
+            std::string label = bars.bars[b];
+            std::replace(label.begin(), label.end(), '\n', ' ');
+            std::printf("%s %zu = %s", b == 0 ? "" : ";", b + 1, label.c_str());
+            bars.bars[b] = std::to_string(b + 1);
+        }
+        std::printf("\n");
     }
     // 4. The figure, PNG and vector PDF.
     plot::writeStackedBars(bars, out + "/budget");
