@@ -39,6 +39,12 @@
 //     blend breaks all the culling", and later soft edits enlarge the region an edit influences).
 //     Because dropped edits change no value bit, later tests that use D stay valid.
 //   - A cell is proven empty (full) when the final D lies above +band (below -band).
+//   - Inside a leaf whose pruned list holds exact distances only (no ellipsoid), the field is
+//     1-Lipschitz (hard and soft min/max keep it so): a sample one spacing after an evaluated (or
+//     skipped) -x, -y or -z neighbour whose |value| exceeds band + spacing is clamped to +-band
+//     with the neighbour's sign without evaluating anything (not with materials, which need the
+//     unclamped value). On the gallery at 256 this saves 0.5-1.5 points of the culling rate at
+//     the same wall time.
 //   - Bounds are widened by a margin of 1e-10 x the largest coordinate or size involved, which
 //     absorbs floating-point rounding with a wide safety factor.
 //

@@ -132,6 +132,14 @@ Interval boundEllipsoid(const scene::CsgEdit& edit, const LocalRange& range, dou
 
 } // namespace
 
+bool isLipschitzPrimitive(const scene::CsgEdit& edit)
+{
+    const glm::dvec3 s = edit.size;
+    return edit.shape != scene::CsgShape::Ellipsoid && isUnitRotation(edit.rotation) &&
+           s.x >= 0.0 && s.y >= 0.0 && s.z >= 0.0 && std::isfinite(s.x + s.y + s.z) &&
+           edit.rounding >= 0.0 && std::isfinite(edit.rounding);
+}
+
 Interval boundPrimitive(const scene::CsgEdit& edit, const glm::dvec3& boxLo, const glm::dvec3& boxHi,
                         double margin)
 {

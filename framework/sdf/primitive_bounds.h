@@ -34,4 +34,9 @@ struct Interval {
 Interval boundPrimitive(const scene::CsgEdit& edit, const glm::dvec3& boxLo, const glm::dvec3& boxHi,
                         double margin);
 
+//! Whether edit.evaluatePrimitive is an exact Euclidean distance, hence 1-Lipschitz: every shape
+//! but the ellipsoid, with a unit rotation and finite, non-negative size and rounding (where
+//! boundPrimitive uses the Lipschitz bound).
+bool isLipschitzPrimitive(const scene::CsgEdit& edit);
+
 } // namespace rtlab::sdf

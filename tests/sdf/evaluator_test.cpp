@@ -216,6 +216,41 @@ TEST(SdfEvaluator, AnisotropicEllipsoidsMatchBruteForce)
     }
 }
 
+TEST(SdfEvaluator, LeafSamplesOutOfTheBandsReachAreSkippedOnlyForLipschitzFields)
+{
+    // 96 samples per axis: every leaf is a whole 4^3 block, so a leaf evaluated in full costs
+    // exactly 64 sample evaluations.
+    const GridSpec grid = makeCubeGrid(-1.0, 1.0, 96);
+    SdfModel sphere;
+    sphere.name = "sphere";
+    CsgEdit e;
+    e.shape = CsgShape::Sphere;
+    e.size = glm::dvec3(0.7);
+    sphere.edits.push_back(e);
+    // A sphere is an exact distance: inside its evaluated leaves, samples more than one spacing
+    // past the band from an evaluated neighbour are known to be clamped and are not evaluated;
+    // the field stays bit-identical to brute force, with a thin and a wide band.
+    for (const double bandCells : {0.5, 2.0}) {
+        EvaluationOptions o;
+        o.bandCells = bandCells;
+        o.computeHermite = false;
+        const EvaluationResult r = evaluateModel(sphere, grid, kAllFrames, o);
+        EXPECT_LT(r.stats.samplesEvaluated, r.stats.leavesEvaluated * 64) << bandCells;
+        EXPECT_GE(r.stats.samplesEvaluated, r.stats.samplesInBand) << bandCells;
+        expectMatchesBruteForce(sphere, grid, kAllFrames, o, "band " + std::to_string(bandCells));
+    }
+    // An ellipsoid's value is not 1-Lipschitz: every sample of an evaluated leaf is evaluated.
+    SdfModel ellipsoid = sphere;
+    ellipsoid.edits[0].shape = CsgShape::Ellipsoid;
+    ellipsoid.edits[0].size = glm::dvec3(0.7, 0.3, 0.5);
+    EvaluationOptions o;
+    o.computeHermite = false;
+    const EvaluationResult r = evaluateModel(ellipsoid, grid, kAllFrames, o);
+    EXPECT_GT(r.stats.leavesEvaluated, 0u);
+    EXPECT_EQ(r.stats.samplesEvaluated, r.stats.leavesEvaluated * 64);
+    expectMatchesBruteForce(ellipsoid, grid, kAllFrames, o, "ellipsoid");
+}
+
 TEST(SdfEvaluator, PrimitiveBoundsContainValues)
 {
     std::mt19937 rng(7);
