@@ -104,8 +104,9 @@ int main(int argc, char** argv)
     bars.xLabel = "run";
     bars.yLabel = "time per frame (ms; GPU where the pass ran GPU work)";
     bars.passes = passOrder;
-    std::printf("| run | technique | frames | frame wall time (ms) | sum of its passes (ms) | frame RMSE "
-                "| most expensive pass |\n|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "| run | technique | frames | frame wall time (ms) | sum of its passes (ms) | frame RMSE "
+        "| most expensive pass |\n|---|---|---|---|---|---|---|\n");
     for (auto& [id, run] : runs) {
         std::vector<double> values;
         std::string top;
@@ -119,8 +120,9 @@ int main(int argc, char** argv)
                 top = pass;
             }
         }
-        std::printf("| %s | %s | %d | %.3g | %.3g | %.4g | %s (%.3g ms) |\n", id.c_str(), run.technique.c_str(),
-                    run.frames, run.frameMs / run.frames, sumMs, run.rmse / run.frames, top.c_str(), topMs);
+        std::printf("| %s | %s | %d | %.3g | %.3g | %.4g | %s (%.3g ms) |\n", id.c_str(),
+                    run.technique.c_str(), run.frames, run.frameMs / run.frames, sumMs,
+                    run.rmse / run.frames, top.c_str(), topMs);
         std::string label = run.technique;
         for (const std::string& key : varying)
             if (run.settings.count(key))

@@ -488,10 +488,10 @@ private:
                 for (int x = first.x; x <= last.x; ++x)
                     positions[i++] = getSamplePosition(grid, x, y, z);
         std::size_t evaluated = count;
-        const bool lipschitz =
-            !outputs.materials && !ops.empty() &&
-            std::all_of(ops.begin(), ops.end(),
-                        [](const Op& op) { return isLipschitzPrimitive(*op.edit); });
+        const bool lipschitz = !outputs.materials && !ops.empty() &&
+                               std::all_of(ops.begin(), ops.end(), [](const Op& op) {
+                                   return isLipschitzPrimitive(*op.edit);
+                               });
         if (!lipschitz) {
             // Edit-major: one primitive over the whole block, the coherent branch on primitive
             // type that the talk's 4x4x4 blocks are for.
@@ -512,7 +512,8 @@ private:
             // the same order as above, so every value stays bit-identical.
             evaluated = 0;
             const double step = grid.spacing + margin;
-            const std::size_t strides[3] = {1, std::size_t(n.x), std::size_t(n.x) * std::size_t(n.y)};
+            const std::size_t strides[3] = {1, std::size_t(n.x),
+                                            std::size_t(n.x) * std::size_t(n.y)};
             std::vector<double> bound(count, 0.0); // |value| (evaluated) or a lower bound of it
             i = 0;
             for (int z = 0; z < n.z; ++z)

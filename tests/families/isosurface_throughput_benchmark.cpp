@@ -23,10 +23,10 @@
 #include <tbb/info.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <algorithm>
 #include <map>
 #include <string>
 #include <vector>
@@ -114,11 +114,10 @@ int main(int argc, char** argv)
             options.grid = 32;
             options.repeats = 1;
         } else {
-            std::fprintf(
-                stderr,
-                "unknown argument %s; usage: %s [--grid N] [--threads N] [--repeats N] "
-                "[--technique NAME]... [--quick]\n",
-                a.c_str(), argv[0]);
+            std::fprintf(stderr,
+                         "unknown argument %s; usage: %s [--grid N] [--threads N] [--repeats N] "
+                         "[--technique NAME]... [--quick]\n",
+                         a.c_str(), argv[0]);
             return 2;
         }
     }

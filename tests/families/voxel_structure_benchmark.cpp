@@ -415,25 +415,27 @@ int main(int argc, char** argv)
     if (!quick)
         sets.emplace_back("narrow_band_sphere", 230); // r = 230 voxels: 4.0 M active voxels
     for (const auto& [sceneName, r] : sets)
-            for (const std::string name :
-                 {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
-                  "svo", "openvdb", "nanovdb"}) {
-                // A dense grid over the band's box would take 468^3 x 12 bytes (1.2 GB).
-                if (sceneName == "narrow_band_sphere" && name == "dense_grid")
-                    continue;
-                const std::string prefix = sceneName + "/" + std::to_string(r) + "/" + name;
-                benchmark::RegisterBenchmark((prefix + "/build").c_str(), [=](benchmark::State& s) {
-                    runBuild(s, sceneName, r, name);
-                })->Unit(benchmark::kMillisecond)->UseRealTime();
-                if (name == "cascades")
-                    continue;
-                for (bool coherent : {false, true})
-                    benchmark::RegisterBenchmark(
-                        (prefix + (coherent ? "/lookup_coherent" : "/lookup_random")).c_str(),
-                        [=](benchmark::State& s) { runLookups(s, sceneName, r, name, coherent); })
-                        ->Unit(benchmark::kMillisecond)
-                        ->UseRealTime();
-            }
+        for (const std::string name :
+             {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
+              "svo", "openvdb", "nanovdb"}) {
+            // A dense grid over the band's box would take 468^3 x 12 bytes (1.2 GB).
+            if (sceneName == "narrow_band_sphere" && name == "dense_grid")
+                continue;
+            const std::string prefix = sceneName + "/" + std::to_string(r) + "/" + name;
+            benchmark::RegisterBenchmark(
+                (prefix + "/build").c_str(),
+                [=](benchmark::State& s) { runBuild(s, sceneName, r, name); })
+                ->Unit(benchmark::kMillisecond)
+                ->UseRealTime();
+            if (name == "cascades")
+                continue;
+            for (bool coherent : {false, true})
+                benchmark::RegisterBenchmark(
+                    (prefix + (coherent ? "/lookup_coherent" : "/lookup_random")).c_str(),
+                    [=](benchmark::State& s) { runLookups(s, sceneName, r, name, coherent); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
+        }
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
     return 0;

@@ -149,8 +149,8 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
                               const std::size_t sample = std::size_t(table.edges[k] / 3u);
                               const int axis = int(table.edges[k] % 3u);
                               bool edgeMissing = false;
-                              table.crossings[k] = source.computeInOrder(
-                                  grid.sampleOf(sample), axis, edgeMissing, cursor);
+                              table.crossings[k] = source.computeInOrder(grid.sampleOf(sample),
+                                                                         axis, edgeMissing, cursor);
                               missingHere += edgeMissing;
                           }
                           missing += missingHere;

@@ -186,8 +186,7 @@ public:
     //! The same for edges visited in increasing key order (scan order): `cursor` is the index
     //! into input.hermite->edges of the first entry not below the previous edge's key (start: 0
     //! or a lower bound), and walks forward with the edges instead of a binary search per edge.
-    Crossing computeInOrder(const glm::ivec3& s, int axis, bool& missing,
-                            std::size_t& cursor) const
+    Crossing computeInOrder(const glm::ivec3& s, int axis, bool& missing, std::size_t& cursor) const
     {
         if (!mUseHermite)
             return compute(s, axis, missing, nullptr);
@@ -207,10 +206,10 @@ public:
         if (!mUseHermite)
             return 0;
         const std::vector<plugin::HermiteEdge>& edges = mInput.hermite->edges;
-        const auto it = std::lower_bound(
-            edges.begin(), edges.end(), key, [&](const plugin::HermiteEdge& e, std::uint64_t k) {
-                return mInput.hermite->key(e.sample, e.axis) < k;
-            });
+        const auto it = std::lower_bound(edges.begin(), edges.end(), key,
+                                         [&](const plugin::HermiteEdge& e, std::uint64_t k) {
+                                             return mInput.hermite->key(e.sample, e.axis) < k;
+                                         });
         return std::size_t(it - edges.begin());
     }
 

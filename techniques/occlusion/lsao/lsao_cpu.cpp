@@ -153,8 +153,8 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
         if (wLower > 0.0f) {
             // The upstream sample itself and its dominant occluder.
             lowerDominant = loadDominant(g, d, k, line, c, row, lower[j], slice, x, minDistance);
-            self = loadLineSample(layout, g.projection, g.depth, g.normal, d, c, lower[j], slice,
-                                  x, minDistance);
+            self = loadLineSample(layout, g.projection, g.depth, g.normal, d, c, lower[j], slice, x,
+                                  minDistance);
             addScaled(total, lineWeight * wLower,
                       evaluateOccluders(slice, lowerDominant, self, near, g.radius, g.invRadius,
                                         g.smoothstep));
@@ -310,10 +310,9 @@ void computeOnCpu(const Layout& layout, const plugin::ScreenProjection& projecti
                             !isSameSurface(pi, z, nRaw, glm::vec2(qx, qy) + 0.5f, zq, nq,
                                            projection.scale, projection.offset, layout.invSize))
                             continue;
-                        const float share =
-                            float(directionCount) /
-                            float(countClassDirections(computePixelClass(qx, qy, n),
-                                                       directionCount, n));
+                        const float share = float(directionCount) /
+                                            float(countClassDirections(computePixelClass(qx, qy, n),
+                                                                       directionCount, n));
                         const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
                         obscurance += share * sums.obscurance[q];
                         visibility += share * sums.visibility[q];
@@ -322,8 +321,9 @@ void computeOnCpu(const Layout& layout, const plugin::ScreenProjection& projecti
                     }
                 }
                 const float inv = 1.0f / count;
-                const PixelResult r = resolvePixel(glm::normalize(nRaw), inv * obscurance, inv * visibility,
-                                                   inv * moment, int(directionCount));
+                const PixelResult r =
+                    resolvePixel(glm::normalize(nRaw), inv * obscurance, inv * visibility,
+                                 inv * moment, int(directionCount));
                 out.ambient.at(px, py) = r.ambient;
                 out.bentNormal.at(px, py) = r.bentNormal;
                 out.coneAperture.at(px, py) = r.aperture;

@@ -151,8 +151,9 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
         }
         cmd.dispatch(mResolve,
                      {gpu::Binding::storageImage(0, depth), gpu::Binding::storageImage(3, normal),
-                      gpu::Binding::storageImage(4, mAccumA), gpu::Binding::storageImage(5, mAccumB),
-                      gpu::Binding::storageImage(6, mOutA), gpu::Binding::storageImage(7, mOutB)},
+                      gpu::Binding::storageImage(4, mAccumA),
+                      gpu::Binding::storageImage(5, mAccumB), gpu::Binding::storageImage(6, mOutA),
+                      gpu::Binding::storageImage(7, mOutB)},
                      gpu::PushConstants(constants.back()),
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), kGatherGroupSize),
                                      gpu::computeGroupCount(std::uint64_t(h), kGatherGroupSize), 1},

@@ -1,8 +1,8 @@
 #pragma once
 // The Vulkan version: shaders/lsao_sweep.comp ("lsao.sweep") and shaders/lsao_gather.comp
 // ("lsao.gather"), one pair of dispatches per batch of directions (one batch at the default
-// settings), then shaders/lsao_resolve.comp ("lsao.resolve"). Pipelines are built on first use; images and buffers are kept across frames and
-// rebuilt when the image size or the layout grows.
+// settings), then shaders/lsao_resolve.comp ("lsao.resolve"). Pipelines are built on first use;
+// images and buffers are kept across frames and rebuilt when the image size or the layout grows.
 
 #include "lsao_core.h"
 

@@ -435,10 +435,12 @@ TEST(Lsao, InterleavingSharesTheDirectionsOutAndTheResolveRestoresThem)
     // Against a dense evaluation (128 directions, 1-px steps and lines) on the floor-box scene,
     // the defaults with 4 directions per pixel (interleave 3) against all 36 per pixel.
     const GBuffer g = renderScene(makeFloorBoxScene(), 160, 120);
-    const auto reference = runCpu(
-        {{"directions", std::int64_t(128)}, {"step", 1.0}, {"line_spacing", 1.0}, {"jitter", false},
-         {"interleave", std::int64_t(1)}},
-        g);
+    const auto reference = runCpu({{"directions", std::int64_t(128)},
+                                   {"step", 1.0},
+                                   {"line_spacing", 1.0},
+                                   {"jitter", false},
+                                   {"interleave", std::int64_t(1)}},
+                                  g);
     std::map<std::int64_t, double> error;
     for (const std::int64_t n : {1, 2, 3}) {
         error[n] = computeMeanError(runCpu({{"interleave", n}}, g), reference, g);
