@@ -19,8 +19,7 @@
 #include "gpu/context.h"
 #include "metrics/timing.h"
 #include "families/occlusion/occlusion.h"
-#include "plugin/screen_space.h"
-#include "scene/camera.h"
+#include "families/occlusion/synthetic_gbuffer.h"
 
 #include <glm/geometric.hpp>
 
@@ -39,13 +38,6 @@
 using namespace rtlab;
 
 namespace {
-
-struct SyntheticGBuffer {
-    Image<float> depth;
-    Image<glm::vec3> normal;
-    glm::mat4 projection{1.0f};
-    glm::mat4 view{1.0f};
-};
 
 //! Nearest hit of a view-space ray from the origin: distance and normal facing the camera.
 std::optional<std::pair<float, glm::vec3>> hitScene(const glm::vec3& d)
@@ -74,29 +66,13 @@ std::optional<std::pair<float, glm::vec3>> hitScene(const glm::vec3& d)
     return best;
 }
 
-SyntheticGBuffer makeGBuffer(int w, int h)
+//! The scene above seen through a 60-degree camera at the origin.
+occlusion::SyntheticGBuffer makeGBuffer(int w, int h)
 {
-    scene::Camera camera;
-    camera.position = {0, 0, 0};
-    camera.target = {0, 0, -1};
-    camera.verticalFovDegrees = 60.0f;
-    camera.nearPlane = 0.05f;
-    camera.farPlane = 100.0f;
-    SyntheticGBuffer g;
-    g.projection = camera.projectionMatrix(float(w) / float(h), glm::vec2(0.0f), {w, h});
-    g.view = camera.viewMatrix();
-    g.depth = Image<float>(w, h, std::numeric_limits<float>::infinity());
-    g.normal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
-    const auto sp = plugin::ScreenProjection::fromMatrix(g.projection, w, h);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const glm::vec3 dir = glm::normalize(sp.toView({x + 0.5f, y + 0.5f}, 1.0f));
-            if (const auto hit = hitScene(dir)) {
-                g.depth.at(x, y) = -(dir * hit->first).z;
-                g.normal.at(x, y) = hit->second;
-            }
-        }
-    return g;
+    return occlusion::makeSyntheticGBuffer(w, h, 60.0f, [](const glm::vec3& d) {
+        const auto hit = hitScene(d);
+        return hit ? *hit : std::pair{-1.0f, glm::vec3(0.0f)};
+    });
 }
 
 struct Options {
@@ -272,7 +248,7 @@ int main(int argc, char** argv)
                 options.cpu ? "CPU (plain C++ path)" : gpu->getDeviceInfo().name.c_str(), source,
                 options.repeats, options.warmup);
 
-    std::vector<SyntheticGBuffer> gbuffers;
+    std::vector<occlusion::SyntheticGBuffer> gbuffers;
     for (const auto& [w, h] : sizes)
         gbuffers.push_back(makeGBuffer(w, h));
 
@@ -285,7 +261,7 @@ int main(int argc, char** argv)
                              std::size_t s) {
         auto technique = entry.create(params);
         auto& occlusion = dynamic_cast<plugin::OcclusionTechnique&>(*technique);
-        const SyntheticGBuffer& g = gbuffers[s];
+        const occlusion::SyntheticGBuffer& g = gbuffers[s];
         plugin::OcclusionInput input;
         input.linearDepth = &g.depth;
         input.normal = &g.normal;

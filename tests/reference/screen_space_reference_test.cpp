@@ -16,6 +16,7 @@
 #include "reference/screen_space_reference.h"
 
 #include "core/error.h"
+#include "families/occlusion/synthetic_gbuffer.h"
 #include "test_scenes.h"
 
 #include <glm/geometric.hpp>
@@ -66,30 +67,12 @@ ViewImages makeViewImages(const scene::GBuffer& g)
 ViewImages makeAnalyticView(int w, int h, float fovDegrees,
                             const std::function<std::pair<float, glm::vec3>(const glm::vec3&)>& hit)
 {
-    scene::Camera camera;
-    camera.position = {0, 0, 0};
-    camera.target = {0, 0, -1};
-    camera.verticalFovDegrees = fovDegrees;
-    camera.nearPlane = 1e-3f;
-    camera.farPlane = 1e6f;
+    occlusion::SyntheticGBuffer g = occlusion::makeSyntheticGBuffer(w, h, fovDegrees, hit);
     ViewImages v;
-    v.projection = camera.projectionMatrix(float(w) / float(h), glm::vec2(0.0f), {w, h});
-    v.viewMatrix = camera.viewMatrix();
-    v.depth = Image<float>(w, h, std::numeric_limits<float>::infinity());
-    v.normal = Image<glm::vec3>(w, h, glm::vec3(0.0f));
-    const float sx = v.projection[0][0];
-    const float sy = v.projection[1][1];
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const glm::vec2 ndc(2.0f * (x + 0.5f) / float(w) - 1.0f,
-                                2.0f * (y + 0.5f) / float(h) - 1.0f);
-            const glm::vec3 dir = glm::normalize(glm::vec3(ndc.x / sx, ndc.y / sy, -1.0f));
-            const auto [t, n] = hit(dir);
-            if (t > 0.0f && std::isfinite(t)) {
-                v.depth.at(x, y) = -(dir * t).z;
-                v.normal.at(x, y) = n;
-            }
-        }
+    v.projection = g.projection;
+    v.viewMatrix = g.view;
+    v.depth = std::move(g.depth);
+    v.normal = std::move(g.normal);
     return v;
 }
 
