@@ -34,6 +34,24 @@ void checkImageFileSize(const std::string& path, long long width, long long heig
 
 namespace {
 
+//! The size in bytes of a value of an OpenEXR attribute type whose size is fixed (OpenEXR file
+//! layout, "attribute types"), or -1 for the variable-size ones (string, chlist, stringvector,
+//! preview, opaque types).
+int getFixedAttributeSize(const std::string& type)
+{
+    static const std::pair<const char*, int> kSizes[] = {
+        {"box2i", 16},   {"box2f", 16},    {"chromaticities", 32}, {"compression", 1},
+        {"double", 8},   {"envmap", 1},    {"float", 4},           {"int", 4},
+        {"keycode", 28}, {"lineOrder", 1}, {"m33f", 36},           {"m44f", 64},
+        {"m33d", 72},    {"m44d", 128},    {"rational", 8},        {"tiledesc", 9},
+        {"timecode", 8}, {"v2i", 8},       {"v2f", 8},             {"v2d", 16},
+        {"v3i", 12},     {"v3f", 12},      {"v3d", 24},            {"deepImageState", 1}};
+    for (const auto& [name, size] : kSizes)
+        if (type == name)
+            return size;
+    return -1;
+}
+
 //! A cursor over the header bytes; every read is bounds-checked.
 class HeaderReader {
 public:
@@ -131,6 +149,13 @@ void checkExrHeader(const std::string& path)
         const std::int32_t size = r.readInt();
         if (size < 0)
             r.fail("attribute '" + name + "' has a negative size");
+        // OpenEXR reads a value of a fixed-size type by its type, not by the size field: a
+        // different size would make its reading of the rest of the header differ from this one
+        // (a later "string" then claims gigabytes, which the decoder allocates before reading).
+        const int fixed = getFixedAttributeSize(type);
+        if (fixed >= 0 && size != fixed)
+            r.fail("attribute '" + name + "' of type " + type + " has size " + std::to_string(size) +
+                   ", expected " + std::to_string(fixed));
         HeaderReader value = r.slice(std::size_t(size));
         if (name == "dataWindow" && type == "box2i") {
             const long long xMin = value.readInt(), yMin = value.readInt();

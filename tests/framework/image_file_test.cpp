@@ -79,6 +79,25 @@ TEST(ExrHeader, RtlabsOwnFilesPassAndHugeOrTruncatedHeadersAreRefused)
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("do not fit"), std::string::npos) << e.what();
     }
+    // A box2i whose size field says 80 bytes: OpenEXR reads 16 by the type, then parses the
+    // rest of the header differently from this check (the fuzzer found a file whose next string
+    // attribute then claimed 2 GB). Refused, naming the attribute.
+    {
+        std::string wide = bytes;
+        const std::string key = std::string("dataWindow\0box2i\0", 17);
+        const std::size_t at = wide.find(key);
+        ASSERT_NE(at, std::string::npos);
+        const std::int32_t size = 80;
+        std::memcpy(wide.data() + at + key.size(), &size, sizeof size);
+        try {
+            experiment::readExrRgb(writeBytes("wide_box.exr", wide).string());
+            FAIL() << "no error";
+        } catch (const Error& e) {
+            EXPECT_NE(std::string(e.what()).find("'dataWindow' of type box2i has size 80, expected 16"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
     // Cut inside the header, and not an EXR at all.
     EXPECT_THROW(checkExrHeader(writeBytes("cut.exr", bytes.substr(0, 40)).string()), Error);
     EXPECT_THROW(checkExrHeader(writeBytes("text.exr", "hello").string()), Error);
