@@ -47,21 +47,9 @@ SyntheticGBuffer makeCrease() { return occlusion::makePlanesGBuffer(64, 48, 60.0
 
 } // namespace
 
-// Cases a technique fails by the design of its algorithm, each documented in its README.
-const std::vector<test::KnownFailure> kKnownFailures = {
-    {"lsao", "crease_closed_form",
-     "LSAO's dominant occluder is the highest horizon over the whole sweep line, so a wall beside "
-     "the receiver "
-     "counts at the distance of its visible top, beyond the radius, unless a nearer sample rises "
-     "above the "
-     "tangent plane (techniques/occlusion/lsao/README.md): it under-occludes, with row-mean RMSE "
-     "0.64 of that of "
-     "answering 1 at 64x48 (0.57 with every direction per pixel, interleave 1; GTAO 0.18)"},
-};
-
 TEST_P(OcclusionSuite, EveryStressCasePassesCpuAndGpu)
 {
-    test::expectEveryStressCasePasses(plugin::builtinRegistry(), *GetParam(), &context(), kKnownFailures);
+    test::expectEveryStressCasePasses(plugin::builtinRegistry(), *GetParam(), &context());
     EXPECT_EQ(context().getValidationLog()->countMessages(), 0u);
 }
 

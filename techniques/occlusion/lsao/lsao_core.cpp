@@ -185,6 +185,44 @@ void sortPair(Occluder& a, Occluder& b)
         std::swap(a, b);
 }
 
+//! Sub-intervals of the part of a half-slice interval where a wall is nearer than the radius.
+constexpr int kWallSteps = 4;
+
+Angle makeAngleAt(float theta)
+{
+    return {theta, std::cos(theta), std::sin(theta)};
+}
+
+//! The obscurance of the rays between angles a and b (measures fa, fb) blocked by occluders whose
+//! nearest own distance is `distance` and nearest wall `wall`: each ray is weighted by 1 - rho of
+//! min(distance, wall / cos(elevation)), the elevation measured from the tangent plane (hi). Where
+//! the wall is nearer than the radius (elevation below acos(wall / radius)) the weight varies
+//! along the interval: a midpoint rule over kWallSteps sub-intervals of exact measure.
+float integrateInterval(const Slice& sl, const Angle& a, const Angle& b, float fa, float fb,
+                        float distance, float wall, float invRadius, bool smoothstep)
+{
+    const float base = 1.0f - evaluateFalloff(distance, invRadius, smoothstep);
+    float sum = base * std::max(0.0f, fb - fa);
+    const float x = wall * invRadius;
+    if (!(x < 1.0f) || !(fb > fa))
+        return sum;
+    const float begin = std::max(a.theta, sl.hi.theta - std::acos(x));
+    const float end = b.theta;
+    if (!(end > begin))
+        return sum;
+    const float width = (end - begin) * (1.0f / float(kWallSteps));
+    float f0 = begin > a.theta ? computeSliceF(sl, makeAngleAt(begin)) : fa;
+    for (int j = 0; j < kWallSteps; ++j) {
+        const float t1 = begin + float(j + 1) * width;
+        const float f1 = j + 1 == kWallSteps ? fb : computeSliceF(sl, makeAngleAt(t1));
+        const float elevation = sl.hi.theta - (t1 - 0.5f * width);
+        const float w = 1.0f - evaluateFalloff(wall / std::cos(elevation), invRadius, smoothstep);
+        sum += std::max(0.0f, w - base) * std::max(0.0f, f1 - f0);
+        f0 = f1;
+    }
+    return sum;
+}
+
 } // namespace
 
 Contribution evaluateOccluders(const Slice& slice, Occluder o0, Occluder o1, Occluder o2,
@@ -203,16 +241,23 @@ Contribution evaluateOccluders(const Slice& slice, Occluder o0, Occluder o1, Occ
     const float f1 = computeSliceF(slice, a1);
     const float f2 = computeSliceF(slice, a2);
     // [Timonen 2013: obscurance; Zhukov 1998] obscurance: from each occluder's horizon to the
-    // tangent plane, rays are weighted by 1 - rho of the nearest occluder above them.
+    // tangent plane, rays are weighted by 1 - rho of the nearest hit above them (an occluder, or
+    // the wall below one).
     const float n0 = o0.distance;
     const float n1 = std::min(n0, o1.distance);
     const float n2 = std::min(n1, o2.distance);
+    const float w0 = o0.wall;
+    const float w1 = std::min(w0, o1.wall);
+    const float w2 = std::min(w1, o2.wall);
     Contribution c;
-    c.obscurance =
-        (1.0f - evaluateFalloff(n0, invRadius, smoothstep)) * std::max(0.0f, f1 - f0) +
-        (1.0f - evaluateFalloff(n1, invRadius, smoothstep)) * std::max(0.0f, f2 - f1) +
-        (1.0f - evaluateFalloff(n2, invRadius, smoothstep)) * std::max(0.0f, slice.fHi - f2);
-    // Visibility (rho = step at the radius): blocked below the highest occluder within it.
+    c.obscurance = integrateInterval(slice, a0, a1, f0, f1, n0, w0, invRadius, smoothstep) +
+                   integrateInterval(slice, a1, a2, f1, f2, n1, w1, invRadius, smoothstep) +
+                   integrateInterval(slice, a2, slice.hi, f2, slice.fHi, n2, w2, invRadius,
+                                     smoothstep);
+    // Visibility (rho = step at the radius): blocked below the highest occluder within it. The
+    // walls are left out here: with them the aperture of the study's scenes turned from 1.6
+    // degrees too open to 0.7 too closed, and its mean absolute error grew (1.7 -> 2.8 degrees,
+    // ao_testbed, radius 0.5); the occluder's own distance is the better visibility estimate.
     const bool in0 = o0.distance < radius, in1 = o1.distance < radius, in2 = o2.distance < radius;
     if (in0 || in1 || in2) {
         const Angle& a = in0 ? a0 : (in1 ? a1 : a2);

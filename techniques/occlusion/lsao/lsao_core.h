@@ -476,6 +476,12 @@ struct Occluder {
     Angle angle;
     float distance = 0.0f; //!< world units, |p - x|
     bool valid = false;    //!< on the upstream side and not the receiver itself
+    //! World units: where the occluder stands on the receiver's tangent plane (its foot is the
+    //! visible surface, see findWallFoot), the distance from the receiver to the wall below it,
+    //! measured in the slice along the tangent plane; the rays below the occluder then meet
+    //! that wall at wall / cos(elevation). Infinity where no wall is known: every ray below the
+    //! occluder takes the occluder's own distance.
+    float wall = std::numeric_limits<float>::infinity();
 };
 
 //! Projects the view-space point `p` (a G-buffer sample, possibly from a neighbouring line)
@@ -489,6 +495,61 @@ struct Occluder {
 //! Invalid when not upstream (b' <= 0) or closer than minDistance.
 Occluder projectOccluder(const Slice& slice, const glm::vec3& x, const glm::vec3& p,
                          float minDistance);
+
+// ---- Walls below occluders -----------------------------------------------------------------
+// Screen-space horizons know where an occluder's top is, not what lies below it: the gather's
+// model blocks every ray below an occluder at the occluder's own distance. Where a wall or a
+// second plane meets the receiver's plane (a crease: a floor against a wall), the rays below the
+// occluder's top meet the wall much nearer than its top, and with a distance falloff that is most
+// of the occlusion; the top of a tall wall beyond the radius would count for nothing. The
+// sweep's hull keeps only the top (the wall's lower samples are collinear with it in the
+// projective plane, or below the chord to it). So the gather tests a hypothesis per occluder:
+// a wall stands from the occluder down to the receiver's tangent plane. The hypothesis is
+// accepted only when its foot, the occluder projected onto the tangent plane, is itself the
+// visible surface in the depth buffer (the two planes really meet there; computeFootSupport). It is rejected where
+// the foot is hidden, e.g. behind a foreground object in front of a wall facing the camera: the
+// object stands off the wall, and the rays between them are free (the halo that a depth-thick
+// wall would cast; the falloff by the occluder's own distance keeps that case).
+
+//! The occluder's elevation above the tangent plane in the slice, and the foot of the
+//! hypothetical wall below it: `height` = dot(p - x, n) above the plane (n unit), `foot` = p
+//! projected along n onto the plane, `wall` = distance to the wall along the tangent plane in
+//! the slice (o.distance cos(elevation)). `worth` is false where a wall could not change the
+//! result: the occluder below the plane, or the wall beyond the radius everywhere.
+struct WallFoot {
+    glm::vec3 foot{0.0f};
+    float height = 0.0f;
+    float wall = std::numeric_limits<float>::infinity();
+    bool worth = false;
+};
+
+inline WallFoot findWallFoot(const Slice& sl, const glm::vec3& x, const glm::vec3& n,
+                             const glm::vec3& p, const Occluder& o, float radius)
+{
+    WallFoot f;
+    if (!o.valid)
+        return f;
+    const float elevation = sl.hi.theta - o.angle.theta;
+    f.height = glm::dot(p - x, n);
+    if (!(elevation > 0.0f && elevation < 1.57079637f) || !(f.height > 0.0f))
+        return f;
+    f.wall = o.distance * std::cos(elevation);
+    f.foot = p - f.height * n;
+    f.worth = f.wall > 0.0f && f.wall < radius && f.foot.z < 0.0f;
+    return f;
+}
+
+//! How far the foot at linear depth `footDepth` is the visible surface, whose depth at the foot's
+//! screen position is `surfaceDepth` (the tangent plane of the pixel containing it), as the factor
+//! the wall's distance is divided by: 1 within a tenth of the wall's height plus 1e-4 of the depth
+//! (rounding of the projection), falling linearly to 0 (no wall) at twice that. A foreground
+//! object hiding the foot stands off the plane by about the wall's height; the ramp keeps the
+//! result continuous where a foot slides behind an edge.
+inline float computeFootSupport(float footDepth, float surfaceDepth, float height)
+{
+    const float tolerance = 0.1f * height + 1e-4f * footDepth;
+    return std::clamp(2.0f - std::fabs(surfaceDepth - footDepth) / tolerance, 0.0f, 1.0f);
+}
 
 //! rho(distance / radius) as obscurance falloff: 1 at and beyond the radius.
 inline float evaluateFalloff(float distance, float invRadius, bool smoothstep)
@@ -510,8 +571,9 @@ struct Contribution {
 
 //! The contribution of a half-slice with up to three occluders (invalid ones ignored; pass
 //! Occluder{} for unused ones). A ray at angle theta is blocked by every occluder whose angle is
-//! at most theta; it is weighted by 1 - rho of the nearest of those. Visibility: blocked by those
-//! nearer than radius. Branch-free (a 3-element sorting network), as in the shader.
+//! at most theta; it is weighted by 1 - rho of the nearest hit among those: the occluder's own
+//! distance, or its wall's (wall / cos(elevation)) where it has one. Visibility: blocked by
+//! those whose hit is nearer than the radius. A 3-element sorting network, as in the shader.
 Contribution evaluateOccluders(const Slice& slice, Occluder o0, Occluder o1, Occluder o2,
                                float radius, float invRadius, bool smoothstep);
 

@@ -17,41 +17,6 @@ float loadDepth(const Image<float>& depth, glm::ivec2 pixel)
     return z > 0.0f && z < std::numeric_limits<float>::infinity() ? z : 0.0f;
 }
 
-//! The G-buffer point of `pixel` (its centre at its depth) as an occluder of the slice.
-Occluder loadOccluder(const Image<float>& depth, const plugin::ScreenProjection& projection,
-                      glm::ivec2 pixel, const Slice& slice, const glm::vec3& x, float minDistance)
-{
-    const float z = loadDepth(depth, pixel);
-    if (z == 0.0f)
-        return Occluder{};
-    return projectOccluder(slice, x, projection.toView(glm::vec2(pixel) + 0.5f, z), minDistance);
-}
-
-//! The view-space point of a line sample: on its line at the depth of its pixel's tangent plane
-//! (computeSampleHeight), or where that is rejected the pixel centre's G-buffer point.
-Occluder loadLineSample(const Layout& layout, const plugin::ScreenProjection& projection,
-                        const Image<float>& depth, const Image<glm::vec3>& normal,
-                        const Direction& d, float c, const LineSample& sample, const Slice& slice,
-                        const glm::vec3& x, float minDistance)
-{
-    const float z = sample.exists ? loadDepth(depth, sample.pixel) : 0.0f;
-    if (z == 0.0f)
-        return Occluder{};
-    const glm::vec2 q = computeLinePoint(d, sample.t, c);
-    const SampleHeight h =
-        computeSampleHeight(layout, q, sample.pixel, z, normal.at(sample.pixel.x, sample.pixel.y));
-    const glm::vec3 p = h.onLine ? projection.toView(q, h.b / h.a)
-                                 : projection.toView(glm::vec2(sample.pixel) + 0.5f, z);
-    return projectOccluder(slice, x, p, minDistance);
-}
-
-void addScaled(Contribution& total, float weight, const Contribution& c)
-{
-    total.obscurance += weight * c.obscurance;
-    total.visibility += weight * c.visibility;
-    total.moment += weight * c.moment;
-}
-
 struct GatherContext {
     const Layout& layout;
     const plugin::ScreenProjection& projection;
@@ -64,17 +29,86 @@ struct GatherContext {
     float invRadius;
 };
 
+//! The receiver of a gather: its view-space point, unit normal and half-slice.
+struct Receiver {
+    const Slice& slice;
+    glm::vec3 x;
+    glm::vec3 n;
+    float minDistance;
+};
+
+//! Gives occluder o (view-space point p) the wall below it where its foot on the receiver's
+//! tangent plane is the visible surface (findWallFoot, computeFootSupport): the foot's depth
+//! against the tangent plane of the pixel containing its projection; a partly supported wall
+//! counts farther away (its distance divided by the support).
+void findWall(const GatherContext& g, const Receiver& r, const glm::vec3& p, Occluder& o)
+{
+    const WallFoot f = findWallFoot(r.slice, r.x, r.n, p, o, g.radius);
+    if (!f.worth)
+        return;
+    const glm::vec2 q = g.projection.toPixel(f.foot);
+    if (!(q.x >= 0.0f && q.y >= 0.0f && q.x < float(g.layout.width) &&
+          q.y < float(g.layout.height)))
+        return;
+    const glm::ivec2 pixel(int(std::floor(q.x)), int(std::floor(q.y)));
+    const float z = loadDepth(g.depth, pixel);
+    if (z == 0.0f)
+        return;
+    const SampleHeight h =
+        computeSampleHeight(g.layout, q, pixel, z, g.normal.at(pixel.x, pixel.y));
+    const float surface = h.onLine ? h.b / h.a : z;
+    const float support = computeFootSupport(-f.foot.z, surface, f.height);
+    if (support > 0.0f)
+        o.wall = f.wall / support;
+}
+
+//! The G-buffer point of `pixel` (its centre at its depth) as an occluder of the slice.
+Occluder loadOccluder(const GatherContext& g, glm::ivec2 pixel, const Receiver& r)
+{
+    const float z = loadDepth(g.depth, pixel);
+    if (z == 0.0f)
+        return Occluder{};
+    const glm::vec3 p = g.projection.toView(glm::vec2(pixel) + 0.5f, z);
+    Occluder o = projectOccluder(r.slice, r.x, p, r.minDistance);
+    findWall(g, r, p, o);
+    return o;
+}
+
+//! The view-space point of a line sample: on its line at the depth of its pixel's tangent plane
+//! (computeSampleHeight), or where that is rejected the pixel centre's G-buffer point.
+Occluder loadLineSample(const GatherContext& g, const Direction& d, float c,
+                        const LineSample& sample, const Receiver& r)
+{
+    const float z = sample.exists ? loadDepth(g.depth, sample.pixel) : 0.0f;
+    if (z == 0.0f)
+        return Occluder{};
+    const glm::vec2 q = computeLinePoint(d, sample.t, c);
+    const SampleHeight h = computeSampleHeight(g.layout, q, sample.pixel, z,
+                                               g.normal.at(sample.pixel.x, sample.pixel.y));
+    const glm::vec3 p = h.onLine ? g.projection.toView(q, h.b / h.a)
+                                 : g.projection.toView(glm::vec2(sample.pixel) + 0.5f, z);
+    Occluder o = projectOccluder(r.slice, r.x, p, r.minDistance);
+    findWall(g, r, p, o);
+    return o;
+}
+
+void addScaled(Contribution& total, float weight, const Contribution& c)
+{
+    total.obscurance += weight * c.obscurance;
+    total.visibility += weight * c.visibility;
+    total.moment += weight * c.moment;
+}
+
 //! The dominant occluder stored for `sample` (kNoOccluder: none) as seen from the receiver.
 Occluder loadDominant(const GatherContext& g, const Direction& d, std::uint32_t k,
                       std::uint32_t line, float c, std::uint32_t row, const LineSample& sample,
-                      const Slice& slice, const glm::vec3& x, float minDistance)
+                      const Receiver& r)
 {
     const std::uint32_t id = g.sweep[row + std::uint32_t(sample.stratum)];
     if (id == kNoOccluder)
         return Occluder{};
     const LineSample s = locateSample(g.layout, d, k, line, c, int(id));
-    return loadLineSample(g.layout, g.projection, g.depth, g.normal, d, c, s, slice, x,
-                          minDistance);
+    return loadLineSample(g, d, c, s, r);
 }
 
 //! The contribution of direction k at receiver x (pixel centre p, unit normal n).
@@ -92,7 +126,7 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
     const Slice slice = makeSlice(x, n, glm::vec3(d.axis));
     if (!slice.hasHemisphere)
         return total;
-    const float minDistance = 1e-4f * glm::length(x);
+    const Receiver r{slice, x, n, 1e-4f * glm::length(x)};
 
     const float cX = p.x * d.perp.x + p.y * d.perp.y;
     const float tX = p.x * d.dir.x + p.y * d.dir.y;
@@ -125,7 +159,7 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
         const float delta = std::max(0.5f * gap, 1.0f);
         const glm::vec2 q(p.x - delta * d.dir.x, p.y - delta * d.dir.y);
         const glm::ivec2 pixel(int(std::floor(q.x)), int(std::floor(q.y)));
-        near = loadOccluder(g.depth, g.projection, pixel, slice, x, minDistance);
+        near = loadOccluder(g, pixel, r);
     }
 
     for (int j = 0; j < 2; ++j) {
@@ -152,9 +186,8 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
         Occluder lowerDominant, self;
         if (wLower > 0.0f) {
             // The upstream sample itself and its dominant occluder.
-            lowerDominant = loadDominant(g, d, k, line, c, row, lower[j], slice, x, minDistance);
-            self = loadLineSample(layout, g.projection, g.depth, g.normal, d, c, lower[j], slice, x,
-                                  minDistance);
+            lowerDominant = loadDominant(g, d, k, line, c, row, lower[j], r);
+            self = loadLineSample(g, d, c, lower[j], r);
             addScaled(total, lineWeight * wLower,
                       evaluateOccluders(slice, lowerDominant, self, near, g.radius, g.invRadius,
                                         g.smoothstep));
@@ -166,7 +199,7 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
                 wLower > 0.0f && id == std::uint32_t(lower[j].stratum) ? self
                 : wLower > 0.0f && id == lowerId
                     ? lowerDominant
-                    : loadDominant(g, d, k, line, c, row, upper[j], slice, x, minDistance);
+                    : loadDominant(g, d, k, line, c, row, upper[j], r);
             addScaled(total, lineWeight * wUpper,
                       evaluateOccluders(slice, dominant, near, Occluder{}, g.radius, g.invRadius,
                                         g.smoothstep));

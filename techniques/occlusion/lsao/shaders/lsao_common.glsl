@@ -310,11 +310,12 @@ struct Occluder {
     Angle angle;
     float distance;
     bool valid;
+    float wall; // lsao::Occluder::wall: LSAO_INF where no wall is known
 };
 
 Occluder lsaoNoOccluder()
 {
-    return Occluder(Angle(0.0, 1.0, 0.0), 0.0, false);
+    return Occluder(Angle(0.0, 1.0, 0.0), 0.0, false, LSAO_INF);
 }
 
 // lsao::projectOccluder: moved into the slice along the tangent plane; c and b eye-relative.
@@ -331,6 +332,37 @@ Occluder lsaoProjectOccluder(Slice sl, vec3 x, vec3 p, float minDistance)
     o.angle = lsaoMakeAngle(a / r, b / r);
     o.valid = true;
     return o;
+}
+
+// lsao::WallFoot / findWallFoot: the foot of the wall below occluder o (point p) on the
+// receiver's tangent plane (x, unit n); worth = false where a wall could not change the result.
+struct WallFoot {
+    vec3 foot;
+    float height;
+    float wall;
+    bool worth;
+};
+
+WallFoot lsaoFindWallFoot(Slice sl, vec3 x, vec3 n, vec3 p, Occluder o)
+{
+    WallFoot f = WallFoot(vec3(0.0), 0.0, LSAO_INF, false);
+    if (!o.valid)
+        return f;
+    float elevation = sl.hi.theta - o.angle.theta;
+    f.height = dot(p - x, n);
+    if (!(elevation > 0.0 && elevation < 1.57079637) || !(f.height > 0.0))
+        return f;
+    f.wall = o.distance * cos(elevation);
+    f.foot = p - f.height * n;
+    f.worth = f.wall > 0.0 && f.wall < pc.radius && f.foot.z < 0.0;
+    return f;
+}
+
+// lsao::computeFootSupport.
+float lsaoFootSupport(float footDepth, float surfaceDepth, float height)
+{
+    float tolerance = 0.1 * height + 1e-4 * footDepth;
+    return clamp(2.0 - abs(surfaceDepth - footDepth) / tolerance, 0.0, 1.0);
 }
 
 float lsaoFalloff(float distance)
@@ -358,7 +390,41 @@ Angle lsaoClampAngle(Slice sl, Angle a)
 
 Occluder lsaoPrepareOccluder(Occluder o)
 {
-    return o.valid ? o : Occluder(Angle(4.0, 1.0, 0.0), LSAO_INF, false);
+    return o.valid ? o : Occluder(Angle(4.0, 1.0, 0.0), LSAO_INF, false, LSAO_INF);
+}
+
+#define LSAO_WALL_STEPS 4
+
+float lsaoSliceFAt(Slice sl, float theta)
+{
+    return lsaoSliceF(sl, Angle(theta, cos(theta), sin(theta)));
+}
+
+// lsao::integrateInterval: the rays in [a, b] weighted by 1 - rho of
+// min(distance, wall / cos(elevation)), a midpoint rule where the wall is within the radius.
+float lsaoIntegrateInterval(Slice sl, Angle a, Angle b, float fa, float fb, float distance,
+                            float wall)
+{
+    float base = 1.0 - lsaoFalloff(distance);
+    float sum = base * max(0.0, fb - fa);
+    float x = wall * pc.invRadius;
+    if (!(x < 1.0) || !(fb > fa))
+        return sum;
+    float begin = max(a.theta, sl.hi.theta - acos(x));
+    float end = b.theta;
+    if (!(end > begin))
+        return sum;
+    float width = (end - begin) * (1.0 / float(LSAO_WALL_STEPS));
+    float f0 = begin > a.theta ? lsaoSliceFAt(sl, begin) : fa;
+    for (int j = 0; j < LSAO_WALL_STEPS; ++j) {
+        float t1 = begin + float(j + 1) * width;
+        float f1 = j + 1 == LSAO_WALL_STEPS ? fb : lsaoSliceFAt(sl, t1);
+        float elevation = sl.hi.theta - (t1 - 0.5 * width);
+        float w = 1.0 - lsaoFalloff(wall / cos(elevation));
+        sum += max(0.0, w - base) * max(0.0, f1 - f0);
+        f0 = f1;
+    }
+    return sum;
 }
 
 // lsao::evaluateOccluders: up to three occluders, a branch-free sorting network.
@@ -390,14 +456,18 @@ Contribution lsaoEvaluateOccluders(Slice sl, Occluder o0, Occluder o1, Occluder 
     float f1 = lsaoSliceF(sl, a1);
     float f2 = lsaoSliceF(sl, a2);
     // [Timonen 2013: obscurance; Zhukov 1998] rays from each occluder's horizon to the tangent
-    // plane are weighted by 1 - rho of the nearest occluder above them.
+    // plane are weighted by 1 - rho of the nearest hit above them (an occluder, or its wall).
     float n0 = o0.distance;
     float n1 = min(n0, o1.distance);
     float n2 = min(n1, o2.distance);
+    float w0 = o0.wall;
+    float w1 = min(w0, o1.wall);
+    float w2 = min(w1, o2.wall);
     Contribution c = Contribution(0.0, 0.0, vec3(0.0));
-    c.obscurance = (1.0 - lsaoFalloff(n0)) * max(0.0, f1 - f0) +
-                   (1.0 - lsaoFalloff(n1)) * max(0.0, f2 - f1) +
-                   (1.0 - lsaoFalloff(n2)) * max(0.0, sl.fHi - f2);
+    c.obscurance = lsaoIntegrateInterval(sl, a0, a1, f0, f1, n0, w0) +
+                   lsaoIntegrateInterval(sl, a1, a2, f1, f2, n1, w1) +
+                   lsaoIntegrateInterval(sl, a2, sl.hi, f2, sl.fHi, n2, w2);
+    // Visibility without the walls (see lsao::evaluateOccluders).
     bool in0 = o0.distance < pc.radius;
     bool in1 = o1.distance < pc.radius;
     bool in2 = o2.distance < pc.radius;

@@ -15,17 +15,40 @@ layout(std430, set = 0, binding = 2) readonly buffer Sweep { uint sweep[]; };
 layout(set = 0, binding = 4, rgba32f) uniform image2D accumA;  // moment.xyz, obscurance
 layout(set = 0, binding = 5, r32f) uniform image2D accumB;     // visibility
 
-Occluder lsaoLoadOccluder(ivec2 pixel, Slice sl, vec3 x, float minDistance)
+// lsao::runGatherCpu's findWall: the wall below occluder o where its foot on the receiver's
+// tangent plane is the visible surface.
+void lsaoFindWall(Slice sl, vec3 x, vec3 n, vec3 p, inout Occluder o)
+{
+    WallFoot f = lsaoFindWallFoot(sl, x, n, p, o);
+    if (!f.worth)
+        return;
+    vec2 q = viewToScreen(f.foot, pc.projScale, pc.projOffset, pc.size);
+    if (!(q.x >= 0.0 && q.y >= 0.0 && q.x < float(pc.width) && q.y < float(pc.height)))
+        return;
+    ivec2 pixel = ivec2(int(floor(q.x)), int(floor(q.y)));
+    float z = lsaoLoadDepth(pixel);
+    if (z == 0.0)
+        return;
+    vec3 h = lsaoSampleHeight(q, pixel, z, imageLoad(normalImage, pixel).xyz);
+    float surface = h.z != 0.0 ? h.y / h.x : z;
+    float support = lsaoFootSupport(-f.foot.z, surface, f.height);
+    if (support > 0.0)
+        o.wall = f.wall / support;
+}
+
+Occluder lsaoLoadOccluder(ivec2 pixel, Slice sl, vec3 x, vec3 n, float minDistance)
 {
     float z = lsaoLoadDepth(pixel);
     if (z == 0.0)
         return lsaoNoOccluder();
     vec3 p = screenToView(vec2(pixel) + 0.5, z, pc.projScale, pc.projOffset, pc.size);
-    return lsaoProjectOccluder(sl, x, p, minDistance);
+    Occluder o = lsaoProjectOccluder(sl, x, p, minDistance);
+    lsaoFindWall(sl, x, n, p, o);
+    return o;
 }
 
 // The point of a line sample: on its line at its tangent-plane depth, else its pixel centre.
-Occluder lsaoLoadLineSample(Direction d, float c, LineSample ls, Slice sl, vec3 x,
+Occluder lsaoLoadLineSample(Direction d, float c, LineSample ls, Slice sl, vec3 x, vec3 n,
                             float minDistance)
 {
     float z = ls.exists ? lsaoLoadDepth(ls.pixel) : 0.0;
@@ -38,17 +61,19 @@ Occluder lsaoLoadLineSample(Direction d, float c, LineSample ls, Slice sl, vec3 
     vec3 p = h.z != 0.0 ? screenToView(q, h.y / h.x, pc.projScale, pc.projOffset, pc.size)
                         : screenToView(vec2(ls.pixel) + 0.5, z, pc.projScale, pc.projOffset,
                                        pc.size);
-    return lsaoProjectOccluder(sl, x, p, minDistance);
+    Occluder o = lsaoProjectOccluder(sl, x, p, minDistance);
+    lsaoFindWall(sl, x, n, p, o);
+    return o;
 }
 
 Occluder lsaoLoadDominant(Direction d, uint k, uint line, float c, uint row, LineSample ls,
-                          Slice sl, vec3 x, float minDistance)
+                          Slice sl, vec3 x, vec3 n, float minDistance)
 {
     uint id = sweep[row + uint(ls.stratum)];
     if (id == LSAO_NO_OCCLUDER)
         return lsaoNoOccluder();
     LineSample s = lsaoLocateSample(d, k, line, c, int(id));
-    return lsaoLoadLineSample(d, c, s, sl, x, minDistance);
+    return lsaoLoadLineSample(d, c, s, sl, x, n, minDistance);
 }
 
 void lsaoAddScaled(inout Contribution total, float weight, Contribution c)
@@ -99,7 +124,8 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         precise float delta = max(0.5 * gap, 1.0);
         precise float qx = p.x - delta * d.dir.x;
         precise float qy = p.y - delta * d.dir.y;
-        nearSample = lsaoLoadOccluder(ivec2(int(floor(qx)), int(floor(qy))), sl, x, minDistance);
+        nearSample =
+            lsaoLoadOccluder(ivec2(int(floor(qx)), int(floor(qy))), sl, x, n, minDistance);
     }
 
     for (int j = 0; j < 2; ++j) {
@@ -125,8 +151,8 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         Occluder lowerDominant = lsaoNoOccluder();
         Occluder self = lsaoNoOccluder();
         if (wLower > 0.0) {
-            lowerDominant = lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, minDistance);
-            self = lsaoLoadLineSample(d, c, lower[j], sl, x, minDistance);
+            lowerDominant = lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, n, minDistance);
+            self = lsaoLoadLineSample(d, c, lower[j], sl, x, n, minDistance);
             lsaoAddScaled(total, lineWeight * wLower,
                           lsaoEvaluateOccluders(sl, lowerDominant, self, nearSample));
         }
@@ -138,7 +164,7 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
             else if (wLower > 0.0 && id == lowerId)
                 dominant = lowerDominant;
             else
-                dominant = lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, minDistance);
+                dominant = lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, n, minDistance);
             lsaoAddScaled(total, lineWeight * wUpper,
                           lsaoEvaluateOccluders(sl, dominant, nearSample, lsaoNoOccluder()));
         }
