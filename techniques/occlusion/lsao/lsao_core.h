@@ -506,10 +506,10 @@ Occluder projectOccluder(const Slice& slice, const glm::vec3& x, const glm::vec3
 // projective plane, or below the chord to it). So the gather tests a hypothesis per occluder:
 // a wall stands from the occluder down to the receiver's tangent plane. The hypothesis is
 // accepted only when its foot, the occluder projected onto the tangent plane, is itself the
-// visible surface in the depth buffer (the two planes really meet there; computeFootSupport). It is rejected where
-// the foot is hidden, e.g. behind a foreground object in front of a wall facing the camera: the
-// object stands off the wall, and the rays between them are free (the halo that a depth-thick
-// wall would cast; the falloff by the occluder's own distance keeps that case).
+// visible surface in the depth buffer (the two planes really meet there; computeFootSupport). It is
+// rejected where the foot is hidden, e.g. behind a foreground object in front of a wall facing the
+// camera: the object stands off the wall, and the rays between them are free (the halo that a
+// depth-thick wall would cast; the falloff by the occluder's own distance keeps that case).
 
 //! The occluder's elevation above the tangent plane in the slice, and the foot of the
 //! hypothetical wall below it: `height` = dot(p - x, n) above the plane (n unit), `foot` = p

@@ -195,11 +195,10 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
         if (wUpper > 0.0f) {
             // The downstream sample's dominant occluder lies at or before the upstream sample.
             const std::uint32_t id = g.sweep[row + std::uint32_t(upper[j].stratum)];
-            const Occluder dominant =
-                wLower > 0.0f && id == std::uint32_t(lower[j].stratum) ? self
-                : wLower > 0.0f && id == lowerId
-                    ? lowerDominant
-                    : loadDominant(g, d, k, line, c, row, upper[j], r);
+            const Occluder dominant = wLower > 0.0f && id == std::uint32_t(lower[j].stratum) ? self
+                                      : wLower > 0.0f && id == lowerId
+                                          ? lowerDominant
+                                          : loadDominant(g, d, k, line, c, row, upper[j], r);
             addScaled(total, lineWeight * wUpper,
                       evaluateOccluders(slice, dominant, near, Occluder{}, g.radius, g.invRadius,
                                         g.smoothstep));
