@@ -158,6 +158,10 @@ config::ParamSchema Lsao::declareParams()
                     "obscurance falloff radius: occluders at or beyond it do not count");
     schema.addEnum("falloff", "linear", kFalloffChoices,
                    "obscurance falloff rho(d/r): linear x or smoothstep 3x^2-2x^3");
+    schema.addBool("walls", true,
+                   "a wall below each occluder whose foot on the receiver's tangent plane is the "
+                   "visible surface: the rays below the occluder meet it at their own distance "
+                   "(creases); false: at the occluder's distance, as in the paper");
     return schema;
 }
 
@@ -177,6 +181,7 @@ Lsao::Lsao(const config::ParamSet& params)
     mParams.directionSets = int(params.getInt("direction_sets"));
     mParams.interleave = int(params.getInt("interleave"));
     mParams.radius = params.getFloat("radius");
+    mParams.walls = params.getBool("walls");
     const std::string& falloff = params.getString("falloff");
     if (falloff == kFalloffChoices[0])
         mParams.falloff = Falloff::Linear;
@@ -201,6 +206,7 @@ config::ParamSet Lsao::effectiveParams() const
     p.set("interleave", std::int64_t(mParams.interleave));
     p.set("radius", mParams.radius);
     p.set("falloff", kFalloffChoices[mParams.falloff == Falloff::Linear ? 0 : 1]);
+    p.set("walls", mParams.walls);
     return p;
 }
 
@@ -221,7 +227,7 @@ void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
             plugin::ScreenProjection::fromMatrix(input.projection, w, h);
         const Layout layout = buildLayout(w, h, projection, mParams, input.frameIndex);
         if (!mGpu || &mGpu->getContext() != input.gpu)
-            mGpu = std::make_unique<GpuRunner>(*input.gpu);
+            mGpu = std::make_unique<GpuRunner>(*input.gpu, mParams.walls);
         mGpu->run(layout, projection, mParams, *input.gpuLinearDepth, *input.gpuNormal, out,
                   input.readBack);
         return;
@@ -248,7 +254,7 @@ void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
         return;
     }
     if (!mGpu || &mGpu->getContext() != input.gpu)
-        mGpu = std::make_unique<GpuRunner>(*input.gpu);
+        mGpu = std::make_unique<GpuRunner>(*input.gpu, mParams.walls);
     mGpu->run(layout, projection, mParams, depth, normal, out, input.readBack);
 }
 

@@ -157,6 +157,60 @@ Occluder projectOccluder(const Slice& slice, const glm::vec3& x, const glm::vec3
     return o;
 }
 
+WallBound makeWallBound(const Slice& sl, const Angle& theta, float f)
+{
+    // cos and sin of hi - theta by the angle difference: no transcendental function.
+    return {sl.hi.theta - theta.theta, sl.hi.c * theta.c + sl.hi.s * theta.s,
+            sl.hi.s * theta.c - sl.hi.c * theta.s, f};
+}
+
+WallBound makeWallCutoff(const Slice& sl, float x)
+{
+    WallBound w;
+    w.c = x;
+    w.s = std::sqrt(std::max(0.0f, 1.0f - x * x));
+    w.phi = computeAtan2(w.s, w.c);
+    const Angle theta{sl.hi.theta - w.phi, sl.hi.c * w.c + sl.hi.s * w.s,
+                      sl.hi.s * w.c - sl.hi.c * w.s};
+    w.f = computeSliceF(sl, theta);
+    return w;
+}
+
+float computeWallObscurance(const Slice& sl, const WallBound& lower, const WallBound& upper,
+                            float a, float base, bool smoothstep)
+{
+    // With the elevation phi = hi - theta (hi the tangent plane, nv >= 0), the measure is
+    // dF = np sin(hi - phi) sin(phi) dphi with np sin(hi) = nv, np cos(hi) = -nt. The weights
+    // 1 - a sec(phi) (linear falloff) and 1 - 3 a^2 sec^2(phi) + 2 a^3 sec^3(phi) (smoothstep)
+    // integrate in closed form against it:
+    //   np Int sin(hi - phi) sin(phi) sec(phi)   = -nv cos(phi) + nt (L(phi) - sin(phi))
+    //   np Int sin(hi - phi) sin(phi) sec^2(phi) = -nv ln cos(phi) + nt (tan(phi) - phi)
+    //   np Int sin(hi - phi) sin(phi) sec^3(phi) = nv sec(phi) + nt (sec(phi) tan(phi) - L(phi)) / 2
+    // with L(phi) = ln(sec(phi) + tan(phi)). Each is multiplied by its power of a and written
+    // with a sec(phi) <= 1 (the upper bound is at most acos(a)), so it stays finite as a -> 0.
+    struct Terms {
+        float t1 = 0.0f; //!< a np I1
+        float t2 = 0.0f; //!< a^2 np I2
+        float t3 = 0.0f; //!< a^3 np I3
+    };
+    auto evaluate = [&](const WallBound& w) {
+        const float as = a / w.c; // a sec(phi) <= 1
+        const float logSecTan = std::log((1.0f + w.s) / w.c);
+        Terms t;
+        t.t1 = a * (-sl.nv * w.c + sl.nt * (logSecTan - w.s));
+        if (smoothstep) {
+            t.t2 = a * a * (-sl.nv * std::log(w.c) + sl.nt * (w.s / w.c - w.phi));
+            t.t3 = a * a * sl.nv * as + sl.nt * (as * as * a * w.s - a * a * a * logSecTan) * 0.5f;
+        }
+        return t;
+    };
+    const Terms lo = evaluate(lower), hi = evaluate(upper);
+    const float measure = std::max(0.0f, lower.f - upper.f);
+    const float weighted = smoothstep ? measure - 3.0f * (hi.t2 - lo.t2) + 2.0f * (hi.t3 - lo.t3)
+                                      : measure - (hi.t1 - lo.t1);
+    return std::max(0.0f, weighted - base * measure);
+}
+
 namespace {
 
 Angle clampAngle(const Slice& slice, const Angle& a)
@@ -185,42 +239,26 @@ void sortPair(Occluder& a, Occluder& b)
         std::swap(a, b);
 }
 
-//! Sub-intervals of the part of a half-slice interval where a wall is nearer than the radius.
-constexpr int kWallSteps = 4;
-
-Angle makeAngleAt(float theta)
-{
-    return {theta, std::cos(theta), std::sin(theta)};
-}
-
 //! The obscurance of the rays between angles a and b (measures fa, fb) blocked by occluders whose
 //! nearest own distance is `distance` and nearest wall `wall`: each ray is weighted by 1 - rho of
-//! min(distance, wall / cos(elevation)), the elevation measured from the tangent plane (hi). Where
-//! the wall is nearer than the radius (elevation below acos(wall / radius)) the weight varies
-//! along the interval: a midpoint rule over kWallSteps sub-intervals of exact measure.
+//! min(distance, wall / cos(elevation)), the elevation measured from the tangent plane (hi).
 float integrateInterval(const Slice& sl, const Angle& a, const Angle& b, float fa, float fb,
                         float distance, float wall, float invRadius, bool smoothstep)
 {
     const float base = 1.0f - evaluateFalloff(distance, invRadius, smoothstep);
-    float sum = base * std::max(0.0f, fb - fa);
-    const float x = wall * invRadius;
-    if (!(x < 1.0f) || !(fb > fa))
+    const float sum = base * std::max(0.0f, fb - fa);
+    // The wall is the nearer hit where wall / cos(elevation) < min(distance, radius): below the
+    // elevation acos(wall / limit).
+    const float limit = std::min(distance, 1.0f / invRadius);
+    if (!(wall < limit) || !(fb > fa))
         return sum;
-    const float begin = std::max(a.theta, sl.hi.theta - std::acos(x));
-    const float end = b.theta;
-    if (!(end > begin))
+    const WallBound lower = makeWallBound(sl, b, fb);
+    const WallBound cutoff = makeWallCutoff(sl, wall / limit);
+    const WallBound top = makeWallBound(sl, a, fa);
+    const WallBound& upper = cutoff.phi < top.phi ? cutoff : top;
+    if (!(upper.phi > lower.phi))
         return sum;
-    const float width = (end - begin) * (1.0f / float(kWallSteps));
-    float f0 = begin > a.theta ? computeSliceF(sl, makeAngleAt(begin)) : fa;
-    for (int j = 0; j < kWallSteps; ++j) {
-        const float t1 = begin + float(j + 1) * width;
-        const float f1 = j + 1 == kWallSteps ? fb : computeSliceF(sl, makeAngleAt(t1));
-        const float elevation = sl.hi.theta - (t1 - 0.5f * width);
-        const float w = 1.0f - evaluateFalloff(wall / std::cos(elevation), invRadius, smoothstep);
-        sum += std::max(0.0f, w - base) * std::max(0.0f, f1 - f0);
-        f0 = f1;
-    }
-    return sum;
+    return sum + computeWallObscurance(sl, lower, upper, wall * invRadius, base, smoothstep);
 }
 
 } // namespace

@@ -45,6 +45,7 @@ struct Params {
     int interleave = 3;       //!< tiles of interleave^2 pixels share the directions out
     double radius = 1.0;      //!< world units: falloff radius
     Falloff falloff = Falloff::Linear;
+    bool walls = true; //!< walls below occluders whose foot is the visible surface
 };
 
 //! One direction of the layout, as the shaders read it (std430, 64 bytes).
@@ -531,9 +532,11 @@ inline WallFoot findWallFoot(const Slice& sl, const glm::vec3& x, const glm::vec
         return f;
     const float elevation = sl.hi.theta - o.angle.theta;
     f.height = glm::dot(p - x, n);
-    if (!(elevation > 0.0f && elevation < 1.57079637f) || !(f.height > 0.0f))
+    if (!(sl.nv >= 0.0f) || !(elevation > 0.0f && elevation < 1.57079637f) ||
+        !(f.height > 0.0f))
         return f;
-    f.wall = o.distance * std::cos(elevation);
+    // cos(hi - theta) by the angle difference.
+    f.wall = o.distance * (sl.hi.c * o.angle.c + sl.hi.s * o.angle.s);
     f.foot = p - f.height * n;
     f.worth = f.wall > 0.0f && f.wall < radius && f.foot.z < 0.0f;
     return f;
@@ -550,6 +553,28 @@ inline float computeFootSupport(float footDepth, float surfaceDepth, float heigh
     const float tolerance = 0.1f * height + 1e-4f * footDepth;
     return std::clamp(2.0f - std::fabs(surfaceDepth - footDepth) / tolerance, 0.0f, 1.0f);
 }
+
+//! A bound of the elevation range where a wall is the nearer hit: the elevation phi above the
+//! tangent plane, its cosine and sine, and the slice measure F at the angle hi - phi.
+struct WallBound {
+    float phi = 0.0f;
+    float c = 1.0f;
+    float s = 0.0f;
+    float f = 0.0f;
+};
+
+//! The bound at angle theta whose slice measure is f.
+WallBound makeWallBound(const Slice& sl, const Angle& theta, float f);
+//! The bound at the elevation whose cosine is x (in [0, 1]).
+WallBound makeWallCutoff(const Slice& sl, float x);
+
+//! The obscurance that a wall at distance a (in radii, along the tangent plane) adds over the
+//! rays at elevations [lower.phi, upper.phi] above the tangent plane, beyond what they have with
+//! weight `base`: the integral of (1 - rho(a / cos(phi)) - base) dF, in closed form
+//! (lsao_core.cpp). Needs the slice's hemisphere to end at the tangent plane (nv >= 0), elevations
+//! in [0, pi / 2) and a / cos(upper.phi) <= 1.
+float computeWallObscurance(const Slice& sl, const WallBound& lower, const WallBound& upper,
+                            float a, float base, bool smoothstep);
 
 //! rho(distance / radius) as obscurance falloff: 1 at and beyond the radius.
 inline float evaluateFalloff(float distance, float invRadius, bool smoothstep)

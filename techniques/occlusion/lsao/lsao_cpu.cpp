@@ -24,6 +24,7 @@ struct GatherContext {
     const Image<glm::vec3>& normal;
     const std::vector<std::uint32_t>& sweep;
     bool nearField;
+    bool walls;
     bool smoothstep;
     float radius;
     float invRadius;
@@ -43,6 +44,8 @@ struct Receiver {
 //! counts farther away (its distance divided by the support).
 void findWall(const GatherContext& g, const Receiver& r, const glm::vec3& p, Occluder& o)
 {
+    if (!g.walls)
+        return;
     const WallFoot f = findWallFoot(r.slice, r.x, r.n, p, o, g.radius);
     if (!f.worth)
         return;
@@ -263,6 +266,7 @@ void runGatherCpu(const Layout& layout, std::size_t batchIndex,
                           normal,
                           sweep,
                           params.nearField,
+                          params.walls,
                           params.falloff == Falloff::Smoothstep,
                           float(params.radius),
                           params.radius > 0.0 ? float(1.0 / params.radius)

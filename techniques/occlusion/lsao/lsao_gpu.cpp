@@ -1,6 +1,9 @@
 #include "lsao_gpu.h"
 
 #include "gpu/shader_compiler.h"
+
+#include <stdexcept>
+#include <string>
 #include "render/gbuffer_pass.h"
 
 #include <string>
@@ -20,10 +23,10 @@ constexpr std::uint32_t kGatherGroupSize = 8;
 
 gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderCompiler& compiler,
                                     const char* file, const char* name,
-                                    std::vector<gpu::BindingSlot> bindings)
+                                    std::vector<gpu::BindingSlot> bindings, bool walls)
 {
     const std::vector<gpu::ShaderDefine> defines = {
-        {"LSAO_HULL_CAPACITY", std::to_string(kHullCapacity)}};
+        {"LSAO_HULL_CAPACITY", std::to_string(kHullCapacity)}, {"LSAO_WALLS", walls ? "1" : "0"}};
     gpu::ComputePipelineDesc desc;
     desc.name = name;
     desc.spirv = compiler.compileFile(getShaderDir() / file, defines).spirv;
@@ -34,7 +37,7 @@ gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderComp
 
 } // namespace
 
-GpuRunner::GpuRunner(gpu::Context& context) : mContext(&context)
+GpuRunner::GpuRunner(gpu::Context& context, bool walls) : mContext(&context), mWalls(walls)
 {
     gpu::ShaderCompilerOptions options;
     options.includeDirs = {getShaderDir(), render::getRenderShaderDir()};
@@ -44,21 +47,24 @@ GpuRunner::GpuRunner(gpu::Context& context) : mContext(&context)
                             {{0, BindingType::StorageImage},
                              {1, BindingType::StorageBuffer},
                              {2, BindingType::StorageBuffer},
-                             {3, BindingType::StorageImage}});
+                             {3, BindingType::StorageImage}},
+                            walls);
     mGather = createPipeline(context, compiler, "lsao_gather.comp", "lsao.gather",
                              {{0, BindingType::StorageImage},
                               {1, BindingType::StorageBuffer},
                               {2, BindingType::StorageBuffer},
                               {3, BindingType::StorageImage},
                               {4, BindingType::StorageImage},
-                              {5, BindingType::StorageImage}});
+                              {5, BindingType::StorageImage}},
+                             walls);
     mResolve = createPipeline(context, compiler, "lsao_resolve.comp", "lsao.resolve",
                               {{0, BindingType::StorageImage},
                                {3, BindingType::StorageImage},
                                {4, BindingType::StorageImage},
                                {5, BindingType::StorageImage},
                                {6, BindingType::StorageImage},
-                               {7, BindingType::StorageImage}});
+                               {7, BindingType::StorageImage}},
+                              walls);
 }
 
 void GpuRunner::prepare(const Layout& layout)
@@ -100,6 +106,9 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
+    if (params.walls != mWalls)
+        throw std::invalid_argument("lsao: the gather was compiled with walls " +
+                                    std::string(mWalls ? "on" : "off"));
     prepare(layout);
     const int w = layout.width, h = layout.height;
     const std::size_t count = std::size_t(w) * std::size_t(h);
@@ -119,6 +128,9 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const gpu::Image& depth, const gpu::Image& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
+    if (params.walls != mWalls)
+        throw std::invalid_argument("lsao: the gather was compiled with walls " +
+                                    std::string(mWalls ? "on" : "off"));
     prepare(layout);
     const int w = layout.width, h = layout.height;
     mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));

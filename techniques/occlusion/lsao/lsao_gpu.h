@@ -22,8 +22,9 @@ std::filesystem::path getShaderDir();
 
 class GpuRunner {
 public:
-    //! Compiles the shaders and creates the pipelines on `context`, which must outlive this.
-    explicit GpuRunner(gpu::Context& context);
+    //! Compiles the shaders and creates the pipelines on `context`, which must outlive this;
+    //! `walls`: Params::walls of every run (the gather is compiled with or without them).
+    explicit GpuRunner(gpu::Context& context, bool walls = true);
 
     gpu::Context& getContext() const { return *mContext; }
 
@@ -47,6 +48,7 @@ private:
     void prepare(const Layout& layout);
 
     gpu::Context* mContext = nullptr;
+    bool mWalls = true;
     gpu::ComputePipeline mSweep;
     gpu::ComputePipeline mGather;
     gpu::ComputePipeline mResolve;

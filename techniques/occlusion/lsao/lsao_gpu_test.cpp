@@ -108,6 +108,8 @@ TEST_F(LsaoGpu, MatchesTheCpuPathAndTheSweepBuffersAreIdentical)
         {{"interleave", std::int64_t(1)}},
         // 20 directions over 16 classes: shares of 2 and 1 directions.
         {{"interleave", std::int64_t(4)}, {"directions", std::int64_t(20)}},
+        {{"walls", false}},
+        {{"walls", false}, {"falloff", std::string("smoothstep")}, {"radius", 0.3}},
     };
     for (int frame : {0, 3}) {
         for (const Overrides& o : configs) {

@@ -209,6 +209,58 @@ TEST(Lsao, FlatPlaneFacingTheCameraIsUnoccludedWithBentNormalEqualToNormal)
     }
 }
 
+TEST(Lsao, TheWallIntegralMatchesAQuadrature)
+{
+    // computeWallObscurance's closed forms against a midpoint rule of 20000 steps over the same
+    // elevations: the integral of (1 - rho(a sec(phi)) - base) dF, dF from the slice measure.
+    // Receivers with normals tilted toward and away from the slice's upstream side, half-slices
+    // whose hemisphere spans a small (14 degrees) or a large range of elevations.
+    for (const auto& [n, axis] :
+         {std::pair{glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, 1.0f, 0.0f)},
+          std::pair{glm::vec3(0.0f, 1.0f, 0.0f), glm::vec3(0.0f, -1.0f, 0.0f)},
+          std::pair{glm::normalize(glm::vec3(0.0f, 1.0f, 0.6f)), glm::vec3(0.0f, -1.0f, 0.0f)},
+          std::pair{glm::normalize(glm::vec3(0.3f, 1.0f, 0.5f)), glm::vec3(0.6f, -0.8f, 0.0f)}}) {
+        const Slice sl = makeSlice(glm::vec3(0.2f, -1.0f, -4.0f), n, axis);
+        ASSERT_TRUE(sl.hasHemisphere);
+        ASSERT_GE(sl.nv, 0.0f);
+        for (const bool smoothstep : {false, true}) {
+            for (const float a : {0.02f, 0.3f, 0.7f}) {
+                const float base = 0.1f;
+                // The weight falls to base at cos(phi) = a / rho^-1(1 - base); stay below it.
+                // Elevations stay inside the half-slice's hemisphere (hi - lo), as the
+                // gather's clamped occluder angles do.
+                const float top = std::min(std::acos(a / (smoothstep ? 0.8f : 0.9f)),
+                                           sl.hi.theta - sl.lo.theta) * 0.999f;
+                for (const auto& [phi1, phi2] : {std::pair{0.0f, top}, std::pair{0.2f * top, 0.7f * top}}) {
+                    auto boundAt = [&](float phi) {
+                        const float theta = sl.hi.theta - phi;
+                        const Angle angle{theta, std::cos(theta), std::sin(theta)};
+                        return makeWallBound(sl, angle, computeSliceF(sl, angle));
+                    };
+                    const float closed =
+                        computeWallObscurance(sl, boundAt(phi1), boundAt(phi2), a, base, smoothstep);
+                    double quadrature = 0.0;
+                    const int steps = 20000;
+                    for (int i = 0; i < steps; ++i) {
+                        // dF = (nv sin(theta) cos(theta) + nt sin^2(theta)) dtheta, theta = hi - phi.
+                        const double dphi = double(phi2 - phi1) / steps;
+                        const double phi = phi1 + (double(i) + 0.5) * dphi;
+                        const double theta = double(sl.hi.theta) - phi;
+                        const double x = a / std::cos(phi);
+                        const double rho = smoothstep ? x * x * (3.0 - 2.0 * x) : x;
+                        const double dF = (sl.nv * std::sin(theta) * std::cos(theta) +
+                                           sl.nt * std::sin(theta) * std::sin(theta)) * dphi;
+                        quadrature += (1.0 - rho - base) * dF;
+                    }
+                    EXPECT_NEAR(closed, quadrature, 2e-5 + 1e-4 * std::fabs(quadrature))
+                        << "a " << a << " smoothstep " << smoothstep << " phi " << phi1 << ".." << phi2;
+                    EXPECT_GT(quadrature, 0.0);
+                }
+            }
+        }
+    }
+}
+
 TEST(Lsao, AWallIsAssumedBelowAnOccluderOnlyWhereItsFootIsTheVisibleSurface)
 {
     // A plate 1.9 to 2 in front of a wall that faces the camera. Seen from the wall, the plate's
@@ -386,7 +438,10 @@ TEST(Lsao, AmbientDoesNotGrowWithTheRadius)
             for (std::size_t i = 0; i < out.ambient.pixels.size(); ++i) {
                 mean += out.ambient.pixels[i];
                 if (!previous.ambient.pixels.empty()) {
-                    ASSERT_LE(out.ambient.pixels[i], previous.ambient.pixels[i])
+                    // 2.5e-7: the walls' closed form is a difference of antiderivatives at two
+                    // bounds, whose float rounding leaves a few ulps of 1 (6e-8 measured) where
+                    // a wall barely reaches into the radius.
+                    ASSERT_LE(out.ambient.pixels[i], previous.ambient.pixels[i] + 2.5e-7f)
                         << falloff << " radius " << radius << " pixel " << i;
                 }
                 if (radius == 0.0) {

@@ -2,7 +2,9 @@
 // lsao_core.h / lsao_core.cpp (same formulas, same order of operations). Values that decide
 // discrete choices (sample positions, hull pops, bracketing) are computed into `precise`
 // variables so that no operation is fused or reordered, as in the C++ build (no contraction).
-// Defines: LSAO_HULL_CAPACITY (power of two, = kHullCapacity).
+// Defines: LSAO_HULL_CAPACITY (power of two, = kHullCapacity); LSAO_WALLS (0 or 1,
+// Params::walls: with 0 the code of the walls below occluders is left out, since lavapipe runs
+// every branch of the gather for every lane).
 #ifndef LSAO_COMMON_GLSL
 #define LSAO_COMMON_GLSL
 
@@ -350,9 +352,9 @@ WallFoot lsaoFindWallFoot(Slice sl, vec3 x, vec3 n, vec3 p, Occluder o)
         return f;
     float elevation = sl.hi.theta - o.angle.theta;
     f.height = dot(p - x, n);
-    if (!(elevation > 0.0 && elevation < 1.57079637) || !(f.height > 0.0))
+    if (!(sl.nv >= 0.0) || !(elevation > 0.0 && elevation < 1.57079637) || !(f.height > 0.0))
         return f;
-    f.wall = o.distance * cos(elevation);
+    f.wall = o.distance * (sl.hi.c * o.angle.c + sl.hi.s * o.angle.s);
     f.foot = p - f.height * n;
     f.worth = f.wall > 0.0 && f.wall < pc.radius && f.foot.z < 0.0;
     return f;
@@ -393,38 +395,67 @@ Occluder lsaoPrepareOccluder(Occluder o)
     return o.valid ? o : Occluder(Angle(4.0, 1.0, 0.0), LSAO_INF, false, LSAO_INF);
 }
 
-#define LSAO_WALL_STEPS 4
-
-float lsaoSliceFAt(Slice sl, float theta)
+// lsao::WallBound: (phi, cos phi, sin phi, F at hi - phi).
+vec4 lsaoWallBound(Slice sl, Angle theta, float f)
 {
-    return lsaoSliceF(sl, Angle(theta, cos(theta), sin(theta)));
+    return vec4(sl.hi.theta - theta.theta, sl.hi.c * theta.c + sl.hi.s * theta.s,
+                sl.hi.s * theta.c - sl.hi.c * theta.s, f);
+}
+
+vec4 lsaoWallCutoff(Slice sl, float x)
+{
+    float s = sqrt(max(0.0, 1.0 - x * x));
+    float phi = lsaoAtan2(s, x);
+    Angle theta = Angle(sl.hi.theta - phi, sl.hi.c * x + sl.hi.s * s, sl.hi.s * x - sl.hi.c * s);
+    return vec4(phi, x, s, lsaoSliceF(sl, theta));
+}
+
+// lsao::computeWallObscurance: closed form, see lsao_core.cpp. Terms (a np I1, a^2 np I2,
+// a^3 np I3) at bound w.
+vec3 lsaoWallTerms(Slice sl, vec4 w, float a)
+{
+    float as = a / w.y;
+    float logSecTan = log((1.0 + w.z) / w.y);
+    vec3 t = vec3(a * (-sl.nv * w.y + sl.nt * (logSecTan - w.z)), 0.0, 0.0);
+    if ((pc.flags & LSAO_FLAG_SMOOTHSTEP) != 0u) {
+        t.y = a * a * (-sl.nv * log(w.y) + sl.nt * (w.z / w.y - w.x));
+        t.z = a * a * sl.nv * as + sl.nt * (as * as * a * w.z - a * a * a * logSecTan) * 0.5;
+    }
+    return t;
+}
+
+float lsaoWallObscurance(Slice sl, vec4 lower, vec4 upper, float a, float base)
+{
+    vec3 lo = lsaoWallTerms(sl, lower, a);
+    vec3 hi = lsaoWallTerms(sl, upper, a);
+    float measure = max(0.0, lower.w - upper.w);
+    float weighted = (pc.flags & LSAO_FLAG_SMOOTHSTEP) != 0u
+                         ? measure - 3.0 * (hi.y - lo.y) + 2.0 * (hi.z - lo.z)
+                         : measure - (hi.x - lo.x);
+    return max(0.0, weighted - base * measure);
 }
 
 // lsao::integrateInterval: the rays in [a, b] weighted by 1 - rho of
-// min(distance, wall / cos(elevation)), a midpoint rule where the wall is within the radius.
+// min(distance, wall / cos(elevation)).
 float lsaoIntegrateInterval(Slice sl, Angle a, Angle b, float fa, float fb, float distance,
                             float wall)
 {
     float base = 1.0 - lsaoFalloff(distance);
     float sum = base * max(0.0, fb - fa);
-    float x = wall * pc.invRadius;
-    if (!(x < 1.0) || !(fb > fa))
+#if LSAO_WALLS
+    float limit = min(distance, 1.0 / pc.invRadius);
+    if (!(wall < limit) || !(fb > fa))
         return sum;
-    float begin = max(a.theta, sl.hi.theta - acos(x));
-    float end = b.theta;
-    if (!(end > begin))
+    vec4 lower = lsaoWallBound(sl, b, fb);
+    vec4 cutoff = lsaoWallCutoff(sl, wall / limit);
+    vec4 top = lsaoWallBound(sl, a, fa);
+    vec4 upper = cutoff.x < top.x ? cutoff : top;
+    if (!(upper.x > lower.x))
         return sum;
-    float width = (end - begin) * (1.0 / float(LSAO_WALL_STEPS));
-    float f0 = begin > a.theta ? lsaoSliceFAt(sl, begin) : fa;
-    for (int j = 0; j < LSAO_WALL_STEPS; ++j) {
-        float t1 = begin + float(j + 1) * width;
-        float f1 = j + 1 == LSAO_WALL_STEPS ? fb : lsaoSliceFAt(sl, t1);
-        float elevation = sl.hi.theta - (t1 - 0.5 * width);
-        float w = 1.0 - lsaoFalloff(wall / cos(elevation));
-        sum += max(0.0, w - base) * max(0.0, f1 - f0);
-        f0 = f1;
-    }
+    return sum + lsaoWallObscurance(sl, lower, upper, wall * pc.invRadius, base);
+#else
     return sum;
+#endif
 }
 
 // lsao::evaluateOccluders: up to three occluders, a branch-free sorting network.

@@ -19,6 +19,7 @@ layout(set = 0, binding = 5, r32f) uniform image2D accumB;     // visibility
 // tangent plane is the visible surface.
 void lsaoFindWall(Slice sl, vec3 x, vec3 n, vec3 p, inout Occluder o)
 {
+#if LSAO_WALLS
     WallFoot f = lsaoFindWallFoot(sl, x, n, p, o);
     if (!f.worth)
         return;
@@ -34,6 +35,7 @@ void lsaoFindWall(Slice sl, vec3 x, vec3 n, vec3 p, inout Occluder o)
     float support = lsaoFootSupport(-f.foot.z, surface, f.height);
     if (support > 0.0)
         o.wall = f.wall / support;
+#endif
 }
 
 Occluder lsaoLoadOccluder(ivec2 pixel, Slice sl, vec3 x, vec3 n, float minDistance)
@@ -148,30 +150,37 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         }
         // Occluders are loaded once per stratum (see lsao::runGatherCpu's gatherDirection).
         uint lowerId = wLower > 0.0 ? sweep[row + uint(lower[j].stratum)] : LSAO_NO_OCCLUDER;
-        Occluder lowerDominant = lsaoNoOccluder();
-        Occluder self = lsaoNoOccluder();
+        Occluder none = lsaoNoOccluder();
+        Occluder lowerDominant = none;
+        Occluder self = none;
+        Occluder dominant = none;
         if (wLower > 0.0) {
             lowerDominant = lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, n, minDistance);
             self = lsaoLoadLineSample(d, c, lower[j], sl, x, n, minDistance);
-            lsaoAddScaled(total, lineWeight * wLower,
-                          lsaoEvaluateOccluders(sl, lowerDominant, self, nearSample));
         }
         if (wUpper > 0.0) {
             uint id = sweep[row + uint(upper[j].stratum)];
-            Occluder dominant;
             if (wLower > 0.0 && id == uint(lower[j].stratum))
                 dominant = self;
             else if (wLower > 0.0 && id == lowerId)
                 dominant = lowerDominant;
             else
                 dominant = lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, n, minDistance);
-            lsaoAddScaled(total, lineWeight * wUpper,
-                          lsaoEvaluateOccluders(sl, dominant, nearSample, lsaoNoOccluder()));
         }
-        if (wNear > 0.0) {
-            Occluder none = lsaoNoOccluder();
-            lsaoAddScaled(total, lineWeight * wNear,
-                          lsaoEvaluateOccluders(sl, nearSample, none, none));
+        // The upstream sample's occluders (or, where the line has no sample around the pixel,
+        // the near-field sample alone: wNear > 0 only where wLower = wUpper = 0), then the
+        // downstream sample's, in the order of the C++ path. One call site in a loop of two keeps
+        // the shader small: lavapipe runs every branch for every lane.
+        for (int e = 0; e < 2; ++e) {
+            bool first = e == 0;
+            float w = first ? wLower + wNear : wUpper;
+            if (!(w > 0.0))
+                continue;
+            bool alone = wNear > 0.0;
+            Occluder o0 = first ? (alone ? nearSample : lowerDominant) : dominant;
+            Occluder o1 = first ? (alone ? none : self) : nearSample;
+            Occluder o2 = first && !alone ? nearSample : none;
+            lsaoAddScaled(total, lineWeight * w, lsaoEvaluateOccluders(sl, o0, o1, o2));
         }
     }
     return total;
