@@ -227,7 +227,7 @@ void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
             plugin::ScreenProjection::fromMatrix(input.projection, w, h);
         const Layout layout = buildLayout(w, h, projection, mParams, input.frameIndex);
         if (!mGpu || &mGpu->getContext() != input.gpu)
-            mGpu = std::make_unique<GpuRunner>(*input.gpu, mParams.walls);
+            mGpu = std::make_unique<GpuRunner>(*input.gpu, mParams);
         mGpu->run(layout, projection, mParams, *input.gpuLinearDepth, *input.gpuNormal, out,
                   input.readBack);
         return;
@@ -254,7 +254,7 @@ void Lsao::compute(const plugin::OcclusionInput& input, plugin::OcclusionOutput&
         return;
     }
     if (!mGpu || &mGpu->getContext() != input.gpu)
-        mGpu = std::make_unique<GpuRunner>(*input.gpu, mParams.walls);
+        mGpu = std::make_unique<GpuRunner>(*input.gpu, mParams);
     mGpu->run(layout, projection, mParams, depth, normal, out, input.readBack);
 }
 

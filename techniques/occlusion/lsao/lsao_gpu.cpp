@@ -23,10 +23,12 @@ constexpr std::uint32_t kGatherGroupSize = 8;
 
 gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderCompiler& compiler,
                                     const char* file, const char* name,
-                                    std::vector<gpu::BindingSlot> bindings, bool walls)
+                                    std::vector<gpu::BindingSlot> bindings, const Params& params)
 {
     const std::vector<gpu::ShaderDefine> defines = {
-        {"LSAO_HULL_CAPACITY", std::to_string(kHullCapacity)}, {"LSAO_WALLS", walls ? "1" : "0"}};
+        {"LSAO_HULL_CAPACITY", std::to_string(kHullCapacity)},
+        {"LSAO_WALLS", params.walls ? "1" : "0"},
+        {"LSAO_SMOOTHSTEP", params.falloff == Falloff::Smoothstep ? "1" : "0"}};
     gpu::ComputePipelineDesc desc;
     desc.name = name;
     desc.spirv = compiler.compileFile(getShaderDir() / file, defines).spirv;
@@ -37,7 +39,8 @@ gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderComp
 
 } // namespace
 
-GpuRunner::GpuRunner(gpu::Context& context, bool walls) : mContext(&context), mWalls(walls)
+GpuRunner::GpuRunner(gpu::Context& context, const Params& params)
+    : mContext(&context), mWalls(params.walls), mFalloff(params.falloff)
 {
     gpu::ShaderCompilerOptions options;
     options.includeDirs = {getShaderDir(), render::getRenderShaderDir()};
@@ -48,7 +51,7 @@ GpuRunner::GpuRunner(gpu::Context& context, bool walls) : mContext(&context), mW
                              {1, BindingType::StorageBuffer},
                              {2, BindingType::StorageBuffer},
                              {3, BindingType::StorageImage}},
-                            walls);
+                            params);
     mGather = createPipeline(context, compiler, "lsao_gather.comp", "lsao.gather",
                              {{0, BindingType::StorageImage},
                               {1, BindingType::StorageBuffer},
@@ -56,7 +59,7 @@ GpuRunner::GpuRunner(gpu::Context& context, bool walls) : mContext(&context), mW
                               {3, BindingType::StorageImage},
                               {4, BindingType::StorageImage},
                               {5, BindingType::StorageImage}},
-                             walls);
+                             params);
     mResolve = createPipeline(context, compiler, "lsao_resolve.comp", "lsao.resolve",
                               {{0, BindingType::StorageImage},
                                {3, BindingType::StorageImage},
@@ -64,7 +67,7 @@ GpuRunner::GpuRunner(gpu::Context& context, bool walls) : mContext(&context), mW
                                {5, BindingType::StorageImage},
                                {6, BindingType::StorageImage},
                                {7, BindingType::StorageImage}},
-                              walls);
+                              params);
 }
 
 void GpuRunner::prepare(const Layout& layout)
@@ -106,9 +109,8 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
-    if (params.walls != mWalls)
-        throw std::invalid_argument("lsao: the gather was compiled with walls " +
-                                    std::string(mWalls ? "on" : "off"));
+    if (params.walls != mWalls || params.falloff != mFalloff)
+        throw std::invalid_argument("lsao: the shaders were compiled for other walls or falloff");
     prepare(layout);
     const int w = layout.width, h = layout.height;
     const std::size_t count = std::size_t(w) * std::size_t(h);
@@ -128,9 +130,8 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const gpu::Image& depth, const gpu::Image& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
-    if (params.walls != mWalls)
-        throw std::invalid_argument("lsao: the gather was compiled with walls " +
-                                    std::string(mWalls ? "on" : "off"));
+    if (params.walls != mWalls || params.falloff != mFalloff)
+        throw std::invalid_argument("lsao: the shaders were compiled for other walls or falloff");
     prepare(layout);
     const int w = layout.width, h = layout.height;
     mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));

@@ -22,9 +22,10 @@ std::filesystem::path getShaderDir();
 
 class GpuRunner {
 public:
-    //! Compiles the shaders and creates the pipelines on `context`, which must outlive this;
-    //! `walls`: Params::walls of every run (the gather is compiled with or without them).
-    explicit GpuRunner(gpu::Context& context, bool walls = true);
+    //! Compiles the shaders and creates the pipelines on `context`, which must outlive this,
+    //! for the walls and falloff of `params` (every run must have the same: the shaders are
+    //! compiled with or without their code).
+    explicit GpuRunner(gpu::Context& context, const Params& params = Params{});
 
     gpu::Context& getContext() const { return *mContext; }
 
@@ -49,6 +50,7 @@ private:
 
     gpu::Context* mContext = nullptr;
     bool mWalls = true;
+    Falloff mFalloff = Falloff::Linear;
     gpu::ComputePipeline mSweep;
     gpu::ComputePipeline mGather;
     gpu::ComputePipeline mResolve;

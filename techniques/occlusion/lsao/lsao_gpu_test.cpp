@@ -132,7 +132,7 @@ TEST_F(LsaoGpu, MatchesTheCpuPathAndTheSweepBuffersAreIdentical)
     const Params params = makeLsao().getParams();
     const Layout layout = buildLayout(160, 120, g.screen, params, 2);
     ASSERT_EQ(layout.batches.size(), 1u);
-    GpuRunner runner(getContext());
+    GpuRunner runner(getContext(), params);
     plugin::OcclusionOutput out;
     runner.run(layout, g.screen, params, g.depth, g.normal, out);
     const std::vector<std::uint32_t> gpuSweep = runner.downloadSweep(layout.batches[0].entryCount);
@@ -152,7 +152,7 @@ TEST_F(LsaoGpu, SeveralBatchesGiveTheSameResultAsOne)
     const Layout many = buildLayout(64, 48, g.screen, params, 1, 2500);
     ASSERT_EQ(one.batches.size(), 1u);
     ASSERT_GT(many.batches.size(), 3u);
-    GpuRunner runner(getContext());
+    GpuRunner runner(getContext(), params);
     plugin::OcclusionOutput a, b, c;
     runner.run(one, g.screen, params, g.depth, g.normal, a);
     runner.run(many, g.screen, params, g.depth, g.normal, b);

@@ -3,8 +3,8 @@
 // discrete choices (sample positions, hull pops, bracketing) are computed into `precise`
 // variables so that no operation is fused or reordered, as in the C++ build (no contraction).
 // Defines: LSAO_HULL_CAPACITY (power of two, = kHullCapacity); LSAO_WALLS (0 or 1,
-// Params::walls: with 0 the code of the walls below occluders is left out, since lavapipe runs
-// every branch of the gather for every lane).
+// Params::walls) and LSAO_SMOOTHSTEP (0 or 1, Params::falloff): the code of the options not
+// taken is left out, since lavapipe runs every branch of a shader for every lane.
 #ifndef LSAO_COMMON_GLSL
 #define LSAO_COMMON_GLSL
 
@@ -372,7 +372,11 @@ float lsaoFalloff(float distance)
     float x = distance * pc.invRadius;
     if (!(x < 1.0))
         return 1.0;
-    return (pc.flags & LSAO_FLAG_SMOOTHSTEP) != 0u ? x * x * (3.0 - 2.0 * x) : x;
+#if LSAO_SMOOTHSTEP
+    return x * x * (3.0 - 2.0 * x);
+#else
+    return x;
+#endif
 }
 
 struct Contribution {
@@ -417,10 +421,12 @@ vec3 lsaoWallTerms(Slice sl, vec4 w, float a)
     float as = a / w.y;
     float logSecTan = log((1.0 + w.z) / w.y);
     vec3 t = vec3(a * (-sl.nv * w.y + sl.nt * (logSecTan - w.z)), 0.0, 0.0);
-    if ((pc.flags & LSAO_FLAG_SMOOTHSTEP) != 0u) {
+#if LSAO_SMOOTHSTEP
+    {
         t.y = a * a * (-sl.nv * log(w.y) + sl.nt * (w.z / w.y - w.x));
         t.z = a * a * sl.nv * as + sl.nt * (as * as * a * w.z - a * a * a * logSecTan) * 0.5;
     }
+#endif
     return t;
 }
 
@@ -429,9 +435,11 @@ float lsaoWallObscurance(Slice sl, vec4 lower, vec4 upper, float a, float base)
     vec3 lo = lsaoWallTerms(sl, lower, a);
     vec3 hi = lsaoWallTerms(sl, upper, a);
     float measure = max(0.0, lower.w - upper.w);
-    float weighted = (pc.flags & LSAO_FLAG_SMOOTHSTEP) != 0u
-                         ? measure - 3.0 * (hi.y - lo.y) + 2.0 * (hi.z - lo.z)
-                         : measure - (hi.x - lo.x);
+#if LSAO_SMOOTHSTEP
+    float weighted = measure - 3.0 * (hi.y - lo.y) + 2.0 * (hi.z - lo.z);
+#else
+    float weighted = measure - (hi.x - lo.x);
+#endif
     return max(0.0, weighted - base * measure);
 }
 
