@@ -57,6 +57,14 @@
 //   the distance of the occluder that defines it (the dominant occluder's above the near samples'
 //   horizons). Cosine-weighted measures are closed-form, GTAO's slice integral:
 //   F(h) = Int_0^h dot(n, w) sin(theta) dtheta = nv sin^2(h)/2 + nt (h - sin h cos h)/2.
+// - Walls below occluders (`walls`, an addition to the paper, lsao_core.h): an occluder whose
+//   foot (the occluder projected along the receiver's normal onto its tangent plane) is the
+//   visible surface in the depth buffer stands on a wall; the rays below it at elevation phi meet
+//   that wall at u / cos(phi) (u its distance along the tangent plane) when that is nearer than
+//   the occluders above them, integrated in closed form. It is what a crease (a floor against a
+//   wall) needs: the wall's top, the only hull vertex, lies beyond the radius. A foreground
+//   object hides its own foot, so it casts no halo. Obscurance only: visibility keeps the
+//   occluders' distances.
 // - Interleaving [Quantum Break seed: "We cycle through the 36 directions on 9 pixel
 //   neighborhoods"]: pixel (x, y) gathers only the directions k = (x mod n) + n (y mod n) mod n^2
 //   (n = interleave; 36 directions, n = 3: 4 directions 90 degrees apart per pixel). Pass 3
@@ -73,12 +81,12 @@
 // - Deviations from the reference integral: one depth layer, thin objects occlude as if infinitely
 //   thick, off-screen geometry is missing (as every screen-space method); with interleaving, a
 //   pixel's directions come from receivers up to floor(n/2) px away; per half-slice only
-//   horizons are known, so every ray below one counts as blocked at that occluder's distance (a
-//   tall wall next to the receiver is weighted by the distance of its top where no nearer sample
-//   rises above the tangent plane); the dominant occluder is the largest horizon over the whole
-//   line, so a higher occluder beyond the radius hides a lower one within it (the near-field and
-//   upstream samples keep some of it); between two samples of a line only the near-field sample
-//   is seen; N discrete azimuths. See README.md for measured errors.
+//   horizons are known, so every ray below one counts as blocked at that occluder's distance, or
+//   at its wall's where its foot is seen; the dominant occluder is the largest horizon over the
+//   whole line, so a higher occluder beyond the radius hides a lower one within it unless a wall
+//   stands below it (the near-field and upstream samples keep some of it); between two samples
+//   of a line only the near-field sample is seen; N discrete azimuths. See README.md for
+//   measured errors.
 //
 // Parameters
 // | name            | type  | default | range / choices        | unit        |
@@ -92,6 +100,7 @@
 // | interleave      | int   | 3       | [1, 4]                 | px          |
 // | radius          | float | 1       | [0, inf)               | world units |
 // | falloff         | enum  | linear  | {linear, smoothstep}   |             |
+// | walls           | bool  | true    |                        |             |
 //
 // Config:
 //   techniques:

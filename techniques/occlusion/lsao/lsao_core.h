@@ -598,7 +598,8 @@ struct Contribution {
 //! Occluder{} for unused ones). A ray at angle theta is blocked by every occluder whose angle is
 //! at most theta; it is weighted by 1 - rho of the nearest hit among those: the occluder's own
 //! distance, or its wall's (wall / cos(elevation)) where it has one. Visibility: blocked by
-//! those whose hit is nearer than the radius. A 3-element sorting network, as in the shader.
+//! those nearer than the radius (own distances; the walls are left out there, see the .cpp).
+//! A 3-element sorting network, as in the shader.
 Contribution evaluateOccluders(const Slice& slice, Occluder o0, Occluder o1, Occluder o2,
                                float radius, float invRadius, bool smoothstep);
 
