@@ -76,6 +76,17 @@ SwitchType=switch/none
 NodeName=$host NodeAddr=127.0.0.1 CPUs=$(nproc) State=UNKNOWN
 PartitionName=rtlab Nodes=$host Default=YES MaxTime=INFINITE State=UP
 CONF
+# slurmd 22.05 loads its cgroup plugin even with proctrack/linuxproc and task/none, and fails
+# where no cgroup file system is mounted on /sys/fs/cgroup (a bare root, a container): there it
+# gets cgroup v1 controllers mounted under the cluster's own folder instead.
+if ! grep -qs ' /sys/fs/cgroup' /proc/mounts; then
+    mkdir -p "$dir/cgroup"
+    cat >"$dir/cgroup.conf" <<CGROUP
+CgroupPlugin=cgroup/v1
+CgroupAutomount=yes
+CgroupMountpoint=$dir/cgroup
+CGROUP
+fi
 export SLURM_CONF="$dir/slurm.conf"
 slurmctld -f "$SLURM_CONF"
 slurmd -f "$SLURM_CONF"
