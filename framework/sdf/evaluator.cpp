@@ -10,6 +10,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -99,6 +100,12 @@ public:
             cellSamples.push_back(int(size));
             size /= 4;
         }
+        // Distances between two samples of a leaf by their squared offset in samples, rounded up
+        // through the margin (the leaves' Lipschitz bounds subtract them).
+        const int span = cellSamples.back() - 1;
+        reach.resize(std::size_t(3 * span * span) + 1);
+        for (std::size_t k = 0; k < reach.size(); ++k)
+            reach[k] = (grid.spacing + margin) * std::sqrt(double(k));
     }
 
     void run(std::vector<Op> rootOps, std::vector<const CsgEdit*> rootCandidates)
@@ -119,8 +126,17 @@ public:
     double band = 0.0;
     double margin = 0.0;
     std::vector<int> cellSamples;  // per level
+    std::vector<double> reach;     // by squared sample offset inside a leaf: its world distance
     tbb::enumerable_thread_specific<Counters> counters;
     tbb::enumerable_thread_specific<std::vector<LeafRecord>> leaves;
+    //! Per thread, the arrays a leaf works in (kept between leaves: no allocation per leaf).
+    struct LeafScratch {
+        std::vector<glm::dvec3> positions;
+        std::vector<double> values;
+        std::vector<double> bound;
+        std::vector<std::uint8_t> known;
+    };
+    tbb::enumerable_thread_specific<LeafScratch> scratch;
 
 private:
     Counters& getCounters()
@@ -248,13 +264,130 @@ private:
             }
     }
 
+    //! The leaf's values where its pruned list holds exact distances only; returns the samples
+    //! evaluated. Samples the band cannot reach are not evaluated: every op (hard or soft min and
+    //! max, negation) keeps a field of exact distances 1-Lipschitz, so a sample at distance r from
+    //! a sample of value v has |value| >= |v| - r and, while that exceeds the band, the sign of v:
+    //! its clamped value (+-band) is known without evaluating it. Seeds are the leaf's 8 corners,
+    //! evaluated first: each bounds every sample of the leaf by its ball (a corner far outside
+    //! the band clears most of the leaf). The other samples are then visited in scan order, each
+    //! axis swept away from the corners of larger |value| (outside in), and take the best of the
+    //! corners' balls and of their three neighbours one spacing back along the sweep (chained
+    //! through skipped samples). Evaluated samples run the same ops in the same order as the
+    //! edit-major loop, so every value stays bit-identical.
+    std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& ops,
+                                      const std::vector<glm::dvec3>& positions,
+                                      std::vector<double>& values, LeafScratch& work) const
+    {
+        const std::size_t count = values.size();
+        const double step = grid.spacing + margin;
+        const std::size_t strides[3] = {1, std::size_t(n.x), std::size_t(n.x) * std::size_t(n.y)};
+        const auto evaluate = [&](std::size_t i) {
+            double v = kInf;
+            for (const Op& op : ops)
+                v = applyOp(op.kind, v, op.edit->evaluatePrimitive(positions[i]), op.edit->blend);
+            return v;
+        };
+        std::vector<double>& bound = work.bound; // |value| (evaluated) or a lower bound of it
+        bound.assign(count, -kInf);
+        std::vector<std::uint8_t>& known = work.known;
+        known.assign(count, 0);
+        std::size_t evaluated = 0;
+        // The corners (fewer where the leaf is one sample thin along an axis).
+        std::array<std::size_t, 8> corner{};
+        std::array<glm::ivec3, 8> cornerAt{};
+        int corners = 0;
+        for (int k = 0; k < 8; ++k) {
+            const glm::ivec3 at((k & 1) ? n.x - 1 : 0, (k & 2) ? n.y - 1 : 0,
+                                (k & 4) ? n.z - 1 : 0);
+            const std::size_t i = std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
+                                  std::size_t(at.z) * strides[2];
+            if (known[i])
+                continue;
+            values[i] = evaluate(i);
+            bound[i] = std::abs(values[i]);
+            known[i] = 1;
+            ++evaluated;
+            corner[std::size_t(corners)] = i;
+            cornerAt[std::size_t(corners++)] = at;
+        }
+        // Sweep each axis from the side whose corners are farther from the surface.
+        int direction[3];
+        for (int axis = 0; axis < 3; ++axis) {
+            double low = 0.0, high = 0.0;
+            for (int k = 0; k < corners; ++k) {
+                const double b = bound[corner[std::size_t(k)]];
+                (cornerAt[std::size_t(k)][axis] == 0 ? low : high) += b;
+            }
+            direction[axis] = high > low ? -1 : 1;
+        }
+        // Only corners farther than one spacing past the band can prove another sample.
+        int useful = 0;
+        for (int k = 0; k < corners; ++k)
+            if (bound[corner[std::size_t(k)]] - step > band) {
+                corner[std::size_t(useful)] = corner[std::size_t(k)];
+                cornerAt[std::size_t(useful++)] = cornerAt[std::size_t(k)];
+            }
+        const auto index = [&](const glm::ivec3& at) {
+            return std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
+                   std::size_t(at.z) * strides[2];
+        };
+        for (int zi = 0; zi < n.z; ++zi)
+            for (int yi = 0; yi < n.y; ++yi)
+                for (int xi = 0; xi < n.x; ++xi) {
+                    const glm::ivec3 at(direction[0] > 0 ? xi : n.x - 1 - xi,
+                                        direction[1] > 0 ? yi : n.y - 1 - yi,
+                                        direction[2] > 0 ? zi : n.z - 1 - zi);
+                    const std::size_t i = index(at);
+                    if (known[i])
+                        continue;
+                    double lowest = -kInf;
+                    double sign = 1.0;
+                    for (int k = 0; k < useful; ++k) {
+                        const glm::ivec3 d = at - cornerAt[std::size_t(k)];
+                        const double b = bound[corner[std::size_t(k)]] -
+                                         reach[std::size_t(d.x * d.x + d.y * d.y + d.z * d.z)];
+                        if (b > lowest) {
+                            lowest = b;
+                            sign = values[corner[std::size_t(k)]] < 0.0 ? -1.0 : 1.0;
+                        }
+                    }
+                    const int sweep[3] = {xi, yi, zi};
+                    for (int axis = 0; axis < 3; ++axis) {
+                        if (sweep[axis] == 0)
+                            continue;
+                        glm::ivec3 back = at;
+                        back[axis] -= direction[axis];
+                        const std::size_t j = index(back);
+                        const double b = bound[j] - step;
+                        if (b > lowest) {
+                            lowest = b;
+                            sign = values[j] < 0.0 ? -1.0 : 1.0;
+                        }
+                    }
+                    known[i] = 1;
+                    if (lowest > band) {
+                        values[i] = sign * lowest;
+                        bound[i] = lowest;
+                        continue;
+                    }
+                    values[i] = evaluate(i);
+                    bound[i] = std::abs(values[i]);
+                    ++evaluated;
+                }
+        return evaluated;
+    }
+
     void evaluateLeaf(const glm::ivec3& first, const glm::ivec3& last, const std::vector<Op>& ops,
                       const std::vector<const CsgEdit*>& candidates, Counters& c)
     {
         const glm::ivec3 n = last - first + 1;
         const std::size_t count = std::size_t(n.x) * n.y * n.z;
-        std::vector<glm::dvec3> positions(count);
-        std::vector<double> values(count, kInf);
+        LeafScratch& work = scratch.local();
+        std::vector<glm::dvec3>& positions = work.positions;
+        positions.resize(count);
+        std::vector<double>& values = work.values;
+        values.assign(count, kInf);
         std::size_t i = 0;
         for (int z = first.z; z <= last.z; ++z)
             for (int y = first.y; y <= last.y; ++y)
@@ -275,49 +408,7 @@ private:
                         applyOp(op.kind, values[j], e.evaluatePrimitive(positions[j]), e.blend);
             }
         } else {
-            // Samples the band cannot reach. With exact distances every op (hard or soft min and
-            // max, negation) keeps the field 1-Lipschitz, so a sample one spacing from a sample of
-            // value v has |value| >= |v| - spacing and, while that exceeds the band, the sign of
-            // v: its clamped value (+-band) is known without evaluating it. Samples are visited in
-            // scan order and take the best bound of their -x, -y and -z neighbours in the leaf
-            // (chained through skipped samples; the 10 diagonal earlier neighbours skip a few more
-            // samples but cost more time than they save). The evaluated ones run the same ops in
-            // the same order as above, so every value stays bit-identical.
-            evaluated = 0;
-            const double step = grid.spacing + margin;
-            const std::size_t strides[3] = {1, std::size_t(n.x),
-                                            std::size_t(n.x) * std::size_t(n.y)};
-            std::vector<double> bound(count, 0.0); // |value| (evaluated) or a lower bound of it
-            i = 0;
-            for (int z = 0; z < n.z; ++z)
-                for (int y = 0; y < n.y; ++y)
-                    for (int x = 0; x < n.x; ++x, ++i) {
-                        double lowest = -kInf;
-                        double sign = 1.0;
-                        const int at[3] = {x, y, z};
-                        for (int axis = 0; axis < 3; ++axis) {
-                            if (at[axis] == 0)
-                                continue;
-                            const std::size_t j = i - strides[axis];
-                            const double b = bound[j] - step;
-                            if (b > lowest) {
-                                lowest = b;
-                                sign = values[j] < 0.0 ? -1.0 : 1.0;
-                            }
-                        }
-                        if (lowest > band) {
-                            values[i] = sign * lowest;
-                            bound[i] = lowest;
-                            continue;
-                        }
-                        double v = kInf;
-                        for (const Op& op : ops)
-                            v = applyOp(op.kind, v, op.edit->evaluatePrimitive(positions[i]),
-                                        op.edit->blend);
-                        values[i] = v;
-                        bound[i] = std::abs(v);
-                        ++evaluated;
-                    }
+            evaluated = evaluateLipschitzLeaf(n, ops, positions, values, work);
         }
         c.sampleEvaluations += evaluated * ops.size();
         c.samplesEvaluated += evaluated;

@@ -40,11 +40,14 @@
 //     Because dropped edits change no value bit, later tests that use D stay valid.
 //   - A cell is proven empty (full) when the final D lies above +band (below -band).
 //   - Inside a leaf whose pruned list holds exact distances only (no ellipsoid), the field is
-//     1-Lipschitz (hard and soft min/max keep it so): a sample one spacing after an evaluated (or
-//     skipped) -x, -y or -z neighbour whose |value| exceeds band + spacing is clamped to +-band
-//     with the neighbour's sign without evaluating anything (not with materials, which need the
-//     unclamped value). On the gallery at 256 this saves 0.5-1.5 points of the culling rate at
-//     the same wall time.
+//     1-Lipschitz (hard and soft min/max keep it so): a sample at distance r from a sample of
+//     value v has |value| >= |v| - r, so where that exceeds the band its clamped value is +-band
+//     with the sign of v, known without evaluating anything (not with materials, which need the
+//     unclamped value). The leaf's 8 corners are evaluated first and bound every sample by their
+//     balls; the rest are swept outside in (each axis away from the corners of larger |value|),
+//     each also taking the bound of its neighbours one spacing back. On the gallery at 256 the
+//     corners and the outside-in sweep save 0.2-0.8 points of the culling rate over a +x+y+z
+//     sweep alone, which saved 0.5-1.5 over none, at the same wall time.
 //   - Bounds are widened by a margin of 1e-10 x the largest coordinate or size involved, which
 //     absorbs floating-point rounding with a wide safety factor.
 //

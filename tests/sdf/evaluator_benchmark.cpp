@@ -6,8 +6,10 @@
 // Counters: samples_per_s (grid samples per wall-clock second), culling_rate (1 - primitive
 // evaluations / brute force's, bound evaluations included), evals (primitive evaluations per run),
 // in_band (samples with |d| <= band), ideal_rate (the culling rate of one primitive evaluation per
-// band sample and nothing else: no exact evaluator culls more), edges (Hermite edges, where computed), emptyN / fullN (cells
-// of level N, 0 = coarsest, proven outside / inside the band).
+// band sample and nothing else: no exact evaluator culls more), sample_evals / bound_evals (the
+// two parts of evals: at samples, and bounding cells), edges (Hermite edges, where computed),
+// emptyN / fullN / visitedN (cells of level N, 0 = coarsest, proven outside / inside the band,
+// and visited).
 
 #include "sdf/evaluator.h"
 
@@ -45,12 +47,15 @@ void runEvaluator(benchmark::State& state, const scene::SdfModel& model, int res
     state.counters["evals"] = double(stats.getFieldEvaluations());
     state.counters["in_band"] = double(stats.samplesInBand);
     state.counters["samples"] = double(stats.samples);
+    state.counters["sample_evals"] = double(stats.sampleEvaluations);
+    state.counters["bound_evals"] = double(stats.boundEvaluations);
     if (hermite)
         state.counters["edges"] = double(stats.hermiteEdges);
     // Cells proven outside (empty) or inside (full) the band, per level (0 = coarsest).
     for (std::size_t l = 0; l < stats.cellsEmpty.size(); ++l) {
         state.counters["empty" + std::to_string(l)] = double(stats.cellsEmpty[l]);
         state.counters["full" + std::to_string(l)] = double(stats.cellsFull[l]);
+        state.counters["visited" + std::to_string(l)] = double(stats.cellsVisited[l]);
     }
 }
 
