@@ -131,12 +131,77 @@ SymmetricEigen computeSymmetricEigen(const glm::dmat3& m)
     return result;
 }
 
+namespace {
+
+//! The rank-1 case of the truncated solve without the eigen decomposition: most cells of a smooth
+//! surface have nearly parallel normals, so A^T A has one eigenvalue far above the other two
+//! (sigma_2 / sigma_1 below the threshold: only the first is kept). Then its eigenvector is what
+//! power iteration converges to at the rate lambda_2 / lambda_1 per product: the largest
+//! column of M^4 (M = A^T A / trace, so entries stay near 1) times M^4 is M^8 e_j, within
+//! sqrt(3) (lambda_2 / lambda_1)^8 of the eigenvector. The result is accepted only when it is
+//! certified: the residual |M v - mu v| (mu the Rayleigh quotient) bounds the angle to the
+//! eigenvector by residual / gap [Parlett, "The Symmetric Eigenvalue Problem", thm. 11-7-1], and
+//! lambda_2 + lambda_3 = trace - lambda_1 bounds both dropped eigenvalues from above, so the
+//! rank is decided as the truncation rule would decide it. Returns false (the caller runs the
+//! Jacobi solve) otherwise: two or three kept directions, a dropped eigenvalue near the cut, or a
+//! residual above 1e-13.
+bool solveRankOne(const QefSystem& qef, const glm::dvec3& residual, double threshold,
+                  glm::dvec3& step)
+{
+    const glm::dmat3& ata = qef.ata;
+    const double trace = ata[0][0] + ata[1][1] + ata[2][2];
+    if (!(trace > 0.0) || !std::isfinite(trace))
+        return false;
+    const glm::dmat3 m = ata * (1.0 / trace);
+    const glm::dmat3 m2 = m * m;
+    const glm::dmat3 m4 = m2 * m2;
+    int best = 0;
+    double bestLength = glm::dot(m4[0], m4[0]);
+    for (int c = 1; c < 3; ++c) {
+        const double length = glm::dot(m4[c], m4[c]);
+        if (length > bestLength) {
+            best = c;
+            bestLength = length;
+        }
+    }
+    glm::dvec3 v = m4 * m4[best];
+    const double norm = glm::length(v);
+    if (!(norm > 0.0) || !std::isfinite(norm))
+        return false;
+    v /= norm;
+    const glm::dvec3 mv = m * v;
+    const double mu = glm::dot(v, mv); // lambda_1 / trace
+    const double rest = 1.0 - mu;      // (lambda_2 + lambda_3) / trace, both >= 0
+    // The truncation keeps sigma_k >= cut sigma_max, i.e. lambda_k >= cut^2 lambda_1.
+    const double cut = std::max(threshold, kSingularFloor);
+    const double cutLambda = cut * cut * mu;
+    if (!(rest < 0.5 * cutLambda) || !(mu > 0.5))
+        return false;
+    if (glm::length(mv - mu * v) > 1e-13)
+        return false;
+    // The dropped eigenvalues are below half the cut and mu within 1e-13 of lambda_1 / trace:
+    // sigma_1 is kept (it is sigma_max) and the other two are dropped, as the Jacobi solve does.
+    step = v * (glm::dot(v, residual) / (mu * trace));
+    return true;
+}
+
+} // namespace
+
 QefSolution solveQefNear(const QefSystem& qef, const glm::dvec3& reference, double threshold)
 {
     QefSolution solution;
     solution.position = reference;
     if (qef.planeCount == 0)
         return solution;
+    {
+        const glm::dvec3 residual = qef.atb - qef.ata * (reference - qef.massPoint);
+        glm::dvec3 step;
+        if (solveRankOne(qef, residual, threshold, step)) {
+            solution.position = reference + step;
+            solution.rank = 1;
+            return solution;
+        }
+    }
     const SymmetricEigen eigen = computeSymmetricEigen(qef.ata);
     double largest = 0.0;
     for (int k = 0; k < 3; ++k)

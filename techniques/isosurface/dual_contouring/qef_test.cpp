@@ -252,6 +252,58 @@ TEST(DualContouringQef, RandomSystemsGiveFiniteSolutionsNoWorseThanTheMassPoint)
     }
 }
 
+TEST(DualContouringQef, TheRankOneShortcutAgreesWithTheJacobiSolve)
+{
+    // Cells of a smooth surface: normals within a small cone (rank 1 at threshold 0.1), and, for
+    // contrast, cones wide enough to keep two or three directions. solveQefSvd takes the
+    // certified power-iteration shortcut where only one direction is kept; the reference here is
+    // the truncated solve written out on the Jacobi eigen decomposition. Same rank, positions
+    // within 1e-11 of the step's length (both are accurate to rounding; the shortcut's
+    // eigenvector is certified to 1e-13 / gap, and the Jacobi sweeps stop at 1e-18 of the matrix).
+    std::mt19937 rng(17);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    std::uniform_real_distribution<double> s(-1.0, 1.0);
+    std::uniform_int_distribution<int> count(1, 12);
+    int shortcut = 0;
+    for (int trial = 0; trial < 3000; ++trial) {
+        const double spread = std::pow(10.0, -4.0 + 4.0 * u(rng)); // 1e-4 .. 1
+        const glm::dvec3 axis = glm::normalize(glm::dvec3(s(rng), s(rng), s(rng)) + 1e-9);
+        std::vector<glm::dvec3> points;
+        std::vector<glm::dvec3> normals;
+        const int n = count(rng);
+        for (int i = 0; i < n; ++i) {
+            points.emplace_back(u(rng), u(rng), u(rng));
+            normals.push_back(axis + spread * glm::dvec3(s(rng), s(rng), s(rng)));
+        }
+        const QefSystem qef = dc::buildQef(points, normals);
+        for (const double threshold : {0.0, 0.1, 0.5}) {
+            const dc::SymmetricEigen eigen = dc::computeSymmetricEigen(qef.ata);
+            const double largest = std::max({eigen.values.x, eigen.values.y, eigen.values.z});
+            const double cut = std::max(threshold, dc::kSingularFloor) * std::sqrt(largest);
+            glm::dvec3 step(0.0);
+            int rank = 0;
+            for (int k = 0; k < 3; ++k) {
+                const double lambda = eigen.values[k];
+                if (!(lambda > 0.0) || std::sqrt(lambda) < cut)
+                    continue;
+                step += eigen.vectors[k] * (glm::dot(eigen.vectors[k], qef.atb) / lambda);
+                ++rank;
+            }
+            const dc::QefSolution sol = dc::solveQefSvd(qef, threshold);
+            EXPECT_EQ(sol.rank, rank) << "trial " << trial << " threshold " << threshold;
+            // Relative to the step: with the floor (threshold 0) a direction of lambda near
+            // 1e-12 lambda_max is kept and the step is large.
+            EXPECT_LT(glm::length(sol.position - (qef.massPoint + step)),
+                      1e-11 * (1.0 + glm::length(step)))
+                << "trial " << trial << " threshold " << threshold << " spread " << spread;
+            shortcut += rank == 1;
+        }
+    }
+    // The shortcut's case is the common one in this mix, and the others are exercised too.
+    EXPECT_GT(shortcut, 1000);
+    EXPECT_LT(shortcut, 8000);
+}
+
 TEST(DualContouringQef, SchmitzConvergesToTheSvdCorner)
 {
     // A cube corner seen by one cell: crossings on its 3 faces, 3 + 2 + 1 of them. The mean
