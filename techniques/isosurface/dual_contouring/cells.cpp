@@ -81,6 +81,24 @@ std::uint16_t toCellEdgeMask(unsigned tableMask)
     return mask;
 }
 
+constexpr std::size_t kMaxLoops = tables::kMaxCellLoops;
+
+//! Per case-table entry and loop, the loop's DC cell edge mask (kMaxLoops slots per entry).
+const std::vector<std::uint16_t>& getLoopEdgeMasks()
+{
+    static const std::vector<std::uint16_t> masks = [] {
+        const tables::CaseTable& table = tables::CaseTable::getInstance();
+        std::vector<std::uint16_t> m(table.entryCount() * kMaxLoops, 0);
+        for (std::size_t e = 0; e < table.entryCount(); ++e) {
+            const tables::CellTriangulation& entry = table.entry(e);
+            for (int l = 0; l < entry.loopCount; ++l)
+                m[e * kMaxLoops + std::size_t(l)] = toCellEdgeMask(entry.loops[l]);
+        }
+        return m;
+    }();
+    return masks;
+}
+
 } // namespace
 
 //! Pass 2: the case of every cell and its vertices, numbered in cell scan order.
@@ -155,12 +173,15 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                             c.patches = 1;
                             continue;
                         }
-                        const std::size_t base = grid.index({x, y, z});
-                        std::array<double, 8> values;
-                        for (int j = 0; j < 8; ++j)
-                            values[j] = grid.relative(base + corner[j]);
-                        c.joined = std::uint8_t(tables::decideJoinedFaces(
-                            cube, values, tables::AmbiguityRule::Asymptotic));
+                        // Most cells have no ambiguous face, and then nothing to decide.
+                        if (caseTable.ambiguousFaces(cube) != 0) {
+                            const std::size_t base = grid.index({x, y, z});
+                            std::array<double, 8> values;
+                            for (int j = 0; j < 8; ++j)
+                                values[j] = grid.relative(base + corner[j]);
+                            c.joined = std::uint8_t(tables::decideJoinedFaces(
+                                cube, values, tables::AmbiguityRule::Asymptotic));
+                        }
                         const std::size_t entry = caseTable.entryIndex(cube, c.joined);
                         c.entry = std::uint16_t(entry);
                         c.patches = std::uint8_t(caseTable.entry(entry).loopCount);
@@ -204,6 +225,7 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                                 " vertices exceed 32-bit indices");
     vertices.cell.resize(total);
     vertices.edges.resize(total);
+    const std::vector<std::uint16_t>& loopEdgeMasks = getLoopEdgeMasks();
     vertices.onFace.assign(total, 0);
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         for (int z = r.begin(); z != r.end(); ++z) {
@@ -218,9 +240,10 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                     continue;
                 }
                 const tables::CellTriangulation& entry = caseTable.entry(c.entry);
+                const std::uint16_t* loopMasks = &loopEdgeMasks[std::size_t(c.entry) * kMaxLoops];
                 for (int l = 0; l < entry.loopCount; ++l) {
                     vertices.cell[next] = cell;
-                    vertices.edges[next++] = toCellEdgeMask(entry.loops[l]);
+                    vertices.edges[next++] = loopMasks[l];
                 }
                 for (int f = 1; f < tables::kFaceCount; f += 2) {
                     if (((c.paired >> f) & 1u) == 0)

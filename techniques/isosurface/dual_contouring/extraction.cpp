@@ -47,11 +47,15 @@ void validate(const plugin::IsosurfaceInput& input)
 //! the quad's cycle starts. Returns true for the diagonal v1-v3.
 bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<glm::dvec3, 4>& p)
 {
-    const auto normal = [&](int a, int b, int c) {
-        return normalizeOrZero(glm::cross(p[b] - p[a], p[c] - p[a]));
+    const auto normal = [&](int a, int b, int c) { return glm::cross(p[b] - p[a], p[c] - p[a]); };
+    // The cosine between two triangle normals from their unnormalised cross products (two square
+    // roots per pair instead of four normalisations); 0 where a triangle is degenerate.
+    const auto agree = [](const glm::dvec3& m, const glm::dvec3& n) {
+        const double lengths = std::sqrt(glm::dot(m, m)) * std::sqrt(glm::dot(n, n));
+        return lengths > 0.0 && std::isfinite(lengths) ? glm::dot(m, n) / lengths : 0.0;
     };
-    const double agree02 = glm::dot(normal(0, 1, 2), normal(0, 2, 3));
-    const double agree13 = glm::dot(normal(0, 1, 3), normal(1, 2, 3));
+    const double agree02 = agree(normal(0, 1, 2), normal(0, 2, 3));
+    const double agree13 = agree(normal(0, 1, 3), normal(1, 2, 3));
     if (std::abs(agree02 - agree13) > 1e-12)
         return agree13 > agree02;
     const int smallest = int(std::min_element(q.begin(), q.end()) - q.begin());
@@ -183,6 +187,10 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     // are concatenated in chunk order, so the triangle order is the edge order whatever the
     // thread count.
     constexpr std::size_t kChunk = 8192;
+    // Face vertices are rare (tunnels through ambiguous faces); without any, no quad side can
+    // pass through one and the four lookups per quad are skipped.
+    const bool faceVertices =
+        options.vertices == VertexMode::PerComponent && stats.faceVertices > 0;
     std::vector<ChunkOutput>& chunks = arrays.chunks;
     chunks.resize((edgeCount + kChunk - 1) / kChunk);
     tbb::parallel_for(std::size_t(0), chunks.size(), [&](std::size_t chunk) {
@@ -214,7 +222,7 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
             int firstFace = -1;
             for (int c = 0; c < 4; ++c) {
                 polygon[size++] = q[c];
-                if (options.vertices == VertexMode::PerCell)
+                if (!faceVertices)
                     continue;
                 const std::uint32_t f =
                     findFaceVertex(grid, vertices, around[c], around[(c + 1) % 4], s, axis);
