@@ -3,6 +3,7 @@
 #include "extraction.h"
 #include "isosurface/case_table.h"
 #include "isosurface_test_support.h"
+#include "passes.h"
 #include "plugin/technique.h"
 #include "qef.h"
 
@@ -1162,6 +1163,33 @@ TEST(DualContouringTechnique, RegistersWithItsParametersAndCounters)
     EXPECT_EQ(extract(field, &sdf, {{"solver", std::string("schmitz")}}).counters.at("qef_solver"),
               1.0);
     EXPECT_TRUE(extract(field, &sdf, {{"normals", std::string("none")}}).mesh.normals.empty());
+}
+
+TEST(DualContouringGrid, SampleIndicesDecodeByReciprocalsLikeByDivision)
+{
+    // Grid::sampleOf divides by the row and layer strides through precomputed 64-bit
+    // reciprocals; it must invert index() on every grid shape, powers of two, odd sizes and the
+    // largest index included.
+    std::mt19937 rng(3);
+    for (const glm::ivec3 size :
+         {glm::ivec3(2, 2, 2), glm::ivec3(257, 257, 257), glm::ivec3(256, 3, 7),
+          glm::ivec3(3, 1021, 5), glm::ivec3(4096, 1024, 1023), glm::ivec3(65535, 2, 3)}) {
+        plugin::SampledField field;
+        field.samples = size;
+        const dc::detail::Grid grid(field, 0.0);
+        std::uniform_int_distribution<int> x(0, size.x - 1), y(0, size.y - 1), z(0, size.z - 1);
+        std::vector<glm::ivec3> samples = {glm::ivec3(0), size - 1, glm::ivec3(size.x - 1, 0, 0),
+                                           glm::ivec3(0, size.y - 1, 0),
+                                           glm::ivec3(0, 0, size.z - 1)};
+        for (int i = 0; i < 20000; ++i)
+            samples.emplace_back(x(rng), y(rng), z(rng));
+        for (const glm::ivec3& s : samples) {
+            const std::size_t index =
+                std::size_t(s.x) +
+                std::size_t(size.x) * (std::size_t(s.y) + std::size_t(size.y) * std::size_t(s.z));
+            ASSERT_EQ(grid.sampleOf(index), s) << size.x << "x" << size.y << "x" << size.z;
+        }
+    }
 }
 
 } // namespace

@@ -64,6 +64,12 @@ public:
           mSize(field.samples), mStride{1, std::size_t(field.samples.x),
                                         std::size_t(field.samples.x) * field.samples.y}
     {
+        const std::size_t total = mStride[2] * std::size_t(std::max(field.samples.z, 0));
+        mFastDivide = total < (std::size_t(1) << 32) && mStride[1] >= 2 && mStride[2] >= 2;
+        if (mFastDivide) {
+            mRowReciprocal = computeReciprocal(mStride[1]);
+            mLayerReciprocal = computeReciprocal(mStride[2]);
+        }
     }
 
     int size(int axis) const { return mSize[axis]; }
@@ -72,8 +78,14 @@ public:
     std::size_t index(const glm::ivec3& s) const { return mField.index(s.x, s.y, s.z); }
     glm::ivec3 sampleOf(std::size_t i) const
     {
-        return glm::ivec3(int(i % mStride[1]), int((i / mStride[1]) % mSize.y),
-                          int(i / mStride[2]));
+        if (!mFastDivide)
+            return glm::ivec3(int(i % mStride[1]), int((i / mStride[1]) % mSize.y),
+                              int(i / mStride[2]));
+        // Every edge and quad decodes its sample: a multiply instead of each 64-bit division.
+        const std::size_t z = divide(i, mLayerReciprocal);
+        const std::size_t rest = i - z * mStride[2];
+        const std::size_t y = divide(rest, mRowReciprocal);
+        return glm::ivec3(int(rest - y * mStride[1]), int(y), int(z));
     }
     //! Value relative to the iso-value; f < iso exactly when relative < 0.
     double relative(std::size_t i) const { return double(mField.values[i]) - mIso; }
@@ -104,10 +116,22 @@ public:
     }
 
 private:
+    //! floor((2^64 - 1) / d) + 1 for d >= 2, i.e. floor(2^64 / d) + 1, or 2^64 / d for a power of
+    //! two: for i, d < 2^32, floor(i / d) = (i * r) >> 64 exactly (the product overshoots i / d by
+    //! less than i / 2^64 < 1 / d, which no fractional part of i / d reaches).
+    static std::uint64_t computeReciprocal(std::size_t d) { return ~std::uint64_t(0) / d + 1u; }
+    static std::size_t divide(std::size_t i, std::uint64_t reciprocal)
+    {
+        return std::size_t((unsigned __int128)(i)*reciprocal >> 64);
+    }
+
     const plugin::SampledField& mField;
     double mIso;
     glm::ivec3 mSize;
     std::size_t mStride[3];
+    bool mFastDivide = false;
+    std::uint64_t mRowReciprocal = 0;
+    std::uint64_t mLayerReciprocal = 0;
 };
 
 //! One crossed grid edge's Hermite point and normal (grid units; normal unit or zero).
@@ -354,6 +378,9 @@ struct CellVertices {
     std::vector<glm::dvec3> local;    //!< per vertex, position relative to its cell, cells
     std::vector<glm::dvec3> normal;   //!< per vertex, unit
     std::vector<QefSystem> qef;       //!< per vertex, kept for the relaxation only
+    //! per vertex, placeVertices' counters before their serial sum: rank, left its cell, normals
+    //! skipped, no plane (kept here so that a reused workspace allocates nothing per call).
+    std::vector<std::array<std::uint8_t, 4>> placement;
 
     //! Number of the active cell `cell` (inside the grid), or kNone when it has no sign change.
     std::uint32_t findActive(const glm::ivec3& cell) const

@@ -47,12 +47,13 @@ QefSystem buildQef(std::span<const glm::dvec3> points, std::span<const glm::dvec
     int skippedCount = 0;
     for (std::size_t i = 0; i < count; ++i) {
         const glm::dvec3 n = normals[i];
-        const double length = glm::length(n);
-        if (!isFinite(points[i]) || !std::isfinite(length) || !(length > 0.0)) {
+        const double squared = glm::dot(n, n);
+        if (!isFinite(points[i]) || !std::isfinite(squared) || !(squared > 0.0)) {
             ++skippedCount;
             continue;
         }
-        const glm::dvec3 unit = n / length;
+        // Normals that are unit to rounding (the mesher's are) are used as they are.
+        const glm::dvec3 unit = std::abs(squared - 1.0) <= 1e-15 ? n : n / std::sqrt(squared);
         const double b = glm::dot(unit, points[i] - qef.massPoint);
         qef.ata += glm::outerProduct(unit, unit);
         qef.atb += unit * b;

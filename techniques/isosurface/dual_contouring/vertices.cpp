@@ -14,14 +14,15 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                    bool keepQef, CellVertices& vertices, ExtractionStats& stats)
 {
     const std::size_t count = vertices.cell.size();
-    vertices.local.assign(count, glm::dvec3(0.0));
-    vertices.normal.assign(count, glm::dvec3(0.0));
+    vertices.local.resize(count); // every entry is written below
+    if (options.computeNormals)
+        vertices.normal.resize(count); // likewise
+    else
+        vertices.normal.assign(count, glm::dvec3(0.0));
     if (keepQef)
         vertices.qef.assign(count, QefSystem{});
-    std::vector<std::uint8_t> rank(count, 0);
-    std::vector<std::uint8_t> left(count, 0);
-    std::vector<std::uint8_t> skipped(count, 0);
-    std::vector<std::uint8_t> noPlanes(count, 0);
+    // Every entry of placement is written below (a face vertex's is not read).
+    vertices.placement.resize(count);
     const auto& cellEdges = getCellEdgeOffsets();
 
     tbb::parallel_for(
@@ -59,7 +60,8 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                 int skippedHere = 0;
                 const QefSystem qef = buildQef(std::span(points.data(), n),
                                                std::span(normals.data(), n), &skippedHere);
-                skipped[v] = std::uint8_t(skippedHere);
+                std::array<std::uint8_t, 4>& placed = vertices.placement[v];
+                placed = {0, 0, std::uint8_t(skippedHere), 0};
                 QefSolution solution;
                 if (options.solver == QefSolver::Svd) {
                     solution = solveQefSvd(qef, options.svdThreshold);
@@ -72,13 +74,13 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                 }
                 glm::dvec3 p = solution.position;
                 if (qef.planeCount == 0) {
-                    noPlanes[v] = 1;
+                    placed[3] = 1;
                     p = qef.massPoint;
                 }
                 if (!isFinite(p))
                     p = qef.massPoint;
                 if (!isInsideBox(p)) {
-                    left[v] = 1;
+                    placed[1] = 1;
                     switch (options.outsidePolicy) {
                     case OutsidePolicy::Clamp:
                         p = glm::clamp(p, glm::dvec3(0.0), glm::dvec3(1.0));
@@ -91,7 +93,7 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                     }
                 }
                 vertices.local[v] = p;
-                rank[v] = std::uint8_t(solution.rank);
+                placed[0] = std::uint8_t(solution.rank);
                 if (keepQef)
                     vertices.qef[v] = qef;
                 if (options.computeNormals) {
@@ -113,10 +115,11 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
     for (std::size_t v = 0; v < count; ++v) {
         if (vertices.onFace[v])
             continue;
-        ++stats.rank[std::min<int>(rank[v], 3)];
-        stats.leftCell += left[v];
-        stats.skippedNormals += skipped[v];
-        stats.cellsWithoutPlanes += noPlanes[v];
+        const std::array<std::uint8_t, 4>& placed = vertices.placement[v];
+        ++stats.rank[std::min<int>(placed[0], 3)];
+        stats.leftCell += placed[1];
+        stats.skippedNormals += placed[2];
+        stats.cellsWithoutPlanes += placed[3];
     }
 }
 
