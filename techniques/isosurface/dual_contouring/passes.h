@@ -7,6 +7,7 @@
 #include "extraction.h"
 #include "qef.h"
 
+#include "isosurface/case_table.h"
 #include "isosurface/sign_rows.h"
 
 #include <glm/geometric.hpp>
@@ -348,9 +349,29 @@ inline bool isInsideBox(const glm::dvec3& p)
 }
 
 //! The four cells around edge (sample, axis), counter-clockwise seen from +axis.
-std::array<glm::ivec3, 4> getCellsAroundEdge(const glm::ivec3& s, int axis);
-//! Marching cubes edge id of the cell edge that starts at `offset` and runs along `axis`.
-int getTableEdge(const glm::ivec3& offset, int axis);
+inline std::array<glm::ivec3, 4> getCellsAroundEdge(const glm::ivec3& s, int axis)
+{
+    const int b = (axis + 1) % 3;
+    const int c = (axis + 2) % 3;
+    std::array<glm::ivec3, 4> cells;
+    constexpr int kOrder[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    for (int k = 0; k < 4; ++k) {
+        glm::ivec3 cell = s;
+        cell[b] -= 1 - kOrder[k][0];
+        cell[c] -= 1 - kOrder[k][1];
+        cells[k] = cell;
+    }
+    return cells;
+}
+
+//! Marching cubes edge id (framework/isosurface/case_table.h numbering) of the cell edge that
+//! starts at `offset` (0 or 1 per axis) from the cell's lowest sample and runs along `axis`.
+inline int getTableEdge(const glm::ivec3& offset, int axis)
+{
+    const int u = axis == 0 ? 1 : 0;
+    const int v = axis == 2 ? 1 : 2;
+    return axis * 4 + offset[u] + 2 * offset[v];
+}
 
 //! What the vertex passes need to know about each cell.
 struct CellCase {
@@ -412,9 +433,19 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                  CellVertices& vertices);
 
 //! The vertex that the quads around the crossed grid edge (sample s, axis) use in `cell`.
-std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertices,
-                             const ExtractionOptions& options, const glm::ivec3& cell,
-                             const glm::ivec3& s, int axis);
+inline std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertices,
+                                    const ExtractionOptions& options, const glm::ivec3& cell,
+                                    const glm::ivec3& s, int axis)
+{
+    const std::uint32_t k = vertices.findActive(cell);
+    if (k == kNone)
+        return kNone;
+    const std::uint32_t first = vertices.vertexOfCell[k];
+    if (options.vertices == VertexMode::PerCell)
+        return first;
+    const auto& entry = tables::CaseTable::getInstance().entry(vertices.cases[k].entry);
+    return first + std::uint32_t(entry.edgeLoop[getTableEdge(s - cell, axis)]);
+}
 
 //! The face vertex between `cell` and its neighbour `other` for the segment holding the crossed
 //! grid edge (sample s, axis), or kNone when that face has none.
