@@ -58,6 +58,22 @@ std::uint16_t toCellEdgeMask(unsigned tableMask)
 
 constexpr std::size_t kMaxLoops = tables::kMaxCellLoops;
 
+//! Per case-table entry, its edgeLoop packed 2 bits per table edge (CellCase::edgeLoops).
+const std::vector<std::uint32_t>& getPackedEdgeLoops()
+{
+    static const std::vector<std::uint32_t> packed = [] {
+        static_assert(tables::kMaxCellLoops <= 4 && tables::kEdgeCount <= 16);
+        const tables::CaseTable& table = tables::CaseTable::getInstance();
+        std::vector<std::uint32_t> p(table.entryCount(), 0);
+        for (std::size_t e = 0; e < table.entryCount(); ++e)
+            for (int edge = 0; edge < tables::kEdgeCount; ++edge)
+                if (const int loop = table.entry(e).edgeLoop[std::size_t(edge)]; loop >= 0)
+                    p[e] |= std::uint32_t(loop) << (2 * edge);
+        return p;
+    }();
+    return packed;
+}
+
 //! Per case-table entry and loop, the loop's DC cell edge mask (kMaxLoops slots per entry).
 const std::vector<std::uint16_t>& getLoopEdgeMasks()
 {
@@ -124,9 +140,9 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                                 " cells with a sign change exceed 32-bit indices");
     vertices.activeCell.resize(activeCount);
     vertices.cases.resize(activeCount);
-    vertices.vertexOfCell.resize(activeCount);
 
     // Cases and patches.
+    const std::vector<std::uint32_t>& packedEdgeLoops = getPackedEdgeLoops();
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         std::array<std::size_t, 8> corner{};
         for (int k = 0; k < 8; ++k)
@@ -160,6 +176,7 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                         const std::size_t entry = caseTable.entryIndex(cube, c.joined);
                         c.entry = std::uint16_t(entry);
                         c.patches = std::uint8_t(caseTable.entry(entry).loopCount);
+                        c.edgeLoops = packedEdgeLoops[entry];
                     }
                 }
         }
@@ -206,9 +223,9 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
         for (int z = r.begin(); z != r.end(); ++z) {
             std::uint32_t next = std::uint32_t(layerCount[z]);
             for (std::uint64_t i = layerActive[z]; i != layerActive[z + 1]; ++i) {
-                const CellCase& c = vertices.cases[i];
+                CellCase& c = vertices.cases[i];
                 const glm::ivec3 cell = vertices.activeCell[i];
-                vertices.vertexOfCell[i] = next;
+                c.firstVertex = next;
                 if (!perComponent) {
                     vertices.cell[next] = cell;
                     vertices.edges[next++] = 0xfff;
@@ -260,8 +277,7 @@ std::uint32_t findFaceVertex(const Grid& grid, const CellVertices& vertices, glm
     const int segment = tables::findFaceSegment(c.cube, face, ((c.joined >> face) & 1u) != 0,
                                                 getTableEdge(s - cell, axis));
     const unsigned before = unsigned(c.paired & kHighFaces) & ((1u << face) - 1u);
-    return vertices.vertexOfCell[k] + c.patches + 2u * std::popcount(before) +
-           std::uint32_t(segment);
+    return c.firstVertex + c.patches + 2u * std::popcount(before) + std::uint32_t(segment);
 }
 
 } // namespace rtlab::isosurface::dc::detail

@@ -380,6 +380,10 @@ struct CellCase {
     std::uint8_t joined = 0;  //!< ambiguous faces whose inside corners are joined across them
     std::uint8_t paired = 0;  //!< faces that this cell's and the neighbour's patch both cross twice
     std::uint8_t patches = 0; //!< patch vertices of the cell (0 when it has no sign change)
+    //! 2 bits per table edge: the loop (patch) a crossed edge lies on (the case table's edgeLoop,
+    //! copied here so that a quad's vertex lookup does not reach into the case table).
+    std::uint32_t edgeLoops = 0;
+    std::uint32_t firstVertex = 0; //!< the cell's first vertex (its patches', then face vertices)
 };
 
 //! The active cells (those with a sign change) and their vertices. Cells are found through bit
@@ -392,7 +396,6 @@ struct CellVertices {
     std::vector<std::uint32_t> activeBase;
     std::vector<glm::ivec3> activeCell;      //!< per active cell, in scan order
     std::vector<CellCase> cases;             //!< per active cell
-    std::vector<std::uint32_t> vertexOfCell; //!< per active cell: its first vertex
     std::vector<glm::ivec3> cell;            //!< per vertex
     std::vector<std::uint16_t> edges; //!< per vertex: its cell edges (getCellEdgeOffsets bits)
     std::vector<std::uint8_t> onFace; //!< per vertex: 1 for a face vertex (see numberCells)
@@ -440,11 +443,8 @@ inline std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertic
     const std::uint32_t k = vertices.findActive(cell);
     if (k == kNone)
         return kNone;
-    const std::uint32_t first = vertices.vertexOfCell[k];
-    if (options.vertices == VertexMode::PerCell)
-        return first;
-    const auto& entry = tables::CaseTable::getInstance().entry(vertices.cases[k].entry);
-    return first + std::uint32_t(entry.edgeLoop[getTableEdge(s - cell, axis)]);
+    const CellCase& c = vertices.cases[k];
+    return c.firstVertex + ((c.edgeLoops >> (2 * getTableEdge(s - cell, axis))) & 3u);
 }
 
 //! The face vertex between `cell` and its neighbour `other` for the segment holding the crossed
