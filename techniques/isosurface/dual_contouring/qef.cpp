@@ -165,24 +165,26 @@ bool solveRankOne(const QefSystem& qef, const glm::dvec3& residual, double thres
             bestLength = length;
         }
     }
-    glm::dvec3 v = m4 * m4[best];
-    const double norm = glm::length(v);
-    if (!(norm > 0.0) || !std::isfinite(norm))
+    // v is not normalised: every test below divides by |v|^2 instead (no square root on the
+    // path, which is latency-bound).
+    const glm::dvec3 v = m4 * m4[best];
+    const double vv = glm::dot(v, v);
+    if (!(vv > 0.0) || !std::isfinite(vv))
         return false;
-    v /= norm;
     const glm::dvec3 mv = m * v;
-    const double mu = glm::dot(v, mv); // lambda_1 / trace
-    const double rest = 1.0 - mu;      // (lambda_2 + lambda_3) / trace, both >= 0
+    const double mu = glm::dot(v, mv) / vv; // lambda_1 / trace
+    const double rest = 1.0 - mu;           // (lambda_2 + lambda_3) / trace, both >= 0
     // The truncation keeps sigma_k >= cut sigma_max, i.e. lambda_k >= cut^2 lambda_1.
     const double cut = std::max(threshold, kSingularFloor);
     const double cutLambda = cut * cut * mu;
     if (!(rest < 0.5 * cutLambda) || !(mu > 0.5))
         return false;
-    if (glm::length(mv - mu * v) > 1e-13)
+    const glm::dvec3 r = mv - mu * v; // |r| / |v|: the residual of the unit vector
+    if (glm::dot(r, r) > 1e-26 * vv)
         return false;
     // The dropped eigenvalues are below half the cut and mu within 1e-13 of lambda_1 / trace:
     // sigma_1 is kept (it is sigma_max) and the other two are dropped, as the Jacobi solve does.
-    step = v * (glm::dot(v, residual) / (mu * trace));
+    step = v * (glm::dot(v, residual) / (mu * trace * vv));
     return true;
 }
 
