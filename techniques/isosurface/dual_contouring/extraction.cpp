@@ -8,6 +8,50 @@
 #include <string>
 
 namespace rtlab::isosurface::dc {
+
+namespace detail {
+
+//! Splits quad (v0, v1, v2, v3) into two triangles. Rule: the diagonal whose two triangles'
+//! unit normals agree best (largest dot product), which never folds a planar non-convex quad and
+//! follows the crease of a bent one; a tie (|difference| <= 1e-12, e.g. planar convex quads)
+//! takes the diagonal through the quad's smallest vertex index, which does not depend on where
+//! the quad's cycle starts. Returns true for the diagonal v1-v3.
+bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<glm::dvec3, 4>& p)
+{
+    const auto normal = [&](int a, int b, int c) { return glm::cross(p[b] - p[a], p[c] - p[a]); };
+    // The cosine between two triangle normals from their unnormalised cross products (two square
+    // roots per pair instead of four normalisations); 0 where a triangle is degenerate.
+    const auto agree = [](const glm::dvec3& m, const glm::dvec3& n) {
+        const double lengths = std::sqrt(glm::dot(m, m)) * std::sqrt(glm::dot(n, n));
+        return lengths > 0.0 && std::isfinite(lengths) ? glm::dot(m, n) / lengths : 0.0;
+    };
+    const glm::dvec3 a012 = normal(0, 1, 2), a023 = normal(0, 2, 3);
+    const glm::dvec3 a013 = normal(0, 1, 3), a123 = normal(1, 2, 3);
+    // Most quads are decided without a square root or a division: with the cosines c = d / sqrt(L)
+    // (d the dot product of the two normals, L the product of their squared lengths), c |c| =
+    // d |d| / L is monotonic in c and |c13 - c02| >= |c13 |c13| - c02 |c02|| / 2, so where the
+    // cross-multiplied difference exceeds 3e-12 (1e-12 twice, and a margin for rounding) the
+    // cosines differ by more than the tie tolerance and the sign decides. Degenerate triangles
+    // and near-ties take the exact path below.
+    {
+        const double d02 = glm::dot(a012, a023), l02 = glm::dot(a012, a012) * glm::dot(a023, a023);
+        const double d13 = glm::dot(a013, a123), l13 = glm::dot(a013, a013) * glm::dot(a123, a123);
+        if (l02 > 0.0 && l13 > 0.0 && std::isfinite(l02 * l13)) {
+            const double difference = d13 * std::abs(d13) * l02 - d02 * std::abs(d02) * l13;
+            if (std::abs(difference) > 3e-12 * l02 * l13)
+                return difference > 0.0;
+        }
+    }
+    const double agree02 = agree(a012, a023);
+    const double agree13 = agree(a013, a123);
+    if (std::abs(agree02 - agree13) > 1e-12)
+        return agree13 > agree02;
+    const int smallest = int(std::min_element(q.begin(), q.end()) - q.begin());
+    return smallest % 2 == 1;
+}
+
+} // namespace detail
+
 namespace {
 
 using namespace detail;
@@ -38,28 +82,6 @@ void validate(const plugin::IsosurfaceInput& input)
                                     " materials for " + std::to_string(expected) + " samples");
     if (input.hermite != nullptr && input.hermite->samples != field.samples)
         throw std::invalid_argument("dual_contouring: the Hermite data refers to another grid");
-}
-
-//! Splits quad (v0, v1, v2, v3) into two triangles. Rule: the diagonal whose two triangles'
-//! unit normals agree best (largest dot product), which never folds a planar non-convex quad and
-//! follows the crease of a bent one; a tie (|difference| <= 1e-12, e.g. planar convex quads)
-//! takes the diagonal through the quad's smallest vertex index, which does not depend on where
-//! the quad's cycle starts. Returns true for the diagonal v1-v3.
-bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<glm::dvec3, 4>& p)
-{
-    const auto normal = [&](int a, int b, int c) { return glm::cross(p[b] - p[a], p[c] - p[a]); };
-    // The cosine between two triangle normals from their unnormalised cross products (two square
-    // roots per pair instead of four normalisations); 0 where a triangle is degenerate.
-    const auto agree = [](const glm::dvec3& m, const glm::dvec3& n) {
-        const double lengths = std::sqrt(glm::dot(m, m)) * std::sqrt(glm::dot(n, n));
-        return lengths > 0.0 && std::isfinite(lengths) ? glm::dot(m, n) / lengths : 0.0;
-    };
-    const double agree02 = agree(normal(0, 1, 2), normal(0, 2, 3));
-    const double agree13 = agree(normal(0, 1, 3), normal(1, 2, 3));
-    if (std::abs(agree02 - agree13) > 1e-12)
-        return agree13 > agree02;
-    const int smallest = int(std::min_element(q.begin(), q.end()) - q.begin());
-    return smallest % 2 == 1;
 }
 
 struct ChunkOutput {

@@ -452,6 +452,10 @@ inline std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertic
 std::uint32_t findFaceVertex(const Grid& grid, const CellVertices& vertices, glm::ivec3 cell,
                              glm::ivec3 other, const glm::ivec3& s, int axis);
 
+//! The diagonal a quad (q[0..3], positions p[0..3] in any common frame) is split along: true
+//! for v1-v3 (extraction.cpp; the rule is documented there).
+bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<glm::dvec3, 4>& p);
+
 //! Pass 3: one QEF vertex per cell or patch (vertices.cpp).
 void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOptions& options,
                    bool keepQef, CellVertices& vertices, ExtractionStats& stats);
