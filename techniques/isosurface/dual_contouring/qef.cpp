@@ -23,48 +23,6 @@ double QefSystem::evaluate(const glm::dvec3& x) const
     return glm::dot(y, ata * y) - 2.0 * glm::dot(y, atb) + btb;
 }
 
-QefSystem buildQef(std::span<const glm::dvec3> points, std::span<const glm::dvec3> normals,
-                   int* skipped)
-{
-    QefSystem qef;
-    const std::size_t count = std::min(points.size(), normals.size());
-    glm::dvec3 sum(0.0);
-    int finitePoints = 0;
-    for (std::size_t i = 0; i < count; ++i) {
-        if (!isFinite(points[i]))
-            continue;
-        sum += points[i];
-        ++finitePoints;
-    }
-    qef.pointCount = finitePoints;
-    if (finitePoints == 0) {
-        if (skipped != nullptr)
-            *skipped = int(count);
-        return qef;
-    }
-    qef.massPoint = sum / double(finitePoints);
-
-    int skippedCount = 0;
-    for (std::size_t i = 0; i < count; ++i) {
-        const glm::dvec3 n = normals[i];
-        const double squared = glm::dot(n, n);
-        if (!isFinite(points[i]) || !std::isfinite(squared) || !(squared > 0.0)) {
-            ++skippedCount;
-            continue;
-        }
-        // Normals that are unit to rounding (the mesher's are) are used as they are.
-        const glm::dvec3 unit = std::abs(squared - 1.0) <= 1e-15 ? n : n / std::sqrt(squared);
-        const double b = glm::dot(unit, points[i] - qef.massPoint);
-        qef.ata += glm::outerProduct(unit, unit);
-        qef.atb += unit * b;
-        qef.btb += b * b;
-        ++qef.planeCount;
-    }
-    if (skipped != nullptr)
-        *skipped = skippedCount;
-    return qef;
-}
-
 SymmetricEigen computeSymmetricEigen(const glm::dmat3& m)
 {
     // a[r][c] row-major copy, symmetrised.

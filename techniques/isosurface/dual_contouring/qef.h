@@ -8,14 +8,23 @@
 // the minimiser closest to m [Lindstrom 2000; Schaefer & Warren 2002, "Dual Contouring: The Secret
 // Sauce"].
 
+#include <glm/geometric.hpp>
 #include <glm/mat3x3.hpp>
+#include <glm/matrix.hpp>
 #include <glm/vec3.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <span>
 
 namespace rtlab::isosurface::dc {
+
+inline bool isFiniteVector(const glm::dvec3& v)
+{
+    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
+}
 
 //! A QEF relative to its mass point. Coordinates are whatever the caller uses (grid units here).
 struct QefSystem {
@@ -33,8 +42,48 @@ struct QefSystem {
 //! Builds the QEF of points[i] with normals[i]. Normals are normalised; zero, NaN or infinite
 //! normals (and points that are not finite) give no plane, and are counted in `skipped` when it
 //! is given. Points that are not finite are also left out of the mass point.
-QefSystem buildQef(std::span<const glm::dvec3> points, std::span<const glm::dvec3> normals,
-                   int* skipped = nullptr);
+//! (Inline: the mesher builds one per vertex.)
+inline QefSystem buildQef(std::span<const glm::dvec3> points, std::span<const glm::dvec3> normals,
+                          int* skipped = nullptr)
+{
+    QefSystem qef;
+    const std::size_t count = std::min(points.size(), normals.size());
+    glm::dvec3 sum(0.0);
+    int finitePoints = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        if (!isFiniteVector(points[i]))
+            continue;
+        sum += points[i];
+        ++finitePoints;
+    }
+    qef.pointCount = finitePoints;
+    if (finitePoints == 0) {
+        if (skipped != nullptr)
+            *skipped = int(count);
+        return qef;
+    }
+    qef.massPoint = sum / double(finitePoints);
+
+    int skippedCount = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const glm::dvec3 n = normals[i];
+        const double squared = glm::dot(n, n);
+        if (!isFiniteVector(points[i]) || !std::isfinite(squared) || !(squared > 0.0)) {
+            ++skippedCount;
+            continue;
+        }
+        // Normals that are unit to rounding (the mesher's are) are used as they are.
+        const glm::dvec3 unit = std::abs(squared - 1.0) <= 1e-15 ? n : n / std::sqrt(squared);
+        const double b = glm::dot(unit, points[i] - qef.massPoint);
+        qef.ata += glm::outerProduct(unit, unit);
+        qef.atb += unit * b;
+        qef.btb += b * b;
+        ++qef.planeCount;
+    }
+    if (skipped != nullptr)
+        *skipped = skippedCount;
+    return qef;
+}
 
 //! Eigen decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations [Golub & Van Loan,
 //! "Matrix Computations", sec. 8.5]: m = V diag(values) V^T, columns of V orthonormal.
