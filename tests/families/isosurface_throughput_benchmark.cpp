@@ -4,8 +4,9 @@
 // hierarchical SDF evaluator at grid^3 samples with Hermite data; every technique meshes those
 // samples (dual contouring also reads the Hermite data). Each technique runs inside a TBB arena of
 // `threads` workers, with its own `threads` parameter set to the same count where it has one
-// (VTK's SMP backend is TBB; OpenVDB uses TBB), after one warm-up call; the time is the median of
-// the repeats' wall time around extract().
+// (VTK's SMP backend is TBB; OpenVDB uses TBB), after one warm-up call; the techniques then take
+// turns for --repeats rounds and each time is the median of its rounds' wall time around
+// extract().
 //
 //   isosurface_throughput_benchmark [--grid 256] [--threads N] [--repeats 5] [--technique NAME]...
 //                                   [--quick]
@@ -14,7 +15,6 @@
 // --threads 0 (the default) runs at 1 thread and at all hardware threads. --quick: grid 32, one
 // repeat (the ctest that keeps it compiling and running).
 
-#include "metrics/timing.h"
 #include "families/isosurface/isosurface.h"
 #include "plugin/technique.h"
 #include "scene/procedural.h"
@@ -24,10 +24,12 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -63,25 +65,50 @@ scene::SdfModel makeSphereModel()
     return m;
 }
 
-double timeTechnique(const plugin::TechniqueEntry& entry, const plugin::IsosurfaceInput& input,
-                     int threads, int repeats, std::size_t& triangles)
-{
-    config::ParamSet params = config::ParamSet::defaultsOf(entry.schema);
-    if (entry.schema.find("threads"))
-        params.set("threads", std::int64_t(threads));
-    auto technique = entry.create(params);
-    auto* mesher = dynamic_cast<plugin::IsosurfaceTechnique*>(technique.get());
+//! One technique's mesher, created with the thread count, and its extraction times.
+struct Timed {
+    std::unique_ptr<plugin::Technique> technique;
+    plugin::IsosurfaceTechnique* mesher = nullptr;
     TriangleMesh mesh;
-    metrics::TimingReport report;
+    std::vector<double> ms;
+};
+
+//! Times every technique on one input: one untimed warm-up call each, then `repeats` rounds in
+//! which the techniques take turns, each keeping the median of its rounds. Alternating keeps a
+//! slow phase of a shared machine (other tenants, clock changes) from landing on one technique
+//! only and skewing the ratios, which compare techniques timed within the same rounds.
+void timeTechniques(const std::vector<const plugin::TechniqueEntry*>& entries,
+                    const plugin::IsosurfaceInput& input, int threads, int repeats,
+                    std::map<std::string, double>& ms, std::map<std::string, std::size_t>& tris)
+{
+    std::vector<Timed> timed(entries.size());
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        config::ParamSet params = config::ParamSet::defaultsOf(entries[i]->schema);
+        if (entries[i]->schema.find("threads"))
+            params.set("threads", std::int64_t(threads));
+        timed[i].technique = entries[i]->create(params);
+        timed[i].mesher = dynamic_cast<plugin::IsosurfaceTechnique*>(timed[i].technique.get());
+    }
     tbb::task_arena arena(threads);
     arena.execute([&] {
-        report = metrics::measure({.warmup = 1, .repeats = repeats}, [&] {
-            mesher->extract(input, mesh);
-            return metrics::GpuPassTimes{};
-        });
+        for (Timed& t : timed)
+            t.mesher->extract(input, t.mesh);
+        for (int r = 0; r < repeats; ++r)
+            for (Timed& t : timed) {
+                const auto start = std::chrono::steady_clock::now();
+                t.mesher->extract(input, t.mesh);
+                t.ms.push_back(std::chrono::duration<double, std::milli>(
+                                   std::chrono::steady_clock::now() - start)
+                                   .count());
+            }
     });
-    triangles = mesh.indices.size() / 3;
-    return report.cpuMs.median;
+    for (std::size_t i = 0; i < entries.size(); ++i) {
+        std::vector<double>& v = timed[i].ms;
+        std::sort(v.begin(), v.end());
+        const std::size_t mid = v.size() / 2;
+        ms[entries[i]->info.name] = v.size() % 2 ? v[mid] : 0.5 * (v[mid - 1] + v[mid]);
+        tris[entries[i]->info.name] = timed[i].mesh.indices.size() / 3;
+    }
 }
 
 } // namespace
@@ -154,9 +181,7 @@ int main(int argc, char** argv)
         for (int threads : threadCounts) {
             std::map<std::string, double> ms;
             std::map<std::string, std::size_t> tris;
-            for (const auto* entry : techniques)
-                ms[entry->info.name] =
-                    timeTechnique(*entry, input, threads, options.repeats, tris[entry->info.name]);
+            timeTechniques(techniques, input, threads, options.repeats, ms, tris);
             for (const auto* entry : techniques) {
                 const std::string& name = entry->info.name;
                 auto ratio = [&](const char* baseline) {

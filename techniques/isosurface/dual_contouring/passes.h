@@ -159,8 +159,23 @@ struct EdgeTable {
     std::uint32_t find(const glm::ivec3& s, int axis) const
     {
         const std::size_t w = std::size_t(s.x) >> 6;
-        const int bit = s.x & 63;
-        const SignRows::Crossings c = rows.getCrossings(s.y, s.z, w);
+        return findIn(getWord(s.y, s.z, w), s.x & 63, axis);
+    }
+
+    //! One 64-sample word of a sample row: its crossings and the number of its first edge.
+    struct Word {
+        SignRows::Crossings crossings;
+        std::uint32_t base;
+    };
+    Word getWord(int y, int z, std::size_t w) const
+    {
+        const std::size_t row = std::size_t(z) * std::size_t(rows.size(1)) + std::size_t(y);
+        return {rows.getCrossings(y, z, w), wordBase[row * rows.words() + w]};
+    }
+    //! find() within a word already fetched: `bit` is the sample's x within it.
+    static std::uint32_t findIn(const Word& word, int bit, int axis)
+    {
+        const SignRows::Crossings& c = word.crossings;
         if (((c.axis[axis] >> bit) & 1u) == 0)
             return kNone;
         // Edges before this one in the word: all axes at lower samples, lower axes at this one.
@@ -170,8 +185,7 @@ struct EdgeTable {
                                             std::popcount(c.axis[2] & below));
         for (int a = 0; a < axis; ++a)
             index += std::uint32_t((c.axis[a] >> bit) & 1u);
-        const std::size_t row = std::size_t(s.z) * std::size_t(rows.size(1)) + std::size_t(s.y);
-        return wordBase[row * rows.words() + w] + index;
+        return word.base + index;
     }
 };
 

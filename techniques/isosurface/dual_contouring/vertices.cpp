@@ -30,14 +30,31 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
         [&](const tbb::blocked_range<std::size_t>& range) {
             std::array<glm::dvec3, 12> points;
             std::array<glm::dvec3, 12> normals;
+            // The cell's edges start in 4 sample rows and at most 2 words of each: those words
+            // are fetched once per cell (the vertices of a cell follow each other).
+            glm::ivec3 cached(-1);
+            std::array<EdgeTable::Word, 8> words;
+            unsigned fetched = 0;
             for (std::size_t v = range.begin(); v != range.end(); ++v) {
                 const glm::ivec3 cell = vertices.cell[v];
+                if (cell != cached) {
+                    cached = cell;
+                    fetched = 0;
+                }
                 int n = 0;
                 glm::dvec3 normalSum(0.0);
                 // The set bits only (a loop over all 12 mispredicts at every other edge).
                 for (unsigned bits = vertices.edges[v]; bits != 0; bits &= bits - 1) {
                     const CellEdgeOffset& e = cellEdges[std::size_t(std::countr_zero(bits))];
-                    const std::uint32_t id = table.find(cell + e.offset, e.axis);
+                    const int sx = cell.x + e.offset.x;
+                    const unsigned slot = unsigned(e.offset.y + 2 * e.offset.z) * 2u +
+                                          unsigned((sx >> 6) - (cell.x >> 6));
+                    if (((fetched >> slot) & 1u) == 0) {
+                        words[slot] = table.getWord(cell.y + e.offset.y, cell.z + e.offset.z,
+                                                    std::size_t(sx) >> 6);
+                        fetched |= 1u << slot;
+                    }
+                    const std::uint32_t id = EdgeTable::findIn(words[slot], sx & 63, e.axis);
                     if (id == kNone)
                         continue;
                     const Crossing& c = table.crossings[id];
