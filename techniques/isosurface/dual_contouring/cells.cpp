@@ -58,20 +58,32 @@ std::uint16_t toCellEdgeMask(unsigned tableMask)
 
 constexpr std::size_t kMaxLoops = tables::kMaxCellLoops;
 
-//! Per case-table entry, its edgeLoop packed 2 bits per table edge (CellCase::edgeLoops).
-const std::vector<std::uint32_t>& getPackedEdgeLoops()
+//! What numberCells reads of a case-table entry, packed small (the entries themselves hold
+//! triangles and loops, a few cache lines each): edgeLoop at 2 bits per table edge
+//! (CellCase::edgeLoops), the loop count and the doubled faces.
+struct CompactEntry {
+    std::uint32_t edgeLoops = 0;
+    std::uint8_t loopCount = 0;
+    std::uint8_t doubledFaces = 0;
+};
+
+const std::vector<CompactEntry>& getCompactEntries()
 {
-    static const std::vector<std::uint32_t> packed = [] {
+    static const std::vector<CompactEntry> compact = [] {
         static_assert(tables::kMaxCellLoops <= 4 && tables::kEdgeCount <= 16);
         const tables::CaseTable& table = tables::CaseTable::getInstance();
-        std::vector<std::uint32_t> p(table.entryCount(), 0);
-        for (std::size_t e = 0; e < table.entryCount(); ++e)
+        std::vector<CompactEntry> c(table.entryCount());
+        for (std::size_t e = 0; e < table.entryCount(); ++e) {
+            const tables::CellTriangulation& entry = table.entry(e);
             for (int edge = 0; edge < tables::kEdgeCount; ++edge)
-                if (const int loop = table.entry(e).edgeLoop[std::size_t(edge)]; loop >= 0)
-                    p[e] |= std::uint32_t(loop) << (2 * edge);
-        return p;
+                if (const int loop = entry.edgeLoop[std::size_t(edge)]; loop >= 0)
+                    c[e].edgeLoops |= std::uint32_t(loop) << (2 * edge);
+            c[e].loopCount = std::uint8_t(entry.loopCount);
+            c[e].doubledFaces = std::uint8_t(entry.doubledFaces);
+        }
+        return c;
     }();
-    return packed;
+    return compact;
 }
 
 //! Per case-table entry and loop, the loop's DC cell edge mask (kMaxLoops slots per entry).
@@ -142,7 +154,7 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
     vertices.cases.resize(activeCount);
 
     // Cases and patches.
-    const std::vector<std::uint32_t>& packedEdgeLoops = getPackedEdgeLoops();
+    const std::vector<CompactEntry>& compact = getCompactEntries();
     tbb::parallel_for(tbb::blocked_range<int>(0, cells.z), [&](const tbb::blocked_range<int>& r) {
         std::array<std::size_t, 8> corner{};
         for (int k = 0; k < 8; ++k)
@@ -175,8 +187,8 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                         }
                         const std::size_t entry = caseTable.entryIndex(cube, c.joined);
                         c.entry = std::uint16_t(entry);
-                        c.patches = std::uint8_t(caseTable.entry(entry).loopCount);
-                        c.edgeLoops = packedEdgeLoops[entry];
+                        c.patches = compact[entry].loopCount;
+                        c.edgeLoops = compact[entry].edgeLoops;
                     }
                 }
         }
@@ -192,7 +204,7 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                 count += c.patches;
                 if (!perComponent)
                     continue;
-                const unsigned doubled = caseTable.entry(c.entry).doubledFaces;
+                const unsigned doubled = compact[c.entry].doubledFaces;
                 for (int f = 0; f < tables::kFaceCount; ++f) {
                     if (((doubled >> f) & 1u) == 0)
                         continue;
@@ -201,7 +213,7 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                     if (other[f / 2] < 0 || other[f / 2] >= cells[f / 2])
                         continue;
                     const CellCase& n = vertices.getCase(other);
-                    if ((caseTable.entry(n.entry).doubledFaces >> tables::getOppositeFace(f)) & 1u)
+                    if ((compact[n.entry].doubledFaces >> tables::getOppositeFace(f)) & 1u)
                         c.paired |= std::uint8_t(1u << f);
                 }
                 count += 2 * std::popcount(unsigned(c.paired & kHighFaces));
@@ -231,9 +243,8 @@ void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptio
                     vertices.edges[next++] = 0xfff;
                     continue;
                 }
-                const tables::CellTriangulation& entry = caseTable.entry(c.entry);
                 const std::uint16_t* loopMasks = &loopEdgeMasks[std::size_t(c.entry) * kMaxLoops];
-                for (int l = 0; l < entry.loopCount; ++l) {
+                for (int l = 0; l < c.patches; ++l) {
                     vertices.cell[next] = cell;
                     vertices.edges[next++] = loopMasks[l];
                 }
