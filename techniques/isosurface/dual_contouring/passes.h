@@ -260,8 +260,12 @@ private:
         if (mUseHermite) {
             if (edge != nullptr && std::isfinite(edge->t)) {
                 Crossing c;
-                c.point = glm::dvec3(s) + std::clamp(edge->t, 0.0, 1.0) * axisVector(axis);
-                c.normal = normalizeOrZero(edge->normal);
+                c.point = glm::dvec3(s);
+                c.point[axis] += std::clamp(edge->t, 0.0, 1.0);
+                // The evaluator's normals are unit (or zero): those are kept as they are.
+                const double squared = glm::dot(edge->normal, edge->normal);
+                c.normal = std::abs(squared - 1.0) <= 1e-15 ? glm::dvec3(edge->normal)
+                                                            : normalizeOrZero(edge->normal);
                 return c;
             }
             missing = true;
