@@ -7,14 +7,6 @@
 #include <cmath>
 
 namespace rtlab::isosurface::dc {
-namespace {
-
-bool isFinite(const glm::dvec3& v)
-{
-    return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
-}
-
-} // namespace
 
 double QefSystem::evaluate(const glm::dvec3& x) const
 {
