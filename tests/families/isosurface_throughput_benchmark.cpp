@@ -5,8 +5,8 @@
 // samples (dual contouring also reads the Hermite data). Each technique runs inside a TBB arena of
 // `threads` workers, with its own `threads` parameter set to the same count where it has one
 // (VTK's SMP backend is TBB; OpenVDB uses TBB), after one warm-up call; the techniques then take
-// turns for --repeats rounds and each time is the median of its rounds' wall time around
-// extract().
+// turns for --repeats rounds (each an untimed and a timed call) and each time is the median of its
+// rounds' wall time around extract().
 //
 //   isosurface_throughput_benchmark [--grid 256] [--threads N] [--repeats 5] [--technique NAME]...
 //                                   [--quick]
@@ -74,9 +74,10 @@ struct Timed {
 };
 
 //! Times every technique on one input: one untimed warm-up call each, then `repeats` rounds in
-//! which the techniques take turns, each keeping the median of its rounds. Alternating keeps a
-//! slow phase of a shared machine (other tenants, clock changes) from landing on one technique
-//! only and skewing the ratios, which compare techniques timed within the same rounds.
+//! which the techniques take turns (an untimed call, then a timed one), each keeping the median of
+//! its rounds. Alternating keeps a slow phase of a shared machine (other tenants, clock changes)
+//! from landing on one technique only and skewing the ratios, which compare techniques timed
+//! within the same rounds.
 void timeTechniques(const std::vector<const plugin::TechniqueEntry*>& entries,
                     const plugin::IsosurfaceInput& input, int threads, int repeats,
                     std::map<std::string, double>& ms, std::map<std::string, std::size_t>& tris)
@@ -95,6 +96,9 @@ void timeTechniques(const std::vector<const plugin::TechniqueEntry*>& entries,
             t.mesher->extract(input, t.mesh);
         for (int r = 0; r < repeats; ++r)
             for (Timed& t : timed) {
+                // Each timed call follows an untimed one of the same technique, so it finds its
+                // own workspace in the caches as in back-to-back runs, not the previous one's.
+                t.mesher->extract(input, t.mesh);
                 const auto start = std::chrono::steady_clock::now();
                 t.mesher->extract(input, t.mesh);
                 t.ms.push_back(std::chrono::duration<double, std::milli>(

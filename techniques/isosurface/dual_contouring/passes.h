@@ -135,9 +135,11 @@ private:
     std::uint64_t mLayerReciprocal = 0;
 };
 
-//! One crossed grid edge's Hermite point and normal (grid units; normal unit or zero).
+//! One crossed grid edge's Hermite point and normal: the point at t (in [0, 1], cells) along the
+//! edge from its low sample, the normal unit or zero. 32 bytes: the vertex pass reads one per
+//! edge of a cell, from rows a layer apart, and is bound by those loads.
 struct Crossing {
-    glm::dvec3 point{0.0};
+    double t = 0.0;
     glm::dvec3 normal{0.0};
 };
 
@@ -260,8 +262,7 @@ private:
         if (mUseHermite) {
             if (edge != nullptr && std::isfinite(edge->t)) {
                 Crossing c;
-                c.point = glm::dvec3(s);
-                c.point[axis] += std::clamp(edge->t, 0.0, 1.0);
+                c.t = std::clamp(edge->t, 0.0, 1.0);
                 // The evaluator's normals are unit (or zero): those are kept as they are.
                 const double squared = glm::dot(edge->normal, edge->normal);
                 c.normal = std::abs(squared - 1.0) <= 1e-15 ? glm::dvec3(edge->normal)
@@ -278,11 +279,12 @@ private:
         else
             t = interpolateLinear(mGrid.relative(i), mGrid.relative(j));
         Crossing c;
-        c.point = glm::dvec3(s) + t * axisVector(axis);
+        c.t = t;
         if (mUseExactGradient) {
             // Outward normal: the field grows outward. Uniform scaling keeps directions, so the
             // world gradient's direction is the grid-unit normal.
-            c.normal = normalizeOrZero(mInput.exactGradient(mGrid.toWorld(c.point)));
+            c.normal = normalizeOrZero(
+                mInput.exactGradient(mGrid.toWorld(glm::dvec3(s) + t * axisVector(axis))));
         } else {
             glm::ivec3 s1 = s;
             ++s1[axis];

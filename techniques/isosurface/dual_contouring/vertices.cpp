@@ -58,7 +58,8 @@ void placeVertices(const Grid& grid, const EdgeTable& table, const ExtractionOpt
                     if (id == kNone)
                         continue;
                     const Crossing& c = table.crossings[id];
-                    points[n] = c.point - glm::dvec3(cell);
+                    points[n] = glm::dvec3(e.offset); // in the cell's frame
+                    points[n][e.axis] += c.t;
                     normals[n] = c.normal;
                     normalSum += c.normal;
                     ++n;
