@@ -269,12 +269,15 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
     });
 
     // Nothing below throws std::invalid_argument, so the mesh is built in `out` itself, reusing
-    // its storage from the last call (as the vtk_flying_edges wrapper does).
-    out.clear();
+    // its storage from the last call (as the vtk_flying_edges wrapper does). Every entry is
+    // written below: it is resized in place, as marching_cubes does, and nothing is zero-filled
+    // where the size did not change.
     const std::size_t vertexCount = vertices.cell.size();
     out.positions.resize(vertexCount);
     if (options.computeNormals)
         out.normals.resize(vertexCount);
+    else
+        out.normals.clear();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertexCount),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           for (std::size_t v = range.begin(); v != range.end(); ++v) {
