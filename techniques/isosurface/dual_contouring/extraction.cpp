@@ -40,6 +40,12 @@ bool chooseDiagonal13(const std::array<std::uint32_t, 4>& q, const std::array<gl
             const double difference = d13 * std::abs(d13) * l02 - d02 * std::abs(d02) * l13;
             if (std::abs(difference) > 3e-12 * l02 * l13)
                 return difference > 0.0;
+            // Planar convex quads (flat faces): both cosines within 0.4e-12 of 1 (c^2 >= 1 -
+            // 0.8e-12), so they differ by less than the tolerance: a tie, without the exact path.
+            constexpr double kNearOne = 1.0 - 0.8e-12;
+            if (d02 > 0.0 && d13 > 0.0 && d02 * d02 >= kNearOne * l02 &&
+                d13 * d13 >= kNearOne * l13)
+                return (std::min_element(q.begin(), q.end()) - q.begin()) % 2 == 1;
         }
     }
     const double agree02 = agree(a012, a023);
