@@ -103,13 +103,36 @@ bool solveRankOne(const QefSystem& qef, const glm::dvec3& residual, double thres
     const double trace = ata[0][0] + ata[1][1] + ata[2][2];
     if (!(trace > 0.0) || !std::isfinite(trace))
         return false;
-    const glm::dmat3 m = ata * (1.0 / trace);
-    const glm::dmat3 m2 = m * m;
-    const glm::dmat3 m4 = m2 * m2;
+    // Symmetric products on the 6 distinct entries (xx, yy, zz, xy, xz, yz).
+    struct Sym {
+        double xx, yy, zz, xy, xz, yz;
+        Sym squared() const
+        {
+            return {xx * xx + xy * xy + xz * xz, xy * xy + yy * yy + yz * yz,
+                    xz * xz + yz * yz + zz * zz, xx * xy + xy * yy + xz * yz,
+                    xx * xz + xy * yz + xz * zz, xy * xz + yy * yz + yz * zz};
+        }
+        glm::dvec3 column(int c) const
+        {
+            return c == 0   ? glm::dvec3(xx, xy, xz)
+                   : c == 1 ? glm::dvec3(xy, yy, yz)
+                            : glm::dvec3(xz, yz, zz);
+        }
+        glm::dvec3 times(const glm::dvec3& v) const
+        {
+            return {xx * v.x + xy * v.y + xz * v.z, xy * v.x + yy * v.y + yz * v.z,
+                    xz * v.x + yz * v.y + zz * v.z};
+        }
+    };
+    const double inverse = 1.0 / trace;
+    // A^T A is symmetric up to rounding; its upper triangle is used.
+    const Sym m{ata[0][0] * inverse, ata[1][1] * inverse, ata[2][2] * inverse,
+                ata[1][0] * inverse, ata[2][0] * inverse, ata[2][1] * inverse};
+    const Sym m4 = m.squared().squared();
     int best = 0;
-    double bestLength = glm::dot(m4[0], m4[0]);
+    double bestLength = glm::dot(m4.column(0), m4.column(0));
     for (int c = 1; c < 3; ++c) {
-        const double length = glm::dot(m4[c], m4[c]);
+        const double length = glm::dot(m4.column(c), m4.column(c));
         if (length > bestLength) {
             best = c;
             bestLength = length;
@@ -117,11 +140,11 @@ bool solveRankOne(const QefSystem& qef, const glm::dvec3& residual, double thres
     }
     // v is not normalised: every test below divides by |v|^2 instead (no square root on the
     // path, which is latency-bound).
-    const glm::dvec3 v = m4 * m4[best];
+    const glm::dvec3 v = m4.times(m4.column(best));
     const double vv = glm::dot(v, v);
     if (!(vv > 0.0) || !std::isfinite(vv))
         return false;
-    const glm::dvec3 mv = m * v;
+    const glm::dvec3 mv = m.times(v);
     const double mu = glm::dot(v, mv) / vv; // lambda_1 / trace
     const double rest = 1.0 - mu;           // (lambda_2 + lambda_3) / trace, both >= 0
     // The truncation keeps sigma_k >= cut sigma_max, i.e. lambda_k >= cut^2 lambda_1.
