@@ -81,6 +81,20 @@ struct LeafRecord {
     std::vector<Op> ops;
 };
 
+//! What a leaf knows from its culled siblings: per face (2 axis + side, side 1 = the high one),
+//! a lower bound of |value| over the sibling across it and the sign there (-inf: no sibling
+//! culled there). The field is 1-Lipschitz across the two cells when both pruned lists hold
+//! exact distances only, so the leaf's samples on that face have |value| >= bound - spacing.
+struct FaceSeeds {
+    std::array<double, 6> bound{-kInf, -kInf, -kInf, -kInf, -kInf, -kInf};
+    std::array<double, 6> sign{1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
+    //! The sibling's interval is as narrow as its extent along the axis allows (a face parallel
+    //! to the cell: the bound is then the value itself), so a corner it proves needs no
+    //! evaluation of its own; a looser bound (a tilted face) leaves the corner to be evaluated,
+    //! whose exact value proves more of the leaf than the bound would.
+    std::array<bool, 6> tight{};
+};
+
 class Hierarchy {
 public:
     Hierarchy(const SdfModel& model, const GridSpec& grid, int frame, const EvaluationOptions& options,
@@ -277,7 +291,8 @@ private:
     //! edit-major loop, so every value stays bit-identical.
     std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& ops,
                                       const std::vector<glm::dvec3>& positions,
-                                      std::vector<double>& values, LeafScratch& work) const
+                                      std::vector<double>& values, LeafScratch& work,
+                                      const FaceSeeds* seeds) const
     {
         const std::size_t count = values.size();
         const double step = grid.spacing + margin;
@@ -293,6 +308,31 @@ private:
         std::vector<std::uint8_t>& known = work.known;
         known.assign(count, 0);
         std::size_t evaluated = 0;
+        // The culled siblings' bounds, one spacing in, on the face samples (values holds the
+        // sign until the sample is decided).
+        if (seeds != nullptr)
+            for (int face = 0; face < 6; ++face) {
+                const double b = seeds->bound[std::size_t(face)] - step;
+                if (!(b > band))
+                    continue;
+                const int axis = face / 2;
+                const int layer = (face & 1) ? n[axis] - 1 : 0;
+                const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+                for (int j = 0; j < n[v]; ++j)
+                    for (int k = 0; k < n[u]; ++k) {
+                        glm::ivec3 at(0);
+                        at[axis] = layer;
+                        at[u] = k;
+                        at[v] = j;
+                        const std::size_t i = std::size_t(at.x) * strides[0] +
+                                              std::size_t(at.y) * strides[1] +
+                                              std::size_t(at.z) * strides[2];
+                        if (b > bound[i]) {
+                            bound[i] = b;
+                            values[i] = seeds->sign[std::size_t(face)] * b;
+                        }
+                    }
+            }
         // The corners (fewer where the leaf is one sample thin along an axis).
         std::array<std::size_t, 8> corner{};
         std::array<glm::ivec3, 8> cornerAt{};
@@ -304,10 +344,19 @@ private:
                                   std::size_t(at.z) * strides[2];
             if (known[i])
                 continue;
-            values[i] = evaluate(i);
-            bound[i] = std::abs(values[i]);
             known[i] = 1;
-            ++evaluated;
+            bool proven = false; // by a tight seed on one of the corner's three faces
+            if (seeds != nullptr && bound[i] > band)
+                for (int axis = 0; axis < 3; ++axis) {
+                    const int face = 2 * axis + (((k >> axis) & 1) ? 1 : 0);
+                    proven = proven || (seeds->tight[std::size_t(face)] &&
+                                        seeds->bound[std::size_t(face)] - step > band);
+                }
+            if (!proven) {
+                values[i] = evaluate(i);
+                bound[i] = std::abs(values[i]);
+                ++evaluated;
+            }
             corner[std::size_t(corners)] = i;
             cornerAt[std::size_t(corners++)] = at;
         }
@@ -341,8 +390,8 @@ private:
                     const std::size_t i = index(at);
                     if (known[i])
                         continue;
-                    double lowest = -kInf;
-                    double sign = 1.0;
+                    double lowest = bound[i]; // a sibling's seed, or -inf
+                    double sign = values[i] < 0.0 ? -1.0 : 1.0;
                     for (int k = 0; k < useful; ++k) {
                         const glm::ivec3 d = at - cornerAt[std::size_t(k)];
                         const double b = bound[corner[std::size_t(k)]] -
@@ -379,7 +428,8 @@ private:
     }
 
     void evaluateLeaf(const glm::ivec3& first, const glm::ivec3& last, const std::vector<Op>& ops,
-                      const std::vector<const CsgEdit*>& candidates, Counters& c)
+                      const std::vector<const CsgEdit*>& candidates, Counters& c,
+                      const FaceSeeds* seeds = nullptr)
     {
         const glm::ivec3 n = last - first + 1;
         const std::size_t count = std::size_t(n.x) * n.y * n.z;
@@ -408,7 +458,7 @@ private:
                         applyOp(op.kind, values[j], e.evaluatePrimitive(positions[j]), e.blend);
             }
         } else {
-            evaluated = evaluateLipschitzLeaf(n, ops, positions, values, work);
+            evaluated = evaluateLipschitzLeaf(n, ops, positions, values, work, seeds);
         }
         c.sampleEvaluations += evaluated * ops.size();
         c.samplesEvaluated += evaluated;
@@ -479,10 +529,90 @@ private:
         }
         // [Evans 2015] "we actually split by 4x4x4 in one go".
         const int childSize = cellSamples[level + 1];
+        if (level + 2 == int(cellSamples.size())) {
+            processLeaves(level + 1, first, ops, candidates);
+            return;
+        }
         tbb::parallel_for(0, 64, [&](int i) {
             const glm::ivec3 child = first + childSize * glm::ivec3(i % 4, (i / 4) % 4, i / 16);
             if (child.x < grid.samples.x && child.y < grid.samples.y && child.z < grid.samples.z)
                 processCell(level + 1, child, ops, candidates);
+        });
+    }
+
+    //! The 64 leaves of one cell: all bounded first, then the ones not culled evaluated, each
+    //! seeded by its culled siblings (see FaceSeeds).
+    void processLeaves(int level, const glm::ivec3& parentFirst, const std::vector<Op>& parentOps,
+                       const std::vector<const CsgEdit*>& parentCandidates)
+    {
+        struct Child {
+            glm::ivec3 first{0}, last{0};
+            glm::dvec3 lo{0.0}, hi{0.0};
+            Interval d{0.0, 0.0};
+            std::vector<Op> ops;
+            int state = -1; // -1 outside the grid, 0 evaluated, 1 empty, 2 full
+            bool lipschitz = false;
+        };
+        std::array<Child, 64> children;
+        const int size = cellSamples[level];
+        tbb::parallel_for(0, 64, [&](int i) {
+            Child& ch = children[std::size_t(i)];
+            ch.first = parentFirst + size * glm::ivec3(i % 4, (i / 4) % 4, i / 16);
+            if (ch.first.x >= grid.samples.x || ch.first.y >= grid.samples.y ||
+                ch.first.z >= grid.samples.z)
+                return;
+            Counters& c = getCounters();
+            ++c.cellsVisited[level];
+            ch.last = glm::min(ch.first + size - 1, grid.samples - 1);
+            const glm::ivec3 boxLast =
+                options.computeHermite ? glm::min(ch.first + size, grid.samples - 1) : ch.last;
+            ch.lo = getSamplePosition(grid, ch.first.x, ch.first.y, ch.first.z);
+            ch.hi = getSamplePosition(grid, boxLast.x, boxLast.y, boxLast.z);
+            ch.d = pruneOps(parentOps, ch.lo, ch.hi, ch.ops, c);
+            ch.lipschitz = !outputs.materials && !ch.ops.empty() &&
+                           std::all_of(ch.ops.begin(), ch.ops.end(),
+                                       [](const Op& op) { return isLipschitzPrimitive(*op.edit); });
+            if (ch.d.lo > band) {
+                ++c.cellsEmpty[level];
+                fill(ch.first, ch.last, band);
+                ch.state = 1;
+            } else if (ch.d.hi < -band) {
+                ++c.cellsFull[level];
+                fill(ch.first, ch.last, -band);
+                ch.state = 2;
+            } else {
+                ch.state = 0;
+            }
+        });
+        tbb::parallel_for(0, 64, [&](int i) {
+            Child& ch = children[std::size_t(i)];
+            if (ch.state != 0)
+                return;
+            Counters& c = getCounters();
+            std::vector<const CsgEdit*> candidates;
+            if (outputs.materials)
+                pruneCandidates(parentCandidates, ch.lo, ch.hi, ch.d, candidates, c);
+            FaceSeeds seeds;
+            if (ch.lipschitz) {
+                const glm::ivec3 at(i % 4, (i / 4) % 4, i / 16);
+                const int stride[3] = {1, 4, 16};
+                for (int axis = 0; axis < 3; ++axis)
+                    for (int side = 0; side < 2; ++side) {
+                        if (at[axis] + (side ? 1 : -1) < 0 || at[axis] + (side ? 1 : -1) > 3)
+                            continue; // a cousin, in another cell: not known here
+                        const Child& n = children[std::size_t(i + (side ? 1 : -1) * stride[axis])];
+                        if (!n.lipschitz || (n.state != 1 && n.state != 2))
+                            continue;
+                        seeds.bound[std::size_t(2 * axis + side)] = n.state == 1 ? n.d.lo : -n.d.hi;
+                        seeds.sign[std::size_t(2 * axis + side)] = n.state == 1 ? 1.0 : -1.0;
+                        seeds.tight[std::size_t(2 * axis + side)] =
+                            n.d.hi - n.d.lo <= 1.01 * (n.hi[axis] - n.lo[axis]) + margin;
+                    }
+            }
+            evaluateLeaf(ch.first, ch.last, ch.ops, candidates, c, &seeds);
+            // Only a box whose values can be on both sides of 0 can hold a crossing.
+            if (options.computeHermite && ch.d.lo <= 0.0 && ch.d.hi > 0.0)
+                leaves.local().push_back({ch.first, ch.last, std::move(ch.ops)});
         });
     }
 };

@@ -280,6 +280,41 @@ TEST(SdfEvaluator, LeafSweepsRunOutsideInWhicheverSideTheSurfaceFaces)
     }
 }
 
+TEST(SdfEvaluator, LeavesTakeTheBoundsOfTheirCulledSiblings)
+{
+    // The same slab: a face parallel to the grid cuts its leaves so that a layer just past the
+    // band's edge falls into an evaluated leaf, which no corner of that leaf is far enough out to
+    // prove. The culled sibling across that face bounds the layer (its interval, one spacing in):
+    // one sample per leaf is left evaluated out of the band, against 11 per leaf from the corners
+    // and the sweep alone. The field stays bit-identical.
+    const GridSpec grid = makeCubeGrid(-1.0, 1.0, 96);
+    for (const double centre : {0.31, -0.31}) {
+        SdfModel slab;
+        slab.name = "slab";
+        CsgEdit e;
+        e.shape = CsgShape::Box;
+        e.center = glm::dvec3(0.0, 0.0, centre);
+        e.size = glm::dvec3(3.0, 3.0, 0.2);
+        slab.edits.push_back(e);
+        for (const bool hermite : {false, true}) {
+            EvaluationOptions o;
+            o.computeHermite = hermite;
+            const EvaluationResult r = evaluateModel(slab, grid, kAllFrames, o);
+            ASSERT_GT(r.stats.leavesEvaluated, 0u);
+            // With Hermite data a cell's box reaches one sample past its upper faces (its list
+            // must be exact on the edges leaving it), so leaves whose own samples all lie past
+            // the band but whose boxes reach into it are evaluated too: the bound is for values
+            // only.
+            if (!hermite) {
+                EXPECT_LE(r.stats.samplesEvaluated - r.stats.samplesInBand,
+                          2 * r.stats.leavesEvaluated)
+                    << centre;
+            }
+            expectMatchesBruteForce(slab, grid, kAllFrames, o, "slab at " + std::to_string(centre));
+        }
+    }
+}
+
 TEST(SdfEvaluator, PrimitiveBoundsContainValues)
 {
     std::mt19937 rng(7);
