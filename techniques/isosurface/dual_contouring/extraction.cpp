@@ -241,7 +241,7 @@ void extractDualContour(const plugin::IsosurfaceInput& input, const ExtractionOp
             std::array<glm::dvec3, 4> p;
             for (int c = 0; c < 4; ++c) {
                 around[c] = cells[lowInside ? c : (4 - c) % 4];
-                q[c] = findEdgeVertex(grid, vertices, options, around[c], s, axis);
+                q[c] = findEdgeVertex(vertices, around[c], s, axis);
                 p[c] = glm::dvec3(around[c] - s) + vertices.local[q[c]];
             }
             ++result.quads;

@@ -455,9 +455,9 @@ constexpr unsigned kHighFaces = (1u << 1) | (1u << 3) | (1u << 5);
 void numberCells(const Grid& grid, const EdgeTable& table, const ExtractionOptions& options,
                  CellVertices& vertices);
 
-//! The vertex that the quads around the crossed grid edge (sample s, axis) use in `cell`.
-inline std::uint32_t findEdgeVertex(const Grid& grid, const CellVertices& vertices,
-                                    const ExtractionOptions& options, const glm::ivec3& cell,
+//! The vertex that the quads around the crossed grid edge (sample s, axis) use in `cell` (per
+//! cell: the cell's only vertex, its edge loops being all 0).
+inline std::uint32_t findEdgeVertex(const CellVertices& vertices, const glm::ivec3& cell,
                                     const glm::ivec3& s, int axis)
 {
     const std::uint32_t k = vertices.findActive(cell);

@@ -162,8 +162,7 @@ private:
                         !isInteriorEdge(mGrid, s, e.axis) ||
                         findFaceVertex(mGrid, mVertices, cell, other, s, e.axis) != kNone)
                         continue;
-                    const std::uint32_t u =
-                        findEdgeVertex(mGrid, mVertices, mOptions, other, s, e.axis);
+                    const std::uint32_t u = findEdgeVertex(mVertices, other, s, e.axis);
                     if (u == kNone || !mBoundary[u] || std::find(out, out + n, u) != out + n)
                         continue;
                     out[n++] = u;
