@@ -1,6 +1,7 @@
 #include "sdf/evaluator.h"
 
 #include "sdf/edit_ops.h"
+#include "sdf/leaf_bounds.h"
 #include "sdf/primitive_bounds.h"
 
 #include <glm/common.hpp>
@@ -79,20 +80,6 @@ struct Outputs {
 struct LeafRecord {
     glm::ivec3 first{0}, last{0};
     std::vector<Op> ops;
-};
-
-//! What a leaf knows from its culled siblings: per face (2 axis + side, side 1 = the high one),
-//! a lower bound of |value| over the sibling across it and the sign there (-inf: no sibling
-//! culled there). The field is 1-Lipschitz across the two cells when both pruned lists hold
-//! exact distances only, so the leaf's samples on that face have |value| >= bound - spacing.
-struct FaceSeeds {
-    std::array<double, 6> bound{-kInf, -kInf, -kInf, -kInf, -kInf, -kInf};
-    std::array<double, 6> sign{1.0, 1.0, 1.0, 1.0, 1.0, 1.0};
-    //! The sibling's interval is as narrow as its extent along the axis allows (a face parallel
-    //! to the cell: the bound is then the value itself), so a corner it proves needs no
-    //! evaluation of its own; a looser bound (a tilted face) leaves the corner to be evaluated,
-    //! whose exact value proves more of the leaf than the bound would.
-    std::array<bool, 6> tight{};
 };
 
 class Hierarchy {
@@ -278,155 +265,6 @@ private:
             }
     }
 
-    //! The leaf's values where its pruned list holds exact distances only; returns the samples
-    //! evaluated. Samples the band cannot reach are not evaluated: every op (hard or soft min and
-    //! max, negation) keeps a field of exact distances 1-Lipschitz, so a sample at distance r from
-    //! a sample of value v has |value| >= |v| - r and, while that exceeds the band, the sign of v:
-    //! its clamped value (+-band) is known without evaluating it. Seeds are the leaf's 8 corners,
-    //! evaluated first: each bounds every sample of the leaf by its ball (a corner far outside
-    //! the band clears most of the leaf). The other samples are then visited in scan order, each
-    //! axis swept away from the corners of larger |value| (outside in), and take the best of the
-    //! corners' balls and of their three neighbours one spacing back along the sweep (chained
-    //! through skipped samples). Evaluated samples run the same ops in the same order as the
-    //! edit-major loop, so every value stays bit-identical.
-    std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& ops,
-                                      const std::vector<glm::dvec3>& positions,
-                                      std::vector<double>& values, LeafScratch& work,
-                                      const FaceSeeds* seeds) const
-    {
-        const std::size_t count = values.size();
-        const double step = grid.spacing + margin;
-        const std::size_t strides[3] = {1, std::size_t(n.x), std::size_t(n.x) * std::size_t(n.y)};
-        const auto evaluate = [&](std::size_t i) {
-            double v = kInf;
-            for (const Op& op : ops)
-                v = applyOp(op.kind, v, op.edit->evaluatePrimitive(positions[i]), op.edit->blend);
-            return v;
-        };
-        std::vector<double>& bound = work.bound; // |value| (evaluated) or a lower bound of it
-        bound.assign(count, -kInf);
-        std::vector<std::uint8_t>& known = work.known;
-        known.assign(count, 0);
-        std::size_t evaluated = 0;
-        // The culled siblings' bounds, one spacing in, on the face samples (values holds the
-        // sign until the sample is decided).
-        if (seeds != nullptr)
-            for (int face = 0; face < 6; ++face) {
-                const double b = seeds->bound[std::size_t(face)] - step;
-                if (!(b > band))
-                    continue;
-                const int axis = face / 2;
-                const int layer = (face & 1) ? n[axis] - 1 : 0;
-                const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-                for (int j = 0; j < n[v]; ++j)
-                    for (int k = 0; k < n[u]; ++k) {
-                        glm::ivec3 at(0);
-                        at[axis] = layer;
-                        at[u] = k;
-                        at[v] = j;
-                        const std::size_t i = std::size_t(at.x) * strides[0] +
-                                              std::size_t(at.y) * strides[1] +
-                                              std::size_t(at.z) * strides[2];
-                        if (b > bound[i]) {
-                            bound[i] = b;
-                            values[i] = seeds->sign[std::size_t(face)] * b;
-                        }
-                    }
-            }
-        // The corners (fewer where the leaf is one sample thin along an axis).
-        std::array<std::size_t, 8> corner{};
-        std::array<glm::ivec3, 8> cornerAt{};
-        int corners = 0;
-        for (int k = 0; k < 8; ++k) {
-            const glm::ivec3 at((k & 1) ? n.x - 1 : 0, (k & 2) ? n.y - 1 : 0,
-                                (k & 4) ? n.z - 1 : 0);
-            const std::size_t i = std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
-                                  std::size_t(at.z) * strides[2];
-            if (known[i])
-                continue;
-            known[i] = 1;
-            bool proven = false; // by a tight seed on one of the corner's three faces
-            if (seeds != nullptr && bound[i] > band)
-                for (int axis = 0; axis < 3; ++axis) {
-                    const int face = 2 * axis + (((k >> axis) & 1) ? 1 : 0);
-                    proven = proven || (seeds->tight[std::size_t(face)] &&
-                                        seeds->bound[std::size_t(face)] - step > band);
-                }
-            if (!proven) {
-                values[i] = evaluate(i);
-                bound[i] = std::abs(values[i]);
-                ++evaluated;
-            }
-            corner[std::size_t(corners)] = i;
-            cornerAt[std::size_t(corners++)] = at;
-        }
-        // Sweep each axis from the side whose corners are farther from the surface.
-        int direction[3];
-        for (int axis = 0; axis < 3; ++axis) {
-            double low = 0.0, high = 0.0;
-            for (int k = 0; k < corners; ++k) {
-                const double b = bound[corner[std::size_t(k)]];
-                (cornerAt[std::size_t(k)][axis] == 0 ? low : high) += b;
-            }
-            direction[axis] = high > low ? -1 : 1;
-        }
-        // Only corners farther than one spacing past the band can prove another sample.
-        int useful = 0;
-        for (int k = 0; k < corners; ++k)
-            if (bound[corner[std::size_t(k)]] - step > band) {
-                corner[std::size_t(useful)] = corner[std::size_t(k)];
-                cornerAt[std::size_t(useful++)] = cornerAt[std::size_t(k)];
-            }
-        const auto index = [&](const glm::ivec3& at) {
-            return std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
-                   std::size_t(at.z) * strides[2];
-        };
-        for (int zi = 0; zi < n.z; ++zi)
-            for (int yi = 0; yi < n.y; ++yi)
-                for (int xi = 0; xi < n.x; ++xi) {
-                    const glm::ivec3 at(direction[0] > 0 ? xi : n.x - 1 - xi,
-                                        direction[1] > 0 ? yi : n.y - 1 - yi,
-                                        direction[2] > 0 ? zi : n.z - 1 - zi);
-                    const std::size_t i = index(at);
-                    if (known[i])
-                        continue;
-                    double lowest = bound[i]; // a sibling's seed, or -inf
-                    double sign = values[i] < 0.0 ? -1.0 : 1.0;
-                    for (int k = 0; k < useful; ++k) {
-                        const glm::ivec3 d = at - cornerAt[std::size_t(k)];
-                        const double b = bound[corner[std::size_t(k)]] -
-                                         reach[std::size_t(d.x * d.x + d.y * d.y + d.z * d.z)];
-                        if (b > lowest) {
-                            lowest = b;
-                            sign = values[corner[std::size_t(k)]] < 0.0 ? -1.0 : 1.0;
-                        }
-                    }
-                    const int sweep[3] = {xi, yi, zi};
-                    for (int axis = 0; axis < 3; ++axis) {
-                        if (sweep[axis] == 0)
-                            continue;
-                        glm::ivec3 back = at;
-                        back[axis] -= direction[axis];
-                        const std::size_t j = index(back);
-                        const double b = bound[j] - step;
-                        if (b > lowest) {
-                            lowest = b;
-                            sign = values[j] < 0.0 ? -1.0 : 1.0;
-                        }
-                    }
-                    known[i] = 1;
-                    if (lowest > band) {
-                        values[i] = sign * lowest;
-                        bound[i] = lowest;
-                        continue;
-                    }
-                    values[i] = evaluate(i);
-                    bound[i] = std::abs(values[i]);
-                    ++evaluated;
-                }
-        return evaluated;
-    }
-
     void evaluateLeaf(const glm::ivec3& first, const glm::ivec3& last, const std::vector<Op>& ops,
                       const std::vector<const CsgEdit*>& candidates, Counters& c,
                       const FaceSeeds* seeds = nullptr)
@@ -458,7 +296,9 @@ private:
                         applyOp(op.kind, values[j], e.evaluatePrimitive(positions[j]), e.blend);
             }
         } else {
-            evaluated = evaluateLipschitzLeaf(n, ops, positions, values, work, seeds);
+            evaluated =
+                evaluateLipschitzLeaf(n, ops, positions, {band, grid.spacing + margin, reach},
+                                      seeds, values, work.bound, work.known);
         }
         c.sampleEvaluations += evaluated * ops.size();
         c.samplesEvaluated += evaluated;

@@ -1,0 +1,150 @@
+#include "sdf/leaf_bounds.h"
+
+#include <cmath>
+
+namespace rtlab::sdf::detail {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+} // namespace
+
+std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& ops,
+                                  const std::vector<glm::dvec3>& positions, const LeafBand& limits,
+                                  const FaceSeeds* seeds, std::vector<double>& values,
+                                  std::vector<double>& bound, std::vector<std::uint8_t>& known)
+{
+    const std::size_t count = values.size();
+    const double band = limits.band;
+    const double step = limits.step;
+    const std::vector<double>& reach = limits.reach;
+    const std::size_t strides[3] = {1, std::size_t(n.x), std::size_t(n.x) * std::size_t(n.y)};
+    const auto evaluate = [&](std::size_t i) {
+        double v = kInf;
+        for (const Op& op : ops)
+            v = applyOp(op.kind, v, op.edit->evaluatePrimitive(positions[i]), op.edit->blend);
+        return v;
+    };
+    bound.assign(count, -kInf); // |value| (evaluated) or a lower bound of it
+    known.assign(count, 0);
+    std::size_t evaluated = 0;
+    // The culled siblings' bounds, one spacing in, on the face samples (values holds the
+    // sign until the sample is decided).
+    if (seeds != nullptr)
+        for (int face = 0; face < 6; ++face) {
+            const double b = seeds->bound[std::size_t(face)] - step;
+            if (!(b > band))
+                continue;
+            const int axis = face / 2;
+            const int layer = (face & 1) ? n[axis] - 1 : 0;
+            const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+            for (int j = 0; j < n[v]; ++j)
+                for (int k = 0; k < n[u]; ++k) {
+                    glm::ivec3 at(0);
+                    at[axis] = layer;
+                    at[u] = k;
+                    at[v] = j;
+                    const std::size_t i = std::size_t(at.x) * strides[0] +
+                                          std::size_t(at.y) * strides[1] +
+                                          std::size_t(at.z) * strides[2];
+                    if (b > bound[i]) {
+                        bound[i] = b;
+                        values[i] = seeds->sign[std::size_t(face)] * b;
+                    }
+                }
+        }
+    // The corners (fewer where the leaf is one sample thin along an axis).
+    std::array<std::size_t, 8> corner{};
+    std::array<glm::ivec3, 8> cornerAt{};
+    int corners = 0;
+    for (int k = 0; k < 8; ++k) {
+        const glm::ivec3 at((k & 1) ? n.x - 1 : 0, (k & 2) ? n.y - 1 : 0, (k & 4) ? n.z - 1 : 0);
+        const std::size_t i = std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
+                              std::size_t(at.z) * strides[2];
+        if (known[i])
+            continue;
+        known[i] = 1;
+        bool proven = false; // by a tight seed on one of the corner's three faces
+        if (seeds != nullptr && bound[i] > band)
+            for (int axis = 0; axis < 3; ++axis) {
+                const int face = 2 * axis + (((k >> axis) & 1) ? 1 : 0);
+                proven = proven || (seeds->tight[std::size_t(face)] &&
+                                    seeds->bound[std::size_t(face)] - step > band);
+            }
+        if (!proven) {
+            values[i] = evaluate(i);
+            bound[i] = std::abs(values[i]);
+            ++evaluated;
+        }
+        corner[std::size_t(corners)] = i;
+        cornerAt[std::size_t(corners++)] = at;
+    }
+    // Sweep each axis from the side whose corners are farther from the surface.
+    int direction[3];
+    for (int axis = 0; axis < 3; ++axis) {
+        double low = 0.0, high = 0.0;
+        for (int k = 0; k < corners; ++k) {
+            const double b = bound[corner[std::size_t(k)]];
+            (cornerAt[std::size_t(k)][axis] == 0 ? low : high) += b;
+        }
+        direction[axis] = high > low ? -1 : 1;
+    }
+    // Only corners farther than one spacing past the band can prove another sample.
+    int useful = 0;
+    for (int k = 0; k < corners; ++k)
+        if (bound[corner[std::size_t(k)]] - step > band) {
+            corner[std::size_t(useful)] = corner[std::size_t(k)];
+            cornerAt[std::size_t(useful++)] = cornerAt[std::size_t(k)];
+        }
+    const auto index = [&](const glm::ivec3& at) {
+        return std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
+               std::size_t(at.z) * strides[2];
+    };
+    for (int zi = 0; zi < n.z; ++zi)
+        for (int yi = 0; yi < n.y; ++yi)
+            for (int xi = 0; xi < n.x; ++xi) {
+                const glm::ivec3 at(direction[0] > 0 ? xi : n.x - 1 - xi,
+                                    direction[1] > 0 ? yi : n.y - 1 - yi,
+                                    direction[2] > 0 ? zi : n.z - 1 - zi);
+                const std::size_t i = index(at);
+                if (known[i])
+                    continue;
+                double lowest = bound[i]; // a sibling's seed, or -inf
+                double sign = values[i] < 0.0 ? -1.0 : 1.0;
+                for (int k = 0; k < useful; ++k) {
+                    const glm::ivec3 d = at - cornerAt[std::size_t(k)];
+                    const double b = bound[corner[std::size_t(k)]] -
+                                     reach[std::size_t(d.x * d.x + d.y * d.y + d.z * d.z)];
+                    if (b > lowest) {
+                        lowest = b;
+                        sign = values[corner[std::size_t(k)]] < 0.0 ? -1.0 : 1.0;
+                    }
+                }
+                const int sweep[3] = {xi, yi, zi};
+                for (int axis = 0; axis < 3; ++axis) {
+                    if (sweep[axis] == 0)
+                        continue;
+                    glm::ivec3 back = at;
+                    back[axis] -= direction[axis];
+                    const std::size_t j = index(back);
+                    const double b = bound[j] - step;
+                    if (b > lowest) {
+                        lowest = b;
+                        sign = values[j] < 0.0 ? -1.0 : 1.0;
+                    }
+                }
+                known[i] = 1;
+                if (lowest > band) {
+                    values[i] = sign * lowest;
+                    bound[i] = lowest;
+                    continue;
+                }
+                values[i] = evaluate(i);
+                bound[i] = std::abs(values[i]);
+                ++evaluated;
+            }
+    return evaluated;
+}
+
+} // namespace rtlab::sdf::detail
