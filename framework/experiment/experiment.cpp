@@ -397,13 +397,18 @@ struct Loader {
             run.gbufferOnGpu = readBool(value, "frame.gbuffer_on_gpu");
             return;
         }
+        if (key == "reference.max_samples") {
+            run.reference.maxSamples =
+                int(config::readInt(file, value, "reference.max_samples", 1, 1 << 24));
+            return;
+        }
         const auto dot = key.find('.');
         if (dot == std::string::npos)
             file.fail(
                 keyNode,
                 "sweep: unknown axis '" + key +
                     "'; valid axes: scene, grid, resolution, frames, camera_path, frame.culling, "
-                    "frame.gbuffer_on_gpu, "
+                    "frame.gbuffer_on_gpu, reference.max_samples, "
                     "<family>.technique, <family>.<parameter>, zip");
         const std::string family = key.substr(0, dot);
         const std::string field = key.substr(dot + 1);

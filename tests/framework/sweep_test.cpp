@@ -238,6 +238,33 @@ sweep:
     EXPECT_NE(e.runs[0].id().find("static"), std::string::npos) << e.runs[0].id();
 }
 
+TEST(Sweep, TheGroundTruthsSampleCapIsAnAxis)
+{
+    // A study at two image sizes can cap the ground truth's paths per pixel at the larger one.
+    const auto registry = test::makeTestRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: ao_testbed
+  reference: {target_stderr: 0.02, max_samples: 256}
+  techniques: {isosurface: {technique: fake_mesher}}
+sweep:
+  reference.max_samples: [256, 32]
+)",
+                                               "sweep.yaml", registry);
+    ASSERT_EQ(e.runs.size(), 2u);
+    EXPECT_EQ(e.runs[0].reference.maxSamples, 256);
+    EXPECT_EQ(e.runs[1].reference.maxSamples, 32);
+    EXPECT_DOUBLE_EQ(e.runs[1].reference.targetStdErr, 0.02) << "the rest of base's reference kept";
+    EXPECT_NE(e.runs[0].hash(), e.runs[1].hash());
+    const std::string zero = errorOf(R"(base:
+  scene: ao_testbed
+  techniques: {isosurface: {technique: fake_mesher}}
+sweep:
+  reference.max_samples: [0]
+)");
+    EXPECT_NE(zero.find("sweep.yaml:5:27"), std::string::npos) << zero;
+    EXPECT_NE(zero.find("reference.max_samples"), std::string::npos) << zero;
+}
+
 TEST(Sweep, KeysAddedLaterLeaveTheHashOfRunsThatDoNotUseThemUnchanged)
 {
     // Results written before camera_path, metrics and the ground-truth override existed must
