@@ -3,6 +3,7 @@
 #include "gpu/resources.h"
 
 #include <cstring>
+#include <mutex>
 
 #include "core/error.h"
 #include "gpu/vulkan_internal.h"
@@ -13,22 +14,51 @@ namespace detail {
 
 namespace {
 
-// A temporary host-visible buffer, freed on scope exit.
+// Transfers up to this size reuse the device's kept staging buffer of their direction.
+constexpr VkDeviceSize kKeptStagingLimit = VkDeviceSize(64) << 20;
+
+// The staging buffer of one transfer: the device's kept buffer of that direction (locked for
+// the transfer, grown to a power of two when too small) or, when the device keeps none or the
+// transfer is larger than the limit, a temporary one freed on scope exit. A kept buffer saves
+// the allocation (and on a discrete GPU the pinning of host pages) of every transfer.
 class StagingBuffer {
 public:
-    StagingBuffer(DeviceState& device, VkDeviceSize size, VkBufferUsageFlags usage)
-        : mDevice(device),
-          mRaw(device.createRawBuffer(size, usage, DeviceState::MemoryKind::HostStaging, "staging"))
+    StagingBuffer(DeviceState& device, VkDeviceSize size, bool upload) : mDevice(device)
     {
+        const VkBufferUsageFlags usage =
+            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+        if (!device.keepStaging || size > kKeptStagingLimit) {
+            mOwned = device.createRawBuffer(size, usage, DeviceState::MemoryKind::HostStaging,
+                                            "staging");
+            mRaw = &mOwned;
+            return;
+        }
+        mLock = std::unique_lock(device.stagingMutex);
+        RawBuffer& kept = upload ? device.uploadStaging : device.downloadStaging;
+        if (kept.size < size) {
+            VkDeviceSize capacity = VkDeviceSize(1) << 20;
+            while (capacity < size)
+                capacity *= 2;
+            device.destroyRawBuffer(kept);
+            kept = device.createRawBuffer(capacity, usage, DeviceState::MemoryKind::HostStaging,
+                                          upload ? "staging.upload" : "staging.download");
+        }
+        mRaw = &kept;
     }
-    ~StagingBuffer() { mDevice.destroyRawBuffer(mRaw); }
+    ~StagingBuffer()
+    {
+        if (mRaw == &mOwned)
+            mDevice.destroyRawBuffer(mOwned);
+    }
     StagingBuffer(const StagingBuffer&) = delete;
     StagingBuffer& operator=(const StagingBuffer&) = delete;
-    const RawBuffer& getRaw() const { return mRaw; }
+    const RawBuffer& getRaw() const { return *mRaw; }
 
 private:
     DeviceState& mDevice;
-    RawBuffer mRaw;
+    RawBuffer mOwned;
+    const RawBuffer* mRaw = nullptr;
+    std::unique_lock<std::mutex> mLock;
 };
 
 } // namespace
@@ -63,7 +93,7 @@ void invalidateMapped(DeviceState& device, const RawBuffer& raw)
 void uploadThroughStaging(DeviceState& device, const void* data, std::size_t size,
                           const std::function<void(VkCommandBuffer, VkBuffer)>& copy)
 {
-    StagingBuffer staging(device, size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    StagingBuffer staging(device, size, true);
     std::memcpy(staging.getRaw().mapped, data, size);
     flushMapped(device, staging.getRaw());
     device.submitAndWait([&](VkCommandBuffer cmd) { copy(cmd, staging.getRaw().buffer); });
@@ -72,7 +102,7 @@ void uploadThroughStaging(DeviceState& device, const void* data, std::size_t siz
 void downloadThroughStaging(DeviceState& device, void* data, std::size_t size,
                             const std::function<void(VkCommandBuffer, VkBuffer)>& copy)
 {
-    StagingBuffer staging(device, size, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+    StagingBuffer staging(device, size, false);
     device.submitAndWait([&](VkCommandBuffer cmd) { copy(cmd, staging.getRaw().buffer); });
     invalidateMapped(device, staging.getRaw());
     std::memcpy(data, staging.getRaw().mapped, size);

@@ -150,6 +150,7 @@ Context::Context(const ContextOptions& options)
     mDevice->instance = std::move(instance);
     createLogicalDevice(*mDevice, choice);
     mDevice->stagingUploads = options.forceStagingUploads || !canMapDeviceMemory(*mDevice);
+    mDevice->keepStaging = options.keepStagingBuffers;
     mDevice->timestampsEnabled = mDevice->info.timestampsSupported && !options.disableTimestamps;
     mRun = std::make_unique<detail::RunState>(mDevice);
 }

@@ -103,6 +103,10 @@ struct ContextOptions {
     //! Move buffer data through staging buffers even where device memory is host-visible
     //! (tests use this to cover the path that discrete GPUs take).
     bool forceStagingUploads = false;
+    //! Keep one host staging buffer per direction between transfers (grown to the largest
+    //! transfer up to 64 MiB) instead of allocating one per upload or download. False: the
+    //! allocation per transfer, the baseline of `gpu_transfer_benchmark`.
+    bool keepStagingBuffers = true;
     //! Record no timestamps, as on a queue without timestamp support: GPU times are then
     //! reported as unavailable (empty), never as zero.
     bool disableTimestamps = false;

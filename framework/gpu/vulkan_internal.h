@@ -80,6 +80,7 @@ struct DeviceState {
     VkPhysicalDeviceMemoryProperties memory{};
     VkPhysicalDeviceLimits limits{};
     bool stagingUploads = true;     //!< buffers live in memory the host cannot map
+    bool keepStaging = true;        //!< reuse the two staging buffers below across transfers
     bool timestampsEnabled = false; //!< run() writes timestamp queries
     PFN_vkSetDebugUtilsObjectNameEXT setObjectNameFn = nullptr; //!< only with validation
 
@@ -88,6 +89,12 @@ struct DeviceState {
     VkCommandBuffer transferCommands = VK_NULL_HANDLE;
     VkFence transferFence = VK_NULL_HANDLE;
     std::mutex queueMutex;
+
+    // The staging buffers kept between transfers (grown to the largest transfer up to
+    // kKeptStagingLimit; larger ones get a buffer of their own), one per direction.
+    RawBuffer uploadStaging;
+    RawBuffer downloadStaging;
+    std::mutex stagingMutex;
 
     DeviceState() = default;
     DeviceState(const DeviceState&) = delete;

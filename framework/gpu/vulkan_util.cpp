@@ -81,6 +81,8 @@ DeviceState::~DeviceState()
 {
     if (device != VK_NULL_HANDLE) {
         vkDeviceWaitIdle(device);
+        destroyRawBuffer(uploadStaging);
+        destroyRawBuffer(downloadStaging);
         if (transferFence != VK_NULL_HANDLE)
             vkDestroyFence(device, transferFence, nullptr);
         if (transferPool != VK_NULL_HANDLE)

@@ -110,6 +110,33 @@ TEST_F(StagedComputeTest, SaxpyMatchesTheCpuExactlyThroughStagingBuffers)
     runSaxpyAndCheck();
 }
 
+TEST_F(StagedComputeTest, KeptStagingBuffersCarryEveryTransferWhateverItsSizeAndOrder)
+{
+    // The kept staging buffer of each direction grows with the transfers (1 MiB, then powers of
+    // two) and a transfer past 64 MiB gets one of its own: interleave sizes on both sides of
+    // every step, several buffers at once, and partial ranges, and check every byte.
+    const std::vector<std::size_t> sizes = {16, std::size_t(1) << 20, (std::size_t(1) << 20) + 4,
+                                            3 << 20, 12, (std::size_t(65) << 20), 8 << 20};
+    std::vector<Buffer> buffers;
+    std::vector<std::vector<std::uint32_t>> sent;
+    for (std::size_t k = 0; k < sizes.size(); ++k) {
+        std::vector<std::uint32_t> words(sizes[k] / 4);
+        for (std::size_t i = 0; i < words.size(); ++i)
+            words[i] = std::uint32_t(i * 2654435761u + k);
+        buffers.push_back(getContext().createBuffer({sizes[k], "kept_staging"}));
+        buffers.back().uploadSpan<std::uint32_t>(words);
+        sent.push_back(std::move(words));
+    }
+    for (std::size_t k = sizes.size(); k-- > 0;)
+        EXPECT_EQ(buffers[k].downloadVector<std::uint32_t>(), sent[k]) << sizes[k] << " bytes";
+    // A partial range in the middle of the largest kept-size buffer.
+    std::vector<std::uint32_t> patch(1000, 0xdeadbeefu);
+    buffers[3].upload(patch.data(), patch.size() * 4, 4096);
+    const auto back = buffers[3].downloadVector<std::uint32_t>();
+    for (std::size_t i = 0; i < back.size(); ++i)
+        ASSERT_EQ(back[i], i >= 1024 && i < 2024 ? 0xdeadbeefu : sent[3][i]) << i;
+}
+
 TEST_F(ComputeTest, ChainedDispatchesSeeEachOthersWrites)
 {
     constexpr std::uint32_t kCount = 4096;
