@@ -3,6 +3,7 @@
 #include "reference/reference.h"
 
 #include "reference/prepared.h"
+#include "reference/progressive.h"
 
 #include "core/error.h"
 #include "test_scenes.h"
@@ -157,6 +158,56 @@ TEST(ReferencePipeline, ProgressiveStopsAtTheTargetOrTheCap)
     const ReferenceResult tighter = computeReference(room.scene, room.gbuffer, s);
     for (std::size_t i = 0; i < r.sampleCount.size(); ++i)
         EXPECT_GE(tighter.sampleCount.pixels[i], r.sampleCount.pixels[i]);
+}
+
+TEST(ReferencePipeline, ProgressiveMomentsEqualTwoPassMomentsForAnyBatchSize)
+{
+    // Whatever the batch size, the running moments (Welford's update) must give the mean and the
+    // covariance of the mean of the whole sample set computed in two passes, to rounding. Three
+    // correlated channels with a large offset (cancellation-prone for a naive sum of squares), 1000
+    // samples, no early stop. Values near 1e4 carry an absolute rounding of about 2e-12, so each
+    // deviation of order 1 agrees to about 1e-12 relative; 1e-10 relative on the covariance leaves
+    // room for 1000 such terms, 1e-12 on the mean.
+    const auto valueOf = [](std::uint32_t i, int c) {
+        const double u = std::sin(0.37 * double(i) + 1.3 * c);
+        return 1.0e4 + double(c) + (c == 2 ? 0.5 : 1.0) * u + 0.25 * std::cos(0.11 * double(i));
+    };
+    constexpr std::uint32_t kSamples = 1000;
+    std::array<double, kMaxChannels> mean{};
+    for (std::uint32_t i = 0; i < kSamples; ++i)
+        for (int c = 0; c < 3; ++c)
+            mean[c] += valueOf(i, c) / kSamples;
+    std::array<double, kMaxChannels * kMaxChannels> covariance{};
+    for (std::uint32_t i = 0; i < kSamples; ++i)
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                covariance[a * kMaxChannels + b] += (valueOf(i, a) - mean[a]) *
+                                                    (valueOf(i, b) - mean[b]) /
+                                                    (double(kSamples - 1) * kSamples);
+    const std::vector<std::uint8_t> active = {1};
+    for (int batch : {1, 7, 16, 1000}) {
+        ProgressiveRule rule;
+        rule.channels = 3;
+        rule.batchSize = batch;
+        rule.maxSamples = int(kSamples);
+        const ProgressiveOutput out = runProgressive(
+            1, 1, active, rule,
+            [&](std::size_t, std::uint32_t first, std::uint32_t count, SampleValue* values) {
+                for (std::uint32_t k = 0; k < count; ++k)
+                    for (int c = 0; c < 3; ++c)
+                        values[k][c] = valueOf(first + k, c);
+                return count;
+            });
+        const PixelEstimate& p = out.pixels[0];
+        EXPECT_EQ(p.samples, kSamples);
+        for (int a = 0; a < 3; ++a) {
+            EXPECT_NEAR(p.mean[a], mean[a], 1e-12 * std::abs(mean[a])) << "batch " << batch;
+            for (int b = 0; b < 3; ++b)
+                EXPECT_NEAR(p.covariance[a * kMaxChannels + b], covariance[a * kMaxChannels + b],
+                            1e-10 * std::abs(covariance[a * kMaxChannels + a]))
+                    << "batch " << batch << " entry " << a << "," << b;
+        }
+    }
 }
 
 TEST(ReferencePipeline, SecondCallIsACacheHitWithIdenticalPixels)

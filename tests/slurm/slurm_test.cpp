@@ -86,8 +86,18 @@ protected:
     {
         runShell(kCluster + " stop " + (mWork / "cluster").string());
         ::unsetenv("SLURM_CONF");
-        if (!HasFailure())
-            fs::remove_all(mWork);
+        if (HasFailure())
+            return;
+        // slurmctld may still be writing its state files as it exits (job_state.old appears
+        // and vanishes under remove_all): retry for up to 5 s instead of failing the test.
+        for (int attempt = 0; attempt < 50; ++attempt) {
+            std::error_code error;
+            fs::remove_all(mWork, error);
+            if (!error)
+                return;
+            std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        ADD_FAILURE() << "could not remove " << mWork << " after the cluster stopped";
     }
 
     //! Runs rtlab in the work folder.
