@@ -115,8 +115,13 @@ TEST_F(StagedComputeTest, KeptStagingBuffersCarryEveryTransferWhateverItsSizeAnd
     // The kept staging buffer of each direction grows with the transfers (1 MiB, then powers of
     // two) and a transfer past 64 MiB gets one of its own: interleave sizes on both sides of
     // every step, several buffers at once, and partial ranges, and check every byte.
-    const std::vector<std::size_t> sizes = {16, std::size_t(1) << 20, (std::size_t(1) << 20) + 4,
-                                            3 << 20, 12, (std::size_t(65) << 20), 8 << 20};
+    const std::vector<std::size_t> sizes = {16,
+                                            std::size_t(1) << 20,
+                                            (std::size_t(1) << 20) + 4,
+                                            3 << 20,
+                                            12,
+                                            (std::size_t(65) << 20),
+                                            8 << 20};
     std::vector<Buffer> buffers;
     std::vector<std::vector<std::uint32_t>> sent;
     for (std::size_t k = 0; k < sizes.size(); ++k) {

@@ -27,7 +27,8 @@ double millisecondsOf(const auto& work)
 {
     const auto start = std::chrono::steady_clock::now();
     work();
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+        .count();
 }
 
 double medianOf(std::vector<double> v)
@@ -38,7 +39,7 @@ double medianOf(std::vector<double> v)
 
 struct Case {
     const char* name;
-    std::size_t bytes; // buffer cases
+    std::size_t bytes;                   // buffer cases
     std::uint32_t width = 0, height = 0; // image cases (RGBA32F)
 };
 
@@ -73,8 +74,9 @@ int main(int argc, char** argv)
     freshOptions.keepStagingBuffers = false;
     gpu::Context kept(keptOptions);
     gpu::Context fresh(freshOptions);
-    std::printf("device: %s\ntime: wall, upload then download, median of %d (contexts alternating)\n\n",
-                kept.getDeviceInfo().name.c_str(), repeats);
+    std::printf(
+        "device: %s\ntime: wall, upload then download, median of %d (contexts alternating)\n\n",
+        kept.getDeviceInfo().name.c_str(), repeats);
     std::printf("%-44s %12s %12s %8s\n", "transfer", "kept ms", "per-call ms", "ratio");
 
     for (const Case& c : cases) {
