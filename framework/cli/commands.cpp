@@ -371,11 +371,11 @@ int newFamily(const NewFamilyOptions& options)
 
 // ------------------------------------------------------------------------------------- report
 
-int reportCommand(const std::string& resultsDirectory)
+int reportCommand(const std::string& resultsDirectory, int timeFromFrame)
 {
     try {
         const report::ReportSummary s =
-            report::writeStudyReport(resultsDirectory, plugin::builtinRegistry());
+            report::writeStudyReport(resultsDirectory, plugin::builtinRegistry(), timeFromFrame);
         fmt::print("report: {} ({} plots in {}/plots, each .png and .pdf)\n", s.html,
                    s.plots.size(), resultsDirectory);
         return kExitOk;

@@ -46,7 +46,7 @@ int submitSlurmCommand(const RunOptions& options, const experiment::Experiment& 
 int statusCommand(const std::string& resultsDirectory);
 
 //! Writes the plots and report.html of a results folder.
-int reportCommand(const std::string& resultsDirectory);
+int reportCommand(const std::string& resultsDirectory, int timeFromFrame = 0);
 int runExperimentCommand(const RunOptions& options);
 
 struct NewTechniqueOptions {

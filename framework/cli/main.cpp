@@ -51,6 +51,12 @@ int main(int argc, char** argv)
     reportCmd->add_option("results", reportDirectory, "A results folder (with results.jsonl)")
         ->required()
         ->check(CLI::ExistingDirectory);
+    int reportTimeFromFrame = 0;
+    reportCmd
+        ->add_option("--time-from-frame", reportTimeFromFrame,
+                     "Average the time columns of runs of more frames over frames N and later "
+                     "(overrides the experiment's report.time_from_frame)")
+        ->check(CLI::Range(0, 100000));
 
     MergeOptions merge;
     auto* mergeCmd = app.add_subcommand("merge", "Join the results of shard folders into one folder");
@@ -182,7 +188,7 @@ int main(int argc, char** argv)
     if (*sceneCmd)
         return sceneCommand(sceneOptions);
     if (*reportCmd)
-        return reportCommand(reportDirectory);
+        return reportCommand(reportDirectory, reportTimeFromFrame);
     if (*refCmd)
         return referenceCommand(ref);
     if (*mergeCmd)

@@ -601,7 +601,8 @@ Experiment parseExperiment(const std::string& text, const std::string& label,
 {
     const YamlFile file = YamlFile::parse(text, label);
     const YAML::Node& root = file.root();
-    config::checkKeys(file, root, {"name", "description", "base", "sweep"}, {"base"}, "experiment");
+    config::checkKeys(file, root, {"name", "description", "base", "sweep", "report"}, {"base"},
+                      "experiment");
     Loader loader{file, registry};
     Experiment e;
     e.path = label;
@@ -609,6 +610,12 @@ Experiment parseExperiment(const std::string& text, const std::string& label,
                           : std::filesystem::path(label).stem().string();
     if (root["description"])
         e.description = config::readString(file, root["description"], "description");
+    if (const YAML::Node report = root["report"]) {
+        config::checkKeys(file, report, {"time_from_frame"}, {}, "report");
+        if (report["time_from_frame"])
+            e.reportTimeFromFrame = int(config::readInt(file, report["time_from_frame"],
+                                                        "report.time_from_frame", 0, 100000));
+    }
     e.base = loader.readBase(root["base"]);
     e.runs = loader.expand(root["sweep"], e.base, e.sweepKeys);
     auto markVolume = [&](RunConfig& run) {

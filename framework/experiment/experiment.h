@@ -119,6 +119,11 @@ struct Experiment {
     std::string path;
     std::string name;
     std::string description;
+    //! `report: {time_from_frame: N}`: the report averages the time columns (`*_ms`) of a run of
+    //! more than N frames over its frames N and later only (the first frames' builds and shader
+    //! compiles left out: a frame's cost once running); errors stay averaged over every frame.
+    //! Written into each row as `report.time_from_frame` when set; not part of a run's identity.
+    int reportTimeFromFrame = 0;
     RunConfig base;
     std::vector<std::string> sweepKeys; //!< axes in file order
     std::vector<RunConfig> runs;        //!< the expanded cross product (just `base` without sweep)

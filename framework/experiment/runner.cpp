@@ -317,6 +317,8 @@ RunnerSummary runExperiment(const Experiment& experiment, const plugin::Registry
             .set("grid", std::int64_t(run.grid))
             .set("width", std::int64_t(run.width))
             .set("height", std::int64_t(run.height));
+        if (experiment.reportTimeFromFrame > 0)
+            common.set("report.time_from_frame", std::int64_t(experiment.reportTimeFromFrame));
         context.setRunDirectory(summary.outputDirectory + "/runs/" + run.id());
         std::vector<ResultRow> rows;
         try {

@@ -59,10 +59,22 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows,
     std::vector<std::string> groupOrder;
     for (const auto& id : order) {
         RunSummary& run = runs[id];
+        // The experiment's report.time_from_frame: time columns of a run of more frames than
+        // that leave the first frames out.
+        const double fromFrame =
+            experiment::getNumber(run.frames.front(), "report.time_from_frame");
+        const bool skipFirst =
+            std::isfinite(fromFrame) && fromFrame > 0.0 && double(run.frames.size()) > fromFrame;
+        run.timeFromFrame = skipFirst ? int(fromFrame) : 0;
+        const auto isTime = [](const std::string& k) {
+            return k.size() > 3 && k.compare(k.size() - 3, 3, "_ms") == 0;
+        };
         std::map<std::string, std::pair<double, int>> sums;
         for (const auto& frame : run.frames)
             for (const auto& [k, v] : frame) {
                 const double x = experiment::getNumber(frame, k);
+                if (skipFirst && isTime(k) && experiment::getNumber(frame, "frame") < fromFrame)
+                    continue;
                 if (std::isfinite(x)) {
                     sums[k].first += x;
                     sums[k].second += 1;
@@ -112,6 +124,17 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows,
     std::vector<Group> out;
     for (const auto& key : groupOrder) {
         Group g = groups[key];
+        int fromFrame = 0;
+        for (const auto& run : g.runs)
+            fromFrame = std::max(fromFrame, run.timeFromFrame);
+        if (fromFrame > 0) {
+            const std::string note =
+                "; runs of several frames: frames " + std::to_string(fromFrame) + " and later";
+            g.columns.costLabel += note;
+            g.columns.passTimeLabel =
+                (g.columns.passTimeLabel.empty() ? "time (ms, median)" : g.columns.passTimeLabel) +
+                note;
+        }
         std::map<std::string, std::set<std::string>> values;
         for (const auto& run : g.runs)
             for (const auto& frame : run.frames)
@@ -260,9 +283,13 @@ collectAcrossScenesLines(const std::vector<Group>& groups, const std::string& fa
 
 } // namespace detail
 
-ReportSummary writeStudyReport(const std::string& directory, const plugin::Registry& registry)
+ReportSummary writeStudyReport(const std::string& directory, const plugin::Registry& registry,
+                               int timeFromFrame)
 {
-    const auto rows = experiment::loadResults(directory);
+    auto rows = experiment::loadResults(directory);
+    if (timeFromFrame > 0)
+        for (auto& row : rows)
+            row["report.time_from_frame"] = std::to_string(timeFromFrame);
     if (rows.empty())
         throw Error(directory + ": no results (results.jsonl is missing or empty)");
     const auto groups = detail::groupRuns(rows, registry);

@@ -36,6 +36,9 @@ struct ReportSummary {
 
 //! Writes the plots and report.html of the study in `directory`, with the figures and columns
 //! each family of `registry` declares. Throws rtlab::Error when the folder has no results.
-ReportSummary writeStudyReport(const std::string& directory, const plugin::Registry& registry);
+//! `timeFromFrame` > 0 overrides the experiment's report.time_from_frame for every run (the
+//! time columns of a run of more frames average frames timeFromFrame and later only).
+ReportSummary writeStudyReport(const std::string& directory, const plugin::Registry& registry,
+                               int timeFromFrame = 0);
 
 } // namespace rtlab::report

@@ -23,6 +23,9 @@ struct RunSummary {
     std::string technique;
     std::map<std::string, std::string> text;  //!< non-numeric columns of the first frame
     std::map<std::string, double> number;     //!< numeric columns, mean over frames
+    //! > 0 where the time columns (`*_ms`) average frames timeFromFrame and later only (the
+    //! experiment's report.time_from_frame, for a run of more frames than that).
+    int timeFromFrame = 0;
     std::vector<experiment::Row> frames;
     double get(const std::string& column) const;
 };

@@ -4,6 +4,8 @@
 
 #include "report/report_detail.h"
 
+#include "plugin/technique.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -136,6 +138,48 @@ TEST(ReportLines, AnErrorColumnWithoutValuesIsANoteNotAnEmptyChart)
     }
     EXPECT_FALSE(edgeChart);
     EXPECT_TRUE(hausdorffChart);
+}
+
+TEST(ReportRuns, TimeColumnsLeaveOutTheFramesBeforeTheExperimentsTimeFromFrame)
+{
+    // report: {time_from_frame: 1}: a run of 3 frames averages its *_ms columns over frames 1
+    // and 2 (frame 0 built everything), its errors over all three; a run of one frame keeps it.
+    plugin::Registry registry;
+    plugin::registerBuiltinFamilies(registry);
+    const auto row = [](const std::string& id, int frame, double ms, double rmse, bool setting) {
+        experiment::Row r{{"status", "ok"},
+                          {"run_id", id},
+                          {"family", "voxel_gi"},
+                          {"technique", "cascades"},
+                          {"scene", "room"},
+                          {"width", "32"},
+                          {"height", "18"},
+                          {"frame", std::to_string(frame)},
+                          {"technique_ms", std::to_string(ms)},
+                          {"voxelize.cpu_ms", frame == 0 ? "800" : ""},
+                          {"indirect.rmse", std::to_string(rmse)}};
+        if (setting)
+            r["report.time_from_frame"] = "1";
+        return r;
+    };
+    const std::vector<experiment::Row> rows = {
+        row("moving", 0, 900, 0.2, true), row("moving", 1, 10, 0.1, true),
+        row("moving", 2, 20, 0.3, true),  row("single", 0, 50, 0.4, true),
+        row("plain", 0, 900, 0.2, false), row("plain", 1, 10, 0.1, false)};
+    const std::vector<detail::Group> groups = detail::groupRuns(rows, registry);
+    ASSERT_EQ(groups.size(), 1u);
+    const auto& runs = groups[0].runs;
+    ASSERT_EQ(runs.size(), 3u);
+    EXPECT_DOUBLE_EQ(runs[0].get("technique_ms"), 15.0);
+    EXPECT_TRUE(std::isnan(runs[0].get("voxelize.cpu_ms"))) << "the pass ran in frame 0 only";
+    EXPECT_NEAR(runs[0].get("indirect.rmse"), 0.2, 1e-12);
+    EXPECT_EQ(runs[0].timeFromFrame, 1);
+    EXPECT_DOUBLE_EQ(runs[1].get("technique_ms"), 50.0) << "a run of one frame keeps it";
+    EXPECT_EQ(runs[1].timeFromFrame, 0);
+    EXPECT_DOUBLE_EQ(runs[2].get("technique_ms"), 455.0)
+        << "without the setting every frame counts";
+    EXPECT_NE(groups[0].columns.costLabel.find("frames 1 and later"), std::string::npos)
+        << groups[0].columns.costLabel;
 }
 
 } // namespace

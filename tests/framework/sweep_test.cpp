@@ -265,6 +265,26 @@ sweep:
     EXPECT_NE(zero.find("reference.max_samples"), std::string::npos) << zero;
 }
 
+TEST(Sweep, TheReportsTimeFromFrameIsAnExperimentSettingOutsideTheRuns)
+{
+    const auto registry = test::makeTestRegistry();
+    const std::string body = R"(base:
+  scene: ao_testbed
+  frames: 4
+  techniques: {isosurface: {technique: fake_mesher}}
+)";
+    const auto with = experiment::parseExperiment("report: {time_from_frame: 2}\n" + body,
+                                                  "sweep.yaml", registry);
+    const auto without = experiment::parseExperiment(body, "sweep.yaml", registry);
+    EXPECT_EQ(with.reportTimeFromFrame, 2);
+    EXPECT_EQ(without.reportTimeFromFrame, 0);
+    EXPECT_EQ(with.runs.at(0).hash(), without.runs.at(0).hash())
+        << "how the report averages is not what a run is";
+    const std::string bad = errorOf("report: {time_from: 1}\n" + body);
+    EXPECT_NE(bad.find("sweep.yaml:1:"), std::string::npos) << bad;
+    EXPECT_NE(bad.find("time_from_frame"), std::string::npos) << bad;
+}
+
 TEST(Sweep, KeysAddedLaterLeaveTheHashOfRunsThatDoNotUseThemUnchanged)
 {
     // Results written before camera_path, metrics and the ground-truth override existed must
