@@ -244,6 +244,7 @@ void Compose::addSlotUploads(FrameGraph& graph)
 void Compose::addPasses(FrameGraph& graph)
 {
     const auto geometry = mStart.geometry();
+    const auto geometryKey = mStart.geometryKey();
     const auto gbuffer = mStart.gbuffer();
     const auto lit = litFrame();
     const Resource<const render::ShadowPass*> shadowMaps{
@@ -287,14 +288,14 @@ void Compose::addPasses(FrameGraph& graph)
 
     graph.addPass(
         {.name = "shadow_maps",
-         .reads = {geometry},
+         .reads = {geometry, geometryKey},
          .writes = {shadowMaps, atlas},
          .needs = {scene::SceneFeature::PointLights},
          .persistent = {shadowMaps.name, atlas.name},
          .reuse =
-             [this, geometry](const PassContext& ctx) {
+             [this, geometry, geometryKey](const PassContext& ctx) {
                  const scene::RenderScene& g = ctx.read(geometry);
-                 if (mShadowFrame < 0 || g.computeContentHash() != mShadowGeometryHash ||
+                 if (mShadowFrame < 0 || ctx.read(geometryKey) != mShadowGeometryHash ||
                      g.pointLights.size() != mShadowLightPositions.size())
                      return std::string();
                  for (std::size_t i = 0; i < g.pointLights.size(); ++i)
@@ -307,7 +308,7 @@ void Compose::addPasses(FrameGraph& graph)
                  mStats.shadowSkips = "every light: " + why;
                  return why;
              }},
-        [this, geometry, shadowMaps, atlas](PassContext& ctx) {
+        [this, geometry, geometryKey, shadowMaps, atlas](PassContext& ctx) {
             const scene::RenderScene& g = ctx.read(geometry);
             if (!mShadows) {
                 mShadows = std::make_unique<render::ShadowPass>(
@@ -361,7 +362,7 @@ void Compose::addPasses(FrameGraph& graph)
             if (!nothingToDraw)
                 mShadows->renderFaces(g, masks);
             // Remembered once the maps hold it (a failed rendering keeps the last state).
-            mShadowGeometryHash = g.computeContentHash();
+            mShadowGeometryHash = ctx.read(geometryKey);
             mShadowLightPositions.clear();
             for (const auto& l : g.pointLights)
                 mShadowLightPositions.push_back(l.position);

@@ -70,6 +70,7 @@ void FrameStart::addPasses(FrameGraph& graph)
     const auto sdfMeshes = this->sdfMeshes();
     const auto capsules = this->capsules();
     const auto geometryRes = geometry();
+    const auto geometryKeyRes = geometryKey();
     const Resource<GpuScene> gpuScene{"gpu_scene", ResourceType::value("uploaded scene")};
     const auto gbufferRes = gbuffer();
     const auto gbufferCpuRes = gbufferCpu();
@@ -105,36 +106,38 @@ void FrameStart::addPasses(FrameGraph& graph)
     graph.addPass({.name = "assemble_geometry",
                    .reads = {sceneRes},
                    .optionalReads = {sdfMeshes, capsules},
-                   .writes = {geometryRes}},
-                  [this, sdfMeshes, capsules, geometryRes](PassContext& ctx) {
+                   .writes = {geometryRes, geometryKeyRes}},
+                  [this, sdfMeshes, capsules, geometryRes, geometryKeyRes](PassContext& ctx) {
                       static const std::vector<scene::SdfMesh> kNoMeshes;
                       static const std::vector<scene::PosedCapsule> kNoCapsules;
                       const auto* meshes = ctx.tryRead(sdfMeshes);
                       const auto* posed = ctx.tryRead(capsules);
-                      ctx.write(geometryRes) = mScene.assembleRenderScene(
-                          meshes ? *meshes : kNoMeshes, posed ? *posed : kNoCapsules, ctx.frame());
+                      const scene::RenderScene& g = ctx.write(geometryRes) =
+                          mScene.assembleRenderScene(meshes ? *meshes : kNoMeshes,
+                                                     posed ? *posed : kNoCapsules, ctx.frame());
+                      ctx.write(geometryKeyRes) = g.computeContentHash();
                       return PassOutcome{};
                   });
     graph.addPass({.name = "scene_upload",
-                   .reads = {geometryRes},
+                   .reads = {geometryRes, geometryKeyRes},
                    .writes = {gpuScene},
                    .persistent = {gpuScene.name},
                    .reuse =
-                       [this, geometryRes](const PassContext& ctx) {
+                       [this, geometryKeyRes](const PassContext& ctx) {
                            if (!mGBufferPass || !mGBufferPass->hasScene())
                                return std::string();
-                           const std::string hash = ctx.read(geometryRes).computeContentHash();
+                           const std::string& hash = ctx.read(geometryKeyRes);
                            // The upload pass's own record of what it uploaded.
                            return hash == mUploadedHash ? "geometry unchanged since frame " +
                                                               std::to_string(mUploadedFrame)
                                                         : std::string();
                        }},
-                  [this, geometryRes, gpuScene](PassContext& ctx) {
+                  [this, geometryRes, geometryKeyRes, gpuScene](PassContext& ctx) {
                       if (!mGBufferPass)
                           mGBufferPass = std::make_unique<render::GBufferPass>(mGpu);
                       const scene::RenderScene& g = ctx.read(geometryRes);
                       mGBufferPass->setScene(g);
-                      mUploadedHash = g.computeContentHash();
+                      mUploadedHash = ctx.read(geometryKeyRes);
                       mUploadedFrame = ctx.frame();
                       ctx.write(gpuScene) = GpuScene{mUploadedHash, ctx.frame()};
                       return PassOutcome{};

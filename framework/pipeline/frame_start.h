@@ -85,6 +85,7 @@ public:
     //! Names of the resources the frame start writes.
     static constexpr const char* kScene = "scene";
     static constexpr const char* kGeometry = "geometry";
+    static constexpr const char* kGeometryKey = "geometry_key";
     static constexpr const char* kGBuffer = "gbuffer";
     static constexpr const char* kGBufferCpu = "gbuffer_cpu";
     static constexpr const char* kViewInputs = "view_inputs";
@@ -118,6 +119,13 @@ public:
     Resource<scene::RenderScene> geometry() const
     {
         return {kGeometry, ResourceType::mesh("render scene")};
+    }
+    //! The geometry's RenderScene::computeContentHash, computed once per frame by the pass that
+    //! assembles it: the passes that skip work on unchanged geometry compare this key instead of
+    //! hashing the whole scene again (a few MB, hashed byte by byte).
+    Resource<std::string> geometryKey() const
+    {
+        return {kGeometryKey, ResourceType::value("geometry content hash")};
     }
     Resource<GpuGBuffer> gbuffer() const
     {
