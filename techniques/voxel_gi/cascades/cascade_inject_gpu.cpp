@@ -65,6 +65,12 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
             directions[std::size_t(k)] = glm::vec4(glm::vec3(volume.getCones().directions[std::size_t(k)]), 0.0f);
         reserve(mCones, directions.size() * sizeof(glm::vec4), "cascades.inject.cones").uploadSpan<glm::vec4>(directions);
     }
+    // Nothing to light (a level whose region holds no surface, e.g. the finest level around a
+    // camera in the air): no light buffers go up and nothing is dispatched.
+    if (volume.getLevel(li).grid.surfaceVoxels.empty()) {
+        out.clear();
+        return;
+    }
     const CascadeSettings& settings = volume.getSettings();
     const int n = volume.getLevelCount();
     const int R = settings.resolution;
@@ -99,8 +105,6 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
     const auto& level = volume.getLevel(li);
     const auto& surface = level.grid.surfaceVoxels;
     out.assign(surface.size(), FaceIrradiance{});
-    if (surface.empty())
-        return;
     std::vector<glm::vec4> voxels(surface.size() * 2);
     for (std::size_t s = 0; s < surface.size(); ++s) {
         const std::uint32_t v = surface[s];
