@@ -89,7 +89,8 @@ std::size_t PixelConeDispatch::uploadPixels(const scene::GBuffer& gbuffer, const
 }
 
 std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& second,
-                                             const gpu::PushConstants& constants, std::vector<glm::vec3>& out,
+                                             const gpu::PushConstants& constants,
+                                             std::vector<glm::vec3>* out,
                                              const std::vector<gpu::Buffer*>& extra, bool points)
 {
     Starts& starts = points ? mPoints : mPixels;
@@ -105,10 +106,13 @@ std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& se
                                      gpu::computeGroupCount(std::uint64_t(starts.height), 8), 1},
                      mLabel.c_str());
     });
-    const std::vector<glm::vec4> e = starts.output.downloadVector<glm::vec4>(starts.count * kConeCount);
-    out.resize(starts.count * kConeCount);
-    for (std::size_t i = 0; i < out.size(); ++i)
-        out[i] = glm::vec3(e[i]);
+    if (out != nullptr) {
+        const std::vector<glm::vec4> e =
+            starts.output.downloadVector<glm::vec4>(starts.count * kConeCount);
+        out->resize(starts.count * kConeCount);
+        for (std::size_t i = 0; i < out->size(); ++i)
+            (*out)[i] = glm::vec3(e[i]);
+    }
     return result.sumGpuMs(mLabel);
 }
 

@@ -36,10 +36,13 @@ public:
     glm::ivec2 getPointsSize() const { return {mPoints.width, mPoints.height}; }
     //! Runs the pipeline over the uploaded pixels (or, with `points`, the uploaded points) with
     //! the structure's two buffers and reads the cone radiances back into `out` (one row of 16
-    //! per pixel or point); returns the dispatch's GPU time when the device has one.
-    std::optional<double> run(gpu::Buffer& first, gpu::Buffer& second, const gpu::PushConstants& constants,
-                              std::vector<glm::vec3>& out, const std::vector<gpu::Buffer*>& extra = {},
-                              bool points = false);
+    //! per pixel or point); returns the dispatch's GPU time when the device has one. With `out`
+    //! null nothing is read back: the radiances stay in getOutput() (for cone_combine_gpu.h).
+    std::optional<double> run(gpu::Buffer& first, gpu::Buffer& second,
+                              const gpu::PushConstants& constants, std::vector<glm::vec3>* out,
+                              const std::vector<gpu::Buffer*>& extra = {}, bool points = false);
+    //! The cone radiances of the last run over pixels, [pixel * 16 + cone] as vec4.
+    const gpu::Buffer& getOutput() const { return mPixels.output; }
     //! A storage buffer of at least `bytes` (16 at least) named `name`.
     gpu::Buffer makeBuffer(std::size_t bytes, const char* name);
 

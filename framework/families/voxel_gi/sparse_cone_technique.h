@@ -8,8 +8,11 @@
 //
 // Structure: injectLight(scene), getCones(), gatherCones(gbuffer, out), gatherRays(gbuffer, rays,
 // out), getLeaves(), getLeafSize(), getMeanStepsPerCone(), getTopologyBytes(), getPayloadBytes().
-// Gpu: gatherCones(context, structure, gbuffer, out), getLastGpuMs(), getLastUploadBytes().
+// Gpu: gatherCones(context, structure, gbuffer, out), gatherConesOnDevice(context, structure,
+// gbuffer), getLastGpuMs(), getLastUploadBytes(). On Vulkan the cones stay on the device and the
+// combine runs there too (cone_combine_gpu.h).
 
+#include "families/voxel_gi/cone_combine_gpu.h"
 #include "families/voxel_gi/sparse_cone_params.h"
 #include "families/voxel_gi/upsample.h"
 #include "families/voxel_gi/voxel_gi.h"
@@ -67,15 +70,23 @@ public:
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
         mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
-        irradiance = gatherConesReduced(*input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
-                                        input.coneVisibility, input.capsules,
-                                        [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                                            if (mGatheredOnGpu)
-                                                mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
-                                            else
-                                                mStructure->gatherCones(reduced, cones);
-                                        },
-                                        &mCombineMs);
+        if (mGatheredOnGpu) {
+            irradiance = gatherConesReducedOnGpu(
+                *input.gpu, mCombineGpu, *input.gbuffer, mParams.traceStep,
+                mStructure->getCones().halfAngle, input.coneVisibility, input.capsules,
+                [&](const scene::GBuffer& reduced) -> const gpu::Buffer& {
+                    return mGpu.gatherConesOnDevice(*input.gpu, *mStructure, reduced);
+                },
+                &mCombineMs);
+            return;
+        }
+        irradiance = gatherConesReduced(
+            *input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
+            input.coneVisibility, input.capsules,
+            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+                mStructure->gatherCones(reduced, cones);
+            },
+            &mCombineMs);
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
@@ -103,9 +114,15 @@ public:
             {"leaves", double(mStructure->getLeaves().size())},
             {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mStructure->getMeanStepsPerCone()},
             {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
-            {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
+            {"gather_gpu_ms",
+             mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
             {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
-            {"combine_ms", mCombineMs}};
+            {"combine_ms", mCombineMs},
+            {"combine_gpu_ms", mGatheredOnGpu && mCombineGpu.getLastGpuMs()
+                                   ? *mCombineGpu.getLastGpuMs()
+                                   : std::nan("")},
+            {"combine_upload_bytes",
+             mGatheredOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0}};
         for (auto& extra : structureCounters())
             c.push_back(std::move(extra));
         return c;
@@ -126,6 +143,7 @@ protected:
 
 private:
     Gpu mGpu;
+    ConeCombineGpu mCombineGpu;
     std::string mGeometryKey, mLightsKey;
     bool mBuilt = false;
     bool mGatheredOnGpu = false;

@@ -28,6 +28,29 @@ std::filesystem::path TreeConeGatherGpu::getShaderDir()
 void TreeConeGatherGpu::gatherCones(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
                                     std::vector<glm::vec3>& out)
 {
+    trace(context, tree, gbuffer, &out);
+}
+
+const gpu::Buffer& TreeConeGatherGpu::gatherConesOnDevice(gpu::Context& context,
+                                                          const VoxelTreeCones& tree,
+                                                          const scene::GBuffer& gbuffer)
+{
+    trace(context, tree, gbuffer, nullptr);
+    if (tree.getTree() != nullptr)
+        return mDispatch.getOutput();
+    const std::vector<glm::vec4> zeros(
+        std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount, glm::vec4(0.0f));
+    if (!mZeros.isValid() || mZeros.getSize() < zeros.size() * sizeof(glm::vec4))
+        mZeros = mDispatch.makeBuffer(zeros.size() * sizeof(glm::vec4),
+                                      "adaptive_voxel_tree_cones.no_tree");
+    if (!zeros.empty())
+        mZeros.uploadSpan<glm::vec4>(zeros);
+    return mZeros;
+}
+
+void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
+                              const scene::GBuffer& gbuffer, std::vector<glm::vec3>* out)
+{
     if (!mDispatch.isReadyFor(context)) {
         *this = TreeConeGatherGpu();
         mDispatch.create(context, getShaderDir() / "tree_cone_gather.comp", kDispatchLabel, sizeof(GatherConstants),
@@ -35,7 +58,9 @@ void TreeConeGatherGpu::gatherCones(gpu::Context& context, const VoxelTreeCones&
     }
     const AdaptiveVoxelTree* t = tree.getTree();
     if (t == nullptr) {
-        out.assign(std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount, glm::vec3(0.0f));
+        if (out != nullptr)
+            out->assign(std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount,
+                        glm::vec3(0.0f));
         return;
     }
     mLastUploadBytes = 0;

@@ -22,6 +22,10 @@ public:
     //! VoxelTreeCones::gatherCones on the GPU, [pixel * 16 + cone].
     void gatherCones(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
                      std::vector<glm::vec3>& out);
+    //! The same without the read-back: the radiances stay on the device, in the returned buffer
+    //! (for cone_combine_gpu.h), valid until the next call.
+    const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const VoxelTreeCones& tree,
+                                           const scene::GBuffer& gbuffer);
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/adaptive_voxel_tree_cones/shaders when set, else the
@@ -29,8 +33,12 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
+    void trace(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
+               std::vector<glm::vec3>* out);
+
     PixelConeDispatch mDispatch;
     gpu::Buffer mNodes, mGathered;
+    gpu::Buffer mZeros; //!< the radiances of an empty tree, when kept on the device
     std::uint64_t mUploadedStamp = 0;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;

@@ -116,6 +116,20 @@ GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anc
 void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& volume,
                                    const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
+    trace(context, volume, gbuffer, &out);
+}
+
+const gpu::Buffer& CascadeGatherGpu::gatherConesOnDevice(gpu::Context& context,
+                                                         const CascadeVolume& volume,
+                                                         const scene::GBuffer& gbuffer)
+{
+    trace(context, volume, gbuffer, nullptr);
+    return mDispatch.getOutput();
+}
+
+void CascadeGatherGpu::trace(gpu::Context& context, const CascadeVolume& volume,
+                             const scene::GBuffer& gbuffer, std::vector<glm::vec3>* out)
+{
     mLastUploadBytes = 0;
     const glm::dvec3 anchor = prepare(context, volume);
     mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
@@ -143,9 +157,10 @@ void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume&
         mFarSlots = mDispatch.makeBuffer(16, "cascades.far_slots");
         mFarCones = mDispatch.makeBuffer(16, "cascades.far_cones");
     }
-    mLastGpuMs = mDispatch.run(mLevels, mCombined,
-                               gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true)),
-                               out, {&mFarSlots, &mFarCones}, true);
+    mLastGpuMs = mDispatch.run(
+        mLevels, mCombined,
+        gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true)), &out,
+        {&mFarSlots, &mFarCones}, true);
 }
 
 void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)

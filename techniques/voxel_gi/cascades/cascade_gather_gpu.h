@@ -36,6 +36,10 @@ public:
     //! split cones (farStart > 0), volume.prepareFarCones(gbuffer) called first.
     void gatherCones(gpu::Context& context, const CascadeVolume& volume,
                      const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! The same without the read-back: the radiances stay on the device, in the returned buffer
+    //! (for cone_combine_gpu.h), valid until the next call.
+    const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const CascadeVolume& volume,
+                                           const scene::GBuffer& gbuffer);
     //! CascadeVolume::FarConeTracer on Vulkan: the 16 far cones of each voxel centre, through
     //! the same pre-combined buffers (uploaded when they changed), [centre * 16 + cone].
     void traceFarCones(gpu::Context& context, const CascadeVolume& volume,
@@ -48,6 +52,8 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
+    void trace(gpu::Context& context, const CascadeVolume& volume, const scene::GBuffer& gbuffer,
+               std::vector<glm::vec3>* out);
     // The pipeline for `context`, the levels' descriptors and the pre-combined buffers of the
     // levels that changed; returns the anchor positions are relative to.
     glm::dvec3 prepare(gpu::Context& context, const CascadeVolume& volume);

@@ -91,6 +91,7 @@
 #include "cascade_gather_gpu.h"
 #include "cascade_inject_gpu.h"
 #include "cascade_volume.h"
+#include "families/voxel_gi/cone_combine_gpu.h"
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -288,20 +289,28 @@ public:
         // each cone's radiance upsampled by depth and normal, times the pixel's own visibilities
         // (bent-cone SSDO) and the characters' capsules.
         mGatheredOnGpu = mOnGpu && mSettings.precombine && input.gpu != nullptr;
-        irradiance = voxelgi::gatherConesReduced(
-            *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
-            input.capsules, [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                if (mGatheredOnGpu) {
+        if (mGatheredOnGpu) {
+            // The cones stay on the device and the combine runs there (cone_combine_gpu.h).
+            irradiance = voxelgi::gatherConesReducedOnGpu(
+                *input.gpu, mCombineGpu, *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle,
+                input.coneVisibility, input.capsules,
+                [&](const scene::GBuffer& reduced) -> const gpu::Buffer& {
                     if (mSettings.farStart > 0.0) // the far cones, on Vulkan too
                         mVolume->prepareFarCones(
                             reduced, [&](const std::vector<std::pair<int, std::uint32_t>>& centres,
                                          std::vector<glm::vec3>& far) {
                                 mGpu.traceFarCones(*input.gpu, *mVolume, centres, far);
                             });
-                    mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
-                } else {
-                    mVolume->gatherCones(reduced, cones);
-                }
+                    return mGpu.gatherConesOnDevice(*input.gpu, *mVolume, reduced);
+                },
+                &mCombineMs);
+            return;
+        }
+        irradiance = voxelgi::gatherConesReduced(
+            *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
+            input.capsules,
+            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+                mVolume->gatherCones(reduced, cones);
             },
             &mCombineMs);
     }
@@ -348,10 +357,15 @@ public:
                 {"surface_voxels", double(surface)},
                 {"steps_per_cone", mGatheredOnGpu ? std::nan("") : c.meanStepsPerCone},
                 {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
-                {"gather_gpu_ms", mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs()
-                                                                         : std::nan("")},
+                {"gather_gpu_ms",
+                 mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
                 {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
                 {"combine_ms", mCombineMs},
+                {"combine_gpu_ms", mGatheredOnGpu && mCombineGpu.getLastGpuMs()
+                                       ? *mCombineGpu.getLastGpuMs()
+                                       : std::nan("")},
+                {"combine_upload_bytes",
+                 mGatheredOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0},
                 {"far_cones_traced", double(c.farConesTraced)},
                 {"far_cones_ms", c.farConesMs},
                 {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
@@ -362,13 +376,19 @@ public:
                                           mInjectGpu.getCounters().dispatches > 0
                                       ? mInjectGpu.getCounters().gpuMs
                                       : std::nan("")},
-                {"inject_upload_bytes", mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0},
-                {"inject_dispatch_ms", mInjectedOnGpu ? mInjectGpu.getCounters().submitMs : std::nan("")},
-                {"inject_device_call_ms", mInjectedOnGpu ? mInjectGpu.getCounters().callMs : std::nan("")},
+                {"inject_upload_bytes",
+                 mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0},
+                {"inject_dispatch_ms",
+                 mInjectedOnGpu ? mInjectGpu.getCounters().submitMs : std::nan("")},
+                {"inject_device_call_ms",
+                 mInjectedOnGpu ? mInjectGpu.getCounters().callMs : std::nan("")},
                 {"voxelize_on_gpu", mVoxelizedOnGpu ? 1.0 : 0.0},
-                {"voxelize_dispatch_ms", mVoxelizedOnGpu ? mVoxelizer.getCounters().submitMs : std::nan("")},
-                {"voxelize_device_call_ms", mVoxelizedOnGpu ? mVoxelizer.getCounters().callMs : std::nan("")},
-                {"voxelize_fallbacks", mVoxelizedOnGpu ? double(mVoxelizer.getCounters().fallbacks) : 0.0}};
+                {"voxelize_dispatch_ms",
+                 mVoxelizedOnGpu ? mVoxelizer.getCounters().submitMs : std::nan("")},
+                {"voxelize_device_call_ms",
+                 mVoxelizedOnGpu ? mVoxelizer.getCounters().callMs : std::nan("")},
+                {"voxelize_fallbacks",
+                 mVoxelizedOnGpu ? double(mVoxelizer.getCounters().fallbacks) : 0.0}};
     }
 
 private:
@@ -376,6 +396,7 @@ private:
     double mVoxelSizeParam = 0.0;
     std::optional<voxelgi::CascadeVolume> mVolume;
     voxelgi::CascadeGatherGpu mGpu;
+    voxelgi::ConeCombineGpu mCombineGpu;
     voxelgi::CascadeInjectGpu mInjectGpu;
     voxelgi::VoxelizerGpu mVoxelizer;
     bool mVoxelizeOnGpu = false;

@@ -5,6 +5,7 @@
 #include "cascade_inject_gpu.h"
 #include "cascade_volume.h"
 
+#include "families/voxel_gi/cone_combine_gpu.h"
 #include "families/voxel_gi/voxel_gi_gpu_parity.h"
 #include "families/voxel_gi/voxel_gi_test_scenes.h"
 #include "families/voxel_gi/voxelize_gpu.h"
@@ -51,6 +52,28 @@ std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>> compare(const glm::vec
     // A second call uploads no level (nothing changed), only the pixels.
     gather.gatherCones(context, volume, g, gpuCones);
     EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
+    // Kept on the device: the same radiances, and the Vulkan combine of them gives the C++ combine
+    // of the read-back ones (to the tolerance of cone_combine_gpu_test.cpp, 1e-4 per pixel).
+    const gpu::Buffer& onDevice = gather.gatherConesOnDevice(context, volume, g);
+    const std::vector<glm::vec4> kept = onDevice.downloadVector<glm::vec4>(gpuCones.size());
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        differ += glm::vec3(kept[i]) != gpuCones[i] ? 1 : 0;
+    EXPECT_EQ(differ, 0u);
+    const ReducedGBuffer same = reduceGBuffer(g, 1);
+    ConeCombineInputs in;
+    in.coneRadiance = &gpuCones;
+    in.reduced = &same;
+    in.full = &g;
+    in.coneHalfAngle = volume.getCones().halfAngle;
+    ConeCombineGpu combiner;
+    const Image<glm::vec3> cpu = combineCones(in), gpu = combiner.combine(context, onDevice, in);
+    std::size_t pixelsOff = 0;
+    for (std::size_t i = 0; i < cpu.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            pixelsOff += std::abs(gpu.pixels[i][c] - cpu.pixels[i][c]) >
+                         1e-4f * std::max(1e-3f, cpu.pixels[i][c]);
+    EXPECT_EQ(pixelsOff, 0u);
     return {cpuCones, gpuCones};
 }
 

@@ -28,6 +28,20 @@ std::filesystem::path OctreeGatherGpu::getShaderDir()
 void OctreeGatherGpu::gatherCones(gpu::Context& context, const SparseVoxelOctree& tree,
                                   const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
+    trace(context, tree, gbuffer, &out);
+}
+
+const gpu::Buffer& OctreeGatherGpu::gatherConesOnDevice(gpu::Context& context,
+                                                        const SparseVoxelOctree& tree,
+                                                        const scene::GBuffer& gbuffer)
+{
+    trace(context, tree, gbuffer, nullptr);
+    return mDispatch.getOutput();
+}
+
+void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree,
+                            const scene::GBuffer& gbuffer, std::vector<glm::vec3>* out)
+{
     if (!mDispatch.isReadyFor(context)) {
         *this = OctreeGatherGpu();
         mDispatch.create(context, getShaderDir() / "svo_gather.comp", kDispatchLabel, sizeof(GatherConstants),

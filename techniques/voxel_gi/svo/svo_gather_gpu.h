@@ -21,12 +21,19 @@ public:
     //! SparseVoxelOctree::gatherCones on the GPU, [pixel * 16 + cone].
     void gatherCones(gpu::Context& context, const SparseVoxelOctree& tree,
                      const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! The same without the read-back: the radiances stay on the device, in the returned buffer
+    //! (for cone_combine_gpu.h), valid until the next call.
+    const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const SparseVoxelOctree& tree,
+                                           const scene::GBuffer& gbuffer);
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/svo/shaders when set, else the source folder.
     static std::filesystem::path getShaderDir();
 
 private:
+    void trace(gpu::Context& context, const SparseVoxelOctree& tree, const scene::GBuffer& gbuffer,
+               std::vector<glm::vec3>* out);
+
     PixelConeDispatch mDispatch;
     gpu::Buffer mChildren, mGathered;
     std::uint64_t mUploadedStamp = 0;

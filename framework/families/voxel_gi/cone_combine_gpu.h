@@ -1,0 +1,59 @@
+#pragma once
+// The final combine of a cone-traced gather on Vulkan (shaders/cone_combine.comp): combineCones
+// (upsample.h) per full-resolution pixel, reading the cone radiances where the pixel cone
+// dispatch left them on the device, so that only the full-resolution irradiance comes back.
+// Shared by the structures gathered on Vulkan (cascades, svo, adaptive_voxel_tree_cones).
+
+#include "families/voxel_gi/upsample.h"
+#include "gpu/context.h"
+
+#include <filesystem>
+#include <functional>
+#include <optional>
+
+namespace rtlab::voxelgi {
+
+class ConeCombineGpu {
+public:
+    static constexpr const char* kDispatchLabel = "voxel_gi.combine";
+
+    //! combineCones(in) on `context`, with the cone radiances [low-res pixel * 16 + cone] (vec4)
+    //! in `coneRadiance` (in.coneRadiance is not read).
+    Image<glm::vec3> combine(gpu::Context& context, const gpu::Buffer& coneRadiance,
+                             const ConeCombineInputs& in);
+    //! The same with in.coneRadiance uploaded first.
+    Image<glm::vec3> combine(gpu::Context& context, const ConeCombineInputs& in);
+
+    //! GPU time of the last dispatch, when the device has timestamps.
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    //! Bytes uploaded by the last call (G-buffer, visibilities, capsules).
+    std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
+    //! $RTLAB_SOURCE_DIR/framework/families/voxel_gi/shaders when set, else the source folder.
+    static std::filesystem::path getShaderDir();
+
+private:
+    // The pipeline and the cone directions on `context` (everything anew for another context).
+    void prepare(gpu::Context& context);
+    gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name);
+
+    gpu::Context* mContext = nullptr;
+    gpu::ComputePipeline mPipeline;
+    gpu::Buffer mRepresentative, mPositions, mNormals, mDepths, mMaterials, mVisibility, mCapsules,
+        mCones, mOutput, mUploadedCones;
+    std::optional<double> mLastGpuMs;
+    std::size_t mLastUploadBytes = 0;
+};
+
+//! gatherConesReduced (upsample.h) with the cones kept on the device: `traceCones(reduced)` runs
+//! a Vulkan pixel cone dispatch without reading back and returns its output buffer
+//! ([low-res pixel * 16 + cone], vec4), and `combiner` brings it to full resolution on the same
+//! device. `combineMs`, when given, receives the wall time of the reduction and the combine.
+Image<glm::vec3>
+gatherConesReducedOnGpu(gpu::Context& context, ConeCombineGpu& combiner, const scene::GBuffer& full,
+                        int traceStep, double coneHalfAngle,
+                        const std::vector<Image<float>>* visibility,
+                        const std::vector<scene::PosedCapsule>* capsules,
+                        const std::function<const gpu::Buffer&(const scene::GBuffer&)>& traceCones,
+                        double* combineMs = nullptr);
+
+} // namespace rtlab::voxelgi

@@ -1,0 +1,261 @@
+#version 450
+// The final combine of a cone-traced gather on Vulkan, per full-resolution pixel: the 16 cone
+// radiances of the reduced pixels around it upsampled with depth- and normal-aware weights (joint
+// bilateral upsampling, Kopf et al. 2007), times the occlusion family's 16 visibilities and the
+// characters' capsules' occlusion of each cone (Oat and Sander, "Ambient Aperture Lighting",
+// I3D 2007), integrated with the pixel's irradiance weights. The same algorithm as
+// voxelgi::combineCones (framework/families/voxel_gi/upsample.cpp), in float. The Tomorrow
+// Children, GDC 2015 (shared/seeds/000_3da000e866ebc485.txt, "Trace at a lower resolution",
+// "Screen Space Directional Occlusion", "Characters").
+//
+// The G-buffer arrives as the frame holds it (float positions, normals and depth, one word of
+// material per pixel), so that the upload is a copy; positions are made relative to an anchor
+// near the camera here, which is exact for the float inputs wherever the capsule tests matter.
+
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+
+layout(std430, binding = 0) readonly buffer ConeBuffer { vec4 coneRadiance[]; };     // [low pixel * 16 + cone]
+layout(std430, binding = 1) readonly buffer RepresentativeBuffer { int representative[]; }; // [low pixel]: full pixel, -1: none
+layout(std430, binding = 2) readonly buffer PositionBuffer { float positions[]; };  // 3 per full pixel, world
+layout(std430, binding = 3) readonly buffer NormalBuffer { float normals[]; };      // 3 per full pixel
+layout(std430, binding = 4) readonly buffer DepthBuffer { float depths[]; };        // linear depth, inf: none
+layout(std430, binding = 5) readonly buffer MaterialBuffer { uint materials[]; };   // ~0u: no surface
+layout(std430, binding = 6) readonly buffer VisibilityBuffer { float visibility[]; }; // [cone][full pixel]
+// Per capsule, 4 vec4, relative to the anchor: (a, radius), (b - a, 1 / |b - a|^2 or 0),
+// (centre of the segment, radius of the sphere around the capsule), (near^2, reach^2, 0, 0).
+layout(std430, binding = 7) readonly buffer CapsuleBuffer { vec4 capsules[]; };
+layout(std430, binding = 8) readonly buffer DirectionBuffer { vec4 cones[16]; };
+layout(std430, binding = 9) writeonly buffer OutputBuffer { vec4 irradiance[]; }; // [full pixel]
+
+layout(push_constant) uniform Constants {
+    ivec4 size;   // full width, height; low width, height
+    ivec4 flags;  // x: factor, y: capsules, z: 1 = visibility given
+    vec4 angle;   // cone half-angle, its cosine, its sine, 1 - its cosine
+    vec4 anchor;  // xyz: what positions are made relative to
+} pc;
+
+const uint kNoMaterial = 0xffffffffu;
+
+vec3 readPosition(int pixel)
+{
+    return vec3(positions[3 * pixel], positions[3 * pixel + 1], positions[3 * pixel + 2]) - pc.anchor.xyz;
+}
+
+vec3 readNormal(int pixel)
+{
+    return vec3(normals[3 * pixel], normals[3 * pixel + 1], normals[3 * pixel + 2]);
+}
+
+// Geometric similarity of low-resolution sample s to the pixel (p, n, view depth d): distance of
+// the sample from the pixel's tangent plane against 2 % of the depth, and cos^8 of the normals.
+float similarity(int s, vec3 p, vec3 n, float d)
+{
+    const int r = representative[s];
+    if (r < 0)
+        return 0.0;
+    const float plane = abs(dot(n, readPosition(r) - p)) / max(0.02 * d, 1e-6);
+    const float c = max(0.0, dot(n, readNormal(r)));
+    const float c2 = c * c, c4 = c2 * c2;
+    return exp(-plane * plane) * c4 * c4;
+}
+
+// upsample.cpp findUpsampleSamples: the four low-resolution samples around the pixel, bilinear
+// times similarity; when all four fail, the most similar of the 3 x 3 around.
+int findSamples(int x, int y, vec3 p, vec3 n, float d, out ivec4 samples, out vec4 weights)
+{
+    samples = ivec4(0);
+    weights = vec4(0.0);
+    const int f = pc.flags.x;
+    const int lw = pc.size.z, lh = pc.size.w;
+    if (f == 1) {
+        samples.x = y * lw + x;
+        weights.x = 1.0;
+        return 1;
+    }
+    const float u = (float(x) + 0.5) / float(f) - 0.5, v = (float(y) + 0.5) / float(f) - 0.5;
+    const int i0 = int(floor(u)), j0 = int(floor(v));
+    const float fu = u - float(i0), fv = v - float(j0);
+    int count = 0;
+    float total = 0.0;
+    for (int dj = 0; dj <= 1; ++dj)
+        for (int di = 0; di <= 1; ++di) {
+            const int i = clamp(i0 + di, 0, lw - 1), j = clamp(j0 + dj, 0, lh - 1);
+            const float bilinear = (di == 1 ? fu : 1.0 - fu) * (dj == 1 ? fv : 1.0 - fv);
+            const int s = j * lw + i;
+            const float w = bilinear * similarity(s, p, n, d);
+            if (w <= 0.0)
+                continue;
+            samples[count] = s;
+            weights[count] = w;
+            total += w;
+            ++count;
+        }
+    if (total > 1e-6) {
+        weights /= total;
+        return count;
+    }
+    const int ci = clamp(x / f, 0, lw - 1), cj = clamp(y / f, 0, lh - 1);
+    float best = -1.0;
+    int bestSample = -1;
+    for (int j = max(0, cj - 1); j <= min(lh - 1, cj + 1); ++j)
+        for (int i = max(0, ci - 1); i <= min(lw - 1, ci + 1); ++i) {
+            const int s = j * lw + i;
+            if (representative[s] < 0)
+                continue;
+            const float w = similarity(s, p, n, d) - 1e-3 * float(abs(i - ci) + abs(j - cj));
+            if (w > best) {
+                best = w;
+                bestSample = s;
+            }
+        }
+    if (bestSample < 0)
+        return 0;
+    samples.x = bestSample;
+    weights = vec4(1.0, 0.0, 0.0, 0.0);
+    return 1;
+}
+
+// atan2(y, x) for y >= 0 in [0, pi], to a few float ulps. Vulkan lets the built-in atan, asin
+// and sin be off by 4096 ulps (and sin by 2^-11 absolute), which the smoothstep below turns into
+// 1e-3 of a capsule's occlusion; this uses only arithmetic. Reduced to t in [0, 1] by the octant,
+// then to |t'| <= tan(pi / 12) by atan(t) = pi / 6 + atan((sqrt(3) t - 1) / (sqrt(3) + t)), then
+// the Taylor series to t'^11 (remainder below 3e-9).
+float preciseAtan2(float y, float x)
+{
+    const float ax = abs(x);
+    const bool swapped = y > ax;
+    float t = swapped ? ax / y : (ax > 0.0 ? y / ax : 0.0);
+    float base = 0.0;
+    if (t > 0.26794919) {
+        t = (1.7320508 * t - 1.0) / (1.7320508 + t);
+        base = 0.52359878;
+    }
+    const float t2 = t * t;
+    float a = base + t * (1.0 + t2 * (-1.0 / 3.0 + t2 * (1.0 / 5.0 + t2 * (-1.0 / 7.0 + t2 * (1.0 / 9.0 - t2 / 11.0)))));
+    if (swapped)
+        a = 1.57079633 - a;
+    return x < 0.0 ? 3.14159265 - a : a;
+}
+
+vec3 closestOnSegment(vec3 q, vec3 a, vec3 u, float inverseLength2)
+{
+    return a + clamp(dot(q - a, u) * inverseLength2, 0.0, 1.0) * u;
+}
+
+// upsample.cpp occludeCone: the share of the cone (axis dir) from p that capsule c hides.
+float occludeCone(vec3 p, vec3 dir, int c)
+{
+    const vec3 a = capsules[4 * c].xyz;
+    const float r = capsules[4 * c].w;
+    const vec3 u = capsules[4 * c + 1].xyz;
+    const float inverseLength2 = capsules[4 * c + 1].w;
+    const float uu = dot(u, u);
+    // On or inside the capsule: its own character's surface is not occluded by it.
+    if (length(p - closestOnSegment(p, a, u, inverseLength2)) <= 1.05 * r)
+        return 0.0;
+    // The point of the segment nearest the cone's axis (closest points of a segment and a ray);
+    // a segment within float rounding of parallel to the axis takes its first end, as in C++.
+    const vec3 w0 = a - p;
+    const float ud = dot(u, dir), uw = dot(u, w0), dw = dot(dir, w0);
+    const float denom = uu - ud * ud;
+    const float s = denom > 1e-6 * uu ? clamp((ud * dw - uw) / denom, 0.0, 1.0) : 0.0;
+    const float t = max(0.0, dot(a + s * u - p, dir));
+    const vec3 toCentre = closestOnSegment(p + t * dir, a, u, inverseLength2) - p;
+    const float distance = length(toCentre);
+    if (!(distance > r))
+        return 0.0;
+    const float sinCap = min(1.0, r / distance), cosCap = sqrt(max(0.0, 1.0 - sinCap * sinCap));
+    const float cosHalf = pc.angle.y, sinHalf = pc.angle.z;
+    const float cosBetween = clamp(dot(toCentre / distance, dir), -1.0, 1.0);
+    // Disjoint caps, tested on cosines (the margin keeps float rounding from returning 0 for a
+    // touching cap; the exact test on angles below decides).
+    if (cosBetween < cosHalf * cosCap - sinHalf * sinCap - 1e-5)
+        return 0.0;
+    // Solid angles / 2 pi: 1 - cos of the smaller angle, as sin^2 / (1 + cos) for the cap (1 - cos
+    // loses most of a float's digits for the small caps of far capsules).
+    const float coneSolid = pc.angle.w;
+    const float smaller = cosCap > cosHalf ? sinCap * sinCap / (1.0 + cosCap) : coneSolid;
+    if (cosBetween >= cosHalf * cosCap + sinHalf * sinCap)
+        return clamp(smaller / coneSolid, 0.0, 1.0);
+    // Between the two: Oat and Sander's smoothstep in the angle between the caps, the angles from
+    // atan2 of well-conditioned pairs rather than acos and asin.
+    const float capAngle = preciseAtan2(sinCap, cosCap);
+    const float between = preciseAtan2(length(cross(toCentre, dir)), dot(toCentre, dir));
+    const float outer = pc.angle.x + capAngle, inner = abs(pc.angle.x - capAngle);
+    if (between >= outer)
+        return 0.0;
+    float share = 1.0;
+    if (between > inner) {
+        const float x = clamp(1.0 - (between - inner) / (outer - inner), 0.0, 1.0);
+        share = x * x * (3.0 - 2.0 * x);
+    }
+    return clamp(smaller * share / coneSolid, 0.0, 1.0);
+}
+
+void main()
+{
+    const int x = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y);
+    const int w = pc.size.x, h = pc.size.y;
+    if (x >= w || y >= h)
+        return;
+    const int pixel = y * w + x;
+    irradiance[pixel] = vec4(0.0);
+    if (materials[pixel] == kNoMaterial)
+        return;
+    const vec3 p = readPosition(pixel), n = readNormal(pixel);
+    const float depth = depths[pixel];
+    const float d = isinf(depth) || isnan(depth) ? 1.0 : depth;
+    ivec4 samples;
+    vec4 weights;
+    const int count = findSamples(x, y, p, n, d, samples, weights);
+    if (count == 0 || dot(n, n) < 0.5)
+        return;
+    // cone_tracing.cpp computeIrradianceWeights: the clamped cosines, scaled to sum to pi.
+    float coneWeight[16];
+    float sum = 0.0;
+    for (int k = 0; k < 16; ++k) {
+        coneWeight[k] = max(0.0, dot(cones[k].xyz, n));
+        sum += coneWeight[k];
+    }
+    float visible[16];
+    for (int k = 0; k < 16; ++k)
+        visible[k] = pc.flags.z != 0 ? clamp(visibility[k * w * h + pixel], 0.0, 1.0) : 1.0;
+    // The capsules in order (as the C++ combine multiplies them per cone): those within 40 radii
+    // of the pixel, and in them the cones that can reach the sphere around the capsule.
+    for (int c = 0; c < pc.flags.y; ++c) {
+        const vec4 centre = capsules[4 * c + 2];
+        const vec4 reach = capsules[4 * c + 3];
+        const vec3 toCentre = centre.xyz - p;
+        const float d2 = dot(toCentre, toCentre);
+        if (d2 >= reach.y)
+            continue;
+        const vec3 fromSegment = p - closestOnSegment(p, capsules[4 * c].xyz, capsules[4 * c + 1].xyz,
+                                                     capsules[4 * c + 1].w);
+        if (dot(fromSegment, fromSegment) >= reach.x)
+            continue;
+        vec3 towardCentre = vec3(0.0);
+        float cosLimit = -2.0;
+        if (d2 > centre.w * centre.w) {
+            const float distance = sqrt(d2);
+            const float sinB = centre.w / distance, cosB = sqrt(max(0.0, 1.0 - sinB * sinB));
+            towardCentre = toCentre / distance;
+            cosLimit = pc.angle.y * cosB - pc.angle.z * sinB;
+        }
+        for (int k = 0; k < 16; ++k) {
+            if (coneWeight[k] == 0.0 || dot(towardCentre, cones[k].xyz) < cosLimit - 1e-5)
+                continue;
+            visible[k] *= 1.0 - occludeCone(p, cones[k].xyz, c);
+        }
+    }
+    vec3 e = vec3(0.0);
+    if (sum > 0.0)
+        for (int k = 0; k < 16; ++k) {
+            if (coneWeight[k] == 0.0)
+                continue;
+            vec3 radiance = vec3(0.0);
+            for (int s = 0; s < count; ++s)
+                radiance += weights[s] * coneRadiance[samples[s] * 16 + k].rgb;
+            e += (coneWeight[k] * 3.14159265358979 / sum) * visible[k] * radiance;
+        }
+    irradiance[pixel] = vec4(max(e, vec3(0.0)), 0.0);
+}
