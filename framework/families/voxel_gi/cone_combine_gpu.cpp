@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 namespace rtlab::voxelgi {
@@ -50,7 +51,18 @@ void ConeCombineGpu::prepare(gpu::Context& context)
     mContext = &context;
     gpu::ComputePipelineDesc desc;
     desc.name = kDispatchLabel;
-    desc.spirv = gpu::ShaderCompiler().compileFile(getShaderDir() / "cone_combine.comp").spirv;
+    // The directions as GLSL constants, to 9 significant digits (float round trip).
+    std::string constants;
+    for (const glm::dvec3& d : scene::getConeDirections()) {
+        char text[96];
+        std::snprintf(text, sizeof(text), "%svec3(%.9g, %.9g, %.9g)", constants.empty() ? "" : ", ",
+                      float(d.x), float(d.y), float(d.z));
+        constants += text;
+    }
+    desc.spirv =
+        gpu::ShaderCompiler()
+            .compileFile(getShaderDir() / "cone_combine.comp", {{"CONE_DIRECTIONS", constants}})
+            .spirv;
     for (std::uint32_t b = 0; b < kBindings; ++b)
         desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
     desc.pushConstantSize = sizeof(CombineConstants);
@@ -67,14 +79,20 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const ConeCombin
 {
     if (in.coneRadiance == nullptr)
         throw Error("cone combine: no cone radiances given");
+    return combine(context, uploadCones(context, *in.coneRadiance), in);
+}
+
+const gpu::Buffer& ConeCombineGpu::uploadCones(gpu::Context& context,
+                                               const std::vector<glm::vec3>& coneRadiance)
+{
     prepare(context);
-    std::vector<glm::vec4> cones(in.coneRadiance->size());
+    std::vector<glm::vec4> cones(coneRadiance.size());
     for (std::size_t i = 0; i < cones.size(); ++i)
-        cones[i] = glm::vec4((*in.coneRadiance)[i], 0.0f);
+        cones[i] = glm::vec4(coneRadiance[i], 0.0f);
     reserve(mUploadedCones, cones.size() * sizeof(glm::vec4), "voxel_gi.combine.cone_radiance");
     if (!cones.empty())
         mUploadedCones.uploadSpan<glm::vec4>(cones);
-    return combine(context, mUploadedCones, in);
+    return mUploadedCones;
 }
 
 Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffer& coneRadiance,
@@ -178,6 +196,15 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
     for (std::size_t i = 0; i < pixels; ++i)
         out.pixels[i] = glm::vec3(e[i]);
     return out;
+}
+
+bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu, std::string_view setting)
+{
+    if (context == nullptr || setting == "cpu")
+        return false;
+    if (setting == "vulkan")
+        return true;
+    return gatheredOnGpu && !context->getDeviceInfo().isCpu;
 }
 
 Image<glm::vec3> gatherConesReducedOnGpu(

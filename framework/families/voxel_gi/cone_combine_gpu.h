@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <string_view>
 
 namespace rtlab::voxelgi {
 
@@ -23,6 +24,10 @@ public:
                              const ConeCombineInputs& in);
     //! The same with in.coneRadiance uploaded first.
     Image<glm::vec3> combine(gpu::Context& context, const ConeCombineInputs& in);
+    //! Uploads cone radiances traced elsewhere (the C++ gather) for combine(context, buffer, in);
+    //! the buffer is valid until the next call.
+    const gpu::Buffer& uploadCones(gpu::Context& context,
+                                   const std::vector<glm::vec3>& coneRadiance);
 
     //! GPU time of the last dispatch, when the device has timestamps.
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
@@ -43,6 +48,14 @@ private:
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;
 };
+
+//! Where a gather's combine runs for `setting` "vulkan", "cpu" or "auto" (without a device, in
+//! C++). "auto": on Vulkan when the cones were traced there and the device is a GPU; in C++ when
+//! they were traced in C++ or the device is a CPU implementation such as lavapipe, where the C++
+//! combine is the faster (at 1280x720 on 2 cores: 78 against 249 ms, and 92 against 805 ms with
+//! 10 capsules; cone_combine_gpu_test's DISABLED_Timing).
+bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu,
+                        std::string_view setting = "auto");
 
 //! gatherConesReduced (upsample.h) with the cones kept on the device: `traceCones(reduced)` runs
 //! a Vulkan pixel cone dispatch without reading back and returns its output buffer

@@ -12,7 +12,10 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 using namespace rtlab;
@@ -217,6 +220,48 @@ TEST(ConeCombineGpu, RefusesVisibilityImagesOfAnotherSize)
         EXPECT_NE(std::string(e.what()).find("visibility image 5 is 20x12, not 40x24"),
                   std::string::npos)
             << e.what();
+    }
+}
+
+// "auto" combines on Vulkan only where the cones were traced there and the device is a GPU.
+TEST(ConeCombineGpu, AutoCombinesOnTheDeviceOnlyForAGpuGather)
+{
+    gpu::Context context;
+    EXPECT_EQ(shouldCombineOnGpu(&context, true), !context.getDeviceInfo().isCpu);
+    EXPECT_FALSE(shouldCombineOnGpu(&context, false));
+    EXPECT_TRUE(shouldCombineOnGpu(&context, false, "vulkan"));
+    EXPECT_FALSE(shouldCombineOnGpu(&context, true, "cpu"));
+    EXPECT_FALSE(shouldCombineOnGpu(nullptr, true, "vulkan"));
+}
+
+// Not a test: the two combines' wall times at 1280x720 with a quarter-resolution trace, with and
+// without capsules, for the choice shouldCombineOnGpu makes (run it with
+// --gtest_also_run_disabled_tests; the medians of three calls, after one).
+TEST(ConeCombineGpu, DISABLED_Timing)
+{
+    for (const bool capsules : {false, true}) {
+        const Inputs in = makeInputs(1280, 720, 4, glm::dvec3(0.0));
+        gpu::Context context;
+        ConeCombineGpu combiner;
+        const ConeCombineInputs c = describe(in, false, capsules);
+        const gpu::Buffer& cones = combiner.uploadCones(context, in.cones);
+        std::vector<double> cpuMs, gpuMs;
+        for (int repeat = 0; repeat < 4; ++repeat) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const Image<glm::vec3> cpu = combineCones(c);
+            const auto t1 = std::chrono::steady_clock::now();
+            const Image<glm::vec3> gpu = combiner.combine(context, cones, c);
+            const auto t2 = std::chrono::steady_clock::now();
+            if (repeat == 0)
+                continue;
+            cpuMs.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+            gpuMs.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
+        }
+        std::sort(cpuMs.begin(), cpuMs.end());
+        std::sort(gpuMs.begin(), gpuMs.end());
+        std::printf("%s: C++ combine %.1f ms, Vulkan combine %.1f ms (%s)\n",
+                    capsules ? "10 capsules" : "no capsules", cpuMs[1], gpuMs[1],
+                    context.getDeviceInfo().name.c_str());
     }
 }
 

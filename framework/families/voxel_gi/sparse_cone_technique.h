@@ -9,8 +9,8 @@
 // Structure: injectLight(scene), getCones(), gatherCones(gbuffer, out), gatherRays(gbuffer, rays,
 // out), getLeaves(), getLeafSize(), getMeanStepsPerCone(), getTopologyBytes(), getPayloadBytes().
 // Gpu: gatherCones(context, structure, gbuffer, out), gatherConesOnDevice(context, structure,
-// gbuffer), getLastGpuMs(), getLastUploadBytes(). On Vulkan the cones stay on the device and the
-// combine runs there too (cone_combine_gpu.h).
+// gbuffer), getLastGpuMs(), getLastUploadBytes(). On a GPU the cones stay on the device and the
+// combine runs there too (cone_combine_gpu.h shouldCombineOnGpu).
 
 #include "families/voxel_gi/cone_combine_gpu.h"
 #include "families/voxel_gi/sparse_cone_params.h"
@@ -70,7 +70,8 @@ public:
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
         mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
-        if (mGatheredOnGpu) {
+        mCombinedOnGpu = shouldCombineOnGpu(input.gpu, mGatheredOnGpu);
+        if (mCombinedOnGpu) {
             irradiance = gatherConesReducedOnGpu(
                 *input.gpu, mCombineGpu, *input.gbuffer, mParams.traceStep,
                 mStructure->getCones().halfAngle, input.coneVisibility, input.capsules,
@@ -84,7 +85,10 @@ public:
             *input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
             input.coneVisibility, input.capsules,
             [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                mStructure->gatherCones(reduced, cones);
+                if (mGatheredOnGpu)
+                    mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
+                else
+                    mStructure->gatherCones(reduced, cones);
             },
             &mCombineMs);
     }
@@ -118,11 +122,12 @@ public:
              mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
             {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
             {"combine_ms", mCombineMs},
-            {"combine_gpu_ms", mGatheredOnGpu && mCombineGpu.getLastGpuMs()
+            {"combine_on_gpu", mCombinedOnGpu ? 1.0 : 0.0},
+            {"combine_gpu_ms", mCombinedOnGpu && mCombineGpu.getLastGpuMs()
                                    ? *mCombineGpu.getLastGpuMs()
                                    : std::nan("")},
             {"combine_upload_bytes",
-             mGatheredOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0}};
+             mCombinedOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0}};
         for (auto& extra : structureCounters())
             c.push_back(std::move(extra));
         return c;
@@ -147,6 +152,7 @@ private:
     std::string mGeometryKey, mLightsKey;
     bool mBuilt = false;
     bool mGatheredOnGpu = false;
+    bool mCombinedOnGpu = false;
     double mCombineMs = std::nan(""); // the gather beyond its cones: reduction and combine
 };
 

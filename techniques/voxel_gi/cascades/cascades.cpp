@@ -34,7 +34,10 @@
 //    with optional pre-combined direction buffers. At full resolution each cone's radiance is
 //    upsampled by depth and normal and multiplied by the pixel's per-direction visibilities of
 //    bentcone_ssdo (when that occlusion technique runs in the same frame) and by the characters'
-//    capsules tested against the cone ("Characters": not voxelized; families/voxel_gi/upsample.h).
+//    capsules tested against the cone ("Characters": not voxelized; families/voxel_gi/upsample.h),
+//    on Vulkan when the gather runs there on a GPU, else in C++, or where `combine_device`
+//    says (Vulkan: cone_combine_gpu.h, the cones of a Vulkan gather read where they are, only
+//    the irradiance read back).
 //
 // The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; so
 // do the cones of light injection (shaders/cascade_inject.comp, `inject_device: vulkan`: the 16
@@ -63,22 +66,23 @@
 // | levels         | int   | 6                 | [1, 10]                               |        |
 // | resolution     | int   | 32                | [4, 128], even                        | voxels |
 // | voxel_size     | float | 0 (auto)          | [0, 1e6]                              | world  |
-// | supersampling  | int   | 4                 | [1, 16]                               | rays per voxel side |
-// | bounces        | int   | 2                 | [1, 3]                                |        |
-// | schedule       | enum  | three_pass        | three_pass, one_pass                  |        |
-// | update         | enum  | one_level_per_frame | one_level_per_frame, all_levels     |        |
-// | cone_angle     | float | 29                | [5, 60]                               | degrees (half-angle) |
-// | start_offset   | float | 1                 | [0, 4]                                | voxels |
-// | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
-// | precombine     | bool  | true              |                                       |        |
-// | solid          | bool  | true              |                                       |        |
-// | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
-// | inject_device  | enum  | cpu               | cpu, vulkan (light injection's cones) |        |
-// | voxelize_device| enum  | cpu               | cpu, vulkan (resolution <= 128)       |        |
-// | trace_step     | int   | 4                 | [1, 8]                                | pixels |
-// | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]               | voxels of the pixel's start level |
-// | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
-// | level_noise    | float | 0                 | [0, 0.5]                              | of a level's radius |
+// | supersampling  | int   | 4                 | [1, 16]                               | rays per
+// voxel side | | bounces        | int   | 2                 | [1, 3] |        | | schedule       |
+// enum  | three_pass        | three_pass, one_pass                  |        | | update         |
+// enum  | one_level_per_frame | one_level_per_frame, all_levels     |        | | cone_angle     |
+// float | 29                | [5, 60]                               | degrees (half-angle) | |
+// start_offset   | float | 1                 | [0, 4]                                | voxels | |
+// step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel
+// size sampled | | precombine     | bool  | true              | |        | | solid          | bool
+// | true              |                                       |        | | device         | enum  |
+// vulkan            | vulkan, cpu (pixel gather)            |        | | combine_device | enum  |
+// auto              | auto, vulkan, cpu (full-resolution combine) |  | | inject_device  | enum  |
+// cpu               | cpu, vulkan (light injection's cones) |        | | voxelize_device| enum  |
+// cpu               | cpu, vulkan (resolution <= 128)       |        | | trace_step     | int   | 4
+// | [1, 8]                                | pixels | | far_start      | float | 0 (whole cones)   |
+// 0 or [start_offset, 64]               | voxels of the pixel's start level | | extrapolate    |
+// bool  | false             | needs bounces >= 2                    |        | | level_noise    |
+// float | 0                 | [0, 0.5]                              | of a level's radius |
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
 // The talk's split is "about a meter" at its 0.4 m finest voxels: far_start about 2.5.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
@@ -155,6 +159,10 @@ public:
                         "transition between levels)");
         schema.addEnum("device", "vulkan", {"vulkan", "cpu"},
                        "where the pixel gather runs (Vulkan needs precombine)");
+        schema.addEnum("combine_device", "auto", {"auto", "vulkan", "cpu"},
+                       "where the full-resolution combine runs (upsampling, visibilities, "
+                       "capsules); auto: on Vulkan when the pixel gather runs there on a GPU "
+                       "(its cones staying on the device), else in C++");
         schema.addEnum("inject_device", "cpu", {"cpu", "vulkan"},
                        "where light injection traces the surface voxels' cones (the light "
                        "buffers stay on the CPU)");
@@ -183,6 +191,7 @@ public:
         mSettings.solid = p.getBool("solid");
         mOnGpu = p.getString("device") == "vulkan";
         mInjectOnGpu = p.getString("inject_device") == "vulkan";
+        mCombineDevice = p.getString("combine_device");
         mVoxelizeOnGpu = p.getString("voxelize_device") == "vulkan";
         mTraceStep = int(p.getInt("trace_step"));
         mSettings.farStart = p.getFloat("far_start");
@@ -214,6 +223,7 @@ public:
         p.set("solid", mSettings.solid);
         p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
         p.set("inject_device", std::string(mInjectOnGpu ? "vulkan" : "cpu"));
+        p.set("combine_device", mCombineDevice);
         p.set("voxelize_device", std::string(mVoxelizeOnGpu ? "vulkan" : "cpu"));
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("far_start", mSettings.farStart);
@@ -289,18 +299,29 @@ public:
         // each cone's radiance upsampled by depth and normal, times the pixel's own visibilities
         // (bent-cone SSDO) and the characters' capsules.
         mGatheredOnGpu = mOnGpu && mSettings.precombine && input.gpu != nullptr;
-        if (mGatheredOnGpu) {
-            // The cones stay on the device and the combine runs there (cone_combine_gpu.h).
+        mCombinedOnGpu = voxelgi::shouldCombineOnGpu(input.gpu, mGatheredOnGpu, mCombineDevice);
+        // The Vulkan gather's cones: the far cones first with split cones (on Vulkan too).
+        const auto prepareGpuCones = [&](const scene::GBuffer& reduced) {
+            if (mSettings.farStart > 0.0)
+                mVolume->prepareFarCones(
+                    reduced, [&](const std::vector<std::pair<int, std::uint32_t>>& centres,
+                                 std::vector<glm::vec3>& far) {
+                        mGpu.traceFarCones(*input.gpu, *mVolume, centres, far);
+                    });
+        };
+        if (mCombinedOnGpu) {
+            // The combine on Vulkan (cone_combine_gpu.h): the cones of the Vulkan gather stay on
+            // the device, those of the C++ gather go up.
             irradiance = voxelgi::gatherConesReducedOnGpu(
                 *input.gpu, mCombineGpu, *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle,
                 input.coneVisibility, input.capsules,
                 [&](const scene::GBuffer& reduced) -> const gpu::Buffer& {
-                    if (mSettings.farStart > 0.0) // the far cones, on Vulkan too
-                        mVolume->prepareFarCones(
-                            reduced, [&](const std::vector<std::pair<int, std::uint32_t>>& centres,
-                                         std::vector<glm::vec3>& far) {
-                                mGpu.traceFarCones(*input.gpu, *mVolume, centres, far);
-                            });
+                    if (!mGatheredOnGpu) {
+                        std::vector<glm::vec3> cones;
+                        mVolume->gatherCones(reduced, cones);
+                        return mCombineGpu.uploadCones(*input.gpu, cones);
+                    }
+                    prepareGpuCones(reduced);
                     return mGpu.gatherConesOnDevice(*input.gpu, *mVolume, reduced);
                 },
                 &mCombineMs);
@@ -310,7 +331,12 @@ public:
             *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
             input.capsules,
             [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                mVolume->gatherCones(reduced, cones);
+                if (mGatheredOnGpu) {
+                    prepareGpuCones(reduced);
+                    mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
+                } else {
+                    mVolume->gatherCones(reduced, cones);
+                }
             },
             &mCombineMs);
     }
@@ -361,11 +387,12 @@ public:
                  mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
                 {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
                 {"combine_ms", mCombineMs},
-                {"combine_gpu_ms", mGatheredOnGpu && mCombineGpu.getLastGpuMs()
+                {"combine_on_gpu", mCombinedOnGpu ? 1.0 : 0.0},
+                {"combine_gpu_ms", mCombinedOnGpu && mCombineGpu.getLastGpuMs()
                                        ? *mCombineGpu.getLastGpuMs()
                                        : std::nan("")},
                 {"combine_upload_bytes",
-                 mGatheredOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0},
+                 mCombinedOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0},
                 {"far_cones_traced", double(c.farConesTraced)},
                 {"far_cones_ms", c.farConesMs},
                 {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
@@ -402,6 +429,8 @@ private:
     bool mVoxelizeOnGpu = false;
     bool mVoxelizedOnGpu = false;
     bool mOnGpu = true;
+    std::string mCombineDevice = "auto";
+    bool mCombinedOnGpu = false;
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;
     bool mGatheredOnGpu = false;

@@ -1,4 +1,5 @@
 #version 450
+#extension GL_EXT_control_flow_attributes : require
 // The final combine of a cone-traced gather on Vulkan, per full-resolution pixel: the 16 cone
 // radiances of the reduced pixels around it upsampled with depth- and normal-aware weights (joint
 // bilateral upsampling, Kopf et al. 2007), times the occlusion family's 16 visibilities and the
@@ -24,7 +25,10 @@ layout(std430, binding = 6) readonly buffer VisibilityBuffer { float visibility[
 // Per capsule, 4 vec4, relative to the anchor: (a, radius), (b - a, 1 / |b - a|^2 or 0),
 // (centre of the segment, radius of the sphere around the capsule), (near^2, reach^2, 0, 0).
 layout(std430, binding = 7) readonly buffer CapsuleBuffer { vec4 capsules[]; };
-layout(std430, binding = 8) readonly buffer DirectionBuffer { vec4 cones[16]; };
+layout(std430, binding = 8) readonly buffer DirectionBuffer { vec4 coneBuffer[16]; };
+// The 16 directions as constants (scene/sky.h getConeDirections, defined by the caller), so that
+// the unrolled loops over the cones read immediates rather than memory.
+const vec3 kCones[16] = vec3[16](CONE_DIRECTIONS);
 layout(std430, binding = 9) writeonly buffer OutputBuffer { vec4 irradiance[]; }; // [full pixel]
 
 layout(push_constant) uniform Constants {
@@ -60,8 +64,10 @@ float similarity(int s, vec3 p, vec3 n, float d)
 }
 
 // upsample.cpp findUpsampleSamples: the four low-resolution samples around the pixel, bilinear
-// times similarity; when all four fail, the most similar of the 3 x 3 around.
-int findSamples(int x, int y, vec3 p, vec3 n, float d, out ivec4 samples, out vec4 weights)
+// times similarity; when all four fail, the most similar of the 3 x 3 around. Unused slots get
+// weight 0 (and sample 0), so that callers sum all four without indexing by a count. Returns
+// false for no sample.
+bool findSamples(int x, int y, vec3 p, vec3 n, float d, out ivec4 samples, out vec4 weights)
 {
     samples = ivec4(0);
     weights = vec4(0.0);
@@ -70,29 +76,22 @@ int findSamples(int x, int y, vec3 p, vec3 n, float d, out ivec4 samples, out ve
     if (f == 1) {
         samples.x = y * lw + x;
         weights.x = 1.0;
-        return 1;
+        return true;
     }
     const float u = (float(x) + 0.5) / float(f) - 0.5, v = (float(y) + 0.5) / float(f) - 0.5;
     const int i0 = int(floor(u)), j0 = int(floor(v));
     const float fu = u - float(i0), fv = v - float(j0);
-    int count = 0;
-    float total = 0.0;
-    for (int dj = 0; dj <= 1; ++dj)
-        for (int di = 0; di <= 1; ++di) {
-            const int i = clamp(i0 + di, 0, lw - 1), j = clamp(j0 + dj, 0, lh - 1);
-            const float bilinear = (di == 1 ? fu : 1.0 - fu) * (dj == 1 ? fv : 1.0 - fv);
-            const int s = j * lw + i;
-            const float w = bilinear * similarity(s, p, n, d);
-            if (w <= 0.0)
-                continue;
-            samples[count] = s;
-            weights[count] = w;
-            total += w;
-            ++count;
-        }
+    const int ia = clamp(i0, 0, lw - 1), ib = clamp(i0 + 1, 0, lw - 1);
+    const int ja = clamp(j0, 0, lh - 1), jb = clamp(j0 + 1, 0, lh - 1);
+    samples = ivec4(ja * lw + ia, ja * lw + ib, jb * lw + ia, jb * lw + ib);
+    weights = vec4((1.0 - fu) * (1.0 - fv), fu * (1.0 - fv), (1.0 - fu) * fv, fu * fv) *
+              vec4(similarity(samples.x, p, n, d), similarity(samples.y, p, n, d), similarity(samples.z, p, n, d),
+                   similarity(samples.w, p, n, d));
+    weights = max(weights, vec4(0.0));
+    const float total = weights.x + weights.y + weights.z + weights.w;
     if (total > 1e-6) {
         weights /= total;
-        return count;
+        return true;
     }
     const int ci = clamp(x / f, 0, lw - 1), cj = clamp(y / f, 0, lh - 1);
     float best = -1.0;
@@ -108,11 +107,9 @@ int findSamples(int x, int y, vec3 p, vec3 n, float d, out ivec4 samples, out ve
                 bestSample = s;
             }
         }
-    if (bestSample < 0)
-        return 0;
-    samples.x = bestSample;
-    weights = vec4(1.0, 0.0, 0.0, 0.0);
-    return 1;
+    samples = ivec4(max(bestSample, 0), 0, 0, 0);
+    weights = vec4(bestSample >= 0 ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+    return bestSample >= 0;
 }
 
 // atan2(y, x) for y >= 0 in [0, pi], to a few float ulps. Vulkan lets the built-in atan, asin
@@ -207,19 +204,21 @@ void main()
     const float d = isinf(depth) || isnan(depth) ? 1.0 : depth;
     ivec4 samples;
     vec4 weights;
-    const int count = findSamples(x, y, p, n, d, samples, weights);
-    if (count == 0 || dot(n, n) < 0.5)
+    if (!findSamples(x, y, p, n, d, samples, weights) || dot(n, n) < 0.5)
         return;
-    // cone_tracing.cpp computeIrradianceWeights: the clamped cosines, scaled to sum to pi.
+    // cone_tracing.cpp computeIrradianceWeights: the clamped cosines, scaled to sum to pi. The
+    // loops over the 16 cones are unrolled so that their arrays stay in registers.
     float coneWeight[16];
-    float sum = 0.0;
-    for (int k = 0; k < 16; ++k) {
-        coneWeight[k] = max(0.0, dot(cones[k].xyz, n));
-        sum += coneWeight[k];
-    }
     float visible[16];
-    for (int k = 0; k < 16; ++k)
-        visible[k] = pc.flags.z != 0 ? clamp(visibility[k * w * h + pixel], 0.0, 1.0) : 1.0;
+    float sum = 0.0;
+    [[unroll]] for (int k = 0; k < 16; ++k) {
+        coneWeight[k] = max(0.0, dot(kCones[k], n));
+        sum += coneWeight[k];
+        visible[k] = 1.0;
+    }
+    if (pc.flags.z != 0)
+        [[unroll]] for (int k = 0; k < 16; ++k)
+            visible[k] = clamp(visibility[k * w * h + pixel], 0.0, 1.0);
     // The capsules in order (as the C++ combine multiplies them per cone): those within 40 radii
     // of the pixel, and in them the cones that can reach the sphere around the capsule.
     for (int c = 0; c < pc.flags.y; ++c) {
@@ -241,21 +240,20 @@ void main()
             towardCentre = toCentre / distance;
             cosLimit = pc.angle.y * cosB - pc.angle.z * sinB;
         }
-        for (int k = 0; k < 16; ++k) {
-            if (coneWeight[k] == 0.0 || dot(towardCentre, cones[k].xyz) < cosLimit - 1e-5)
-                continue;
-            visible[k] *= 1.0 - occludeCone(p, cones[k].xyz, c);
-        }
+        [[unroll]] for (int k = 0; k < 16; ++k)
+            if (coneWeight[k] > 0.0 && dot(towardCentre, kCones[k]) >= cosLimit - 1e-5)
+                visible[k] *= 1.0 - occludeCone(p, kCones[k], c);
     }
     vec3 e = vec3(0.0);
-    if (sum > 0.0)
-        for (int k = 0; k < 16; ++k) {
-            if (coneWeight[k] == 0.0)
-                continue;
-            vec3 radiance = vec3(0.0);
-            for (int s = 0; s < count; ++s)
-                radiance += weights[s] * coneRadiance[samples[s] * 16 + k].rgb;
-            e += (coneWeight[k] * 3.14159265358979 / sum) * visible[k] * radiance;
-        }
+    const float scale = sum > 0.0 ? 3.14159265358979 / sum : 0.0;
+    [[unroll]] for (int k = 0; k < 16; ++k) {
+        if (coneWeight[k] == 0.0)
+            continue;
+        const vec3 radiance = weights.x * coneRadiance[samples.x * 16 + k].rgb +
+                              weights.y * coneRadiance[samples.y * 16 + k].rgb +
+                              weights.z * coneRadiance[samples.z * 16 + k].rgb +
+                              weights.w * coneRadiance[samples.w * 16 + k].rgb;
+        e += (coneWeight[k] * scale) * visible[k] * radiance;
+    }
     irradiance[pixel] = vec4(max(e, vec3(0.0)), 0.0);
 }
