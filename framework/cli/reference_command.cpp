@@ -89,6 +89,11 @@ int referenceCommand(const ReferenceOptions& options)
             fmt::print("  raw rtcIntersect1    {:8.2f} Mrays/s  (reference / raw = {:.2f})\n",
                        t.rawIntersectMraysPerSecond, t.referenceMraysPerSecond / t.rawIntersectMraysPerSecond);
             fmt::print("  raw rtcOccluded1     {:8.2f} Mrays/s\n", t.rawOccludedMraysPerSecond);
+            fmt::print("  raw replay           {:8.2f} Mrays/s  (reference / replay = {:.2f}; the "
+                       "estimator's own "
+                       "{:.3g} M rays through the bare calls it made)\n",
+                       t.replayMraysPerSecond, t.referenceMraysPerSecond / t.replayMraysPerSecond,
+                       double(t.replayRays) * 1e-6);
         }
         return kExitOk;
     } catch (const InputError& e) {

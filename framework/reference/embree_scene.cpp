@@ -157,6 +157,8 @@ bool EmbreeScene::intersect(const glm::vec3& org, const glm::vec3& dir, float tF
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    if (mLog != nullptr)
+        mLog->local().push_back({rh.ray, true});
     rtcIntersect1(mScene, &context, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return false;
@@ -173,6 +175,8 @@ bool EmbreeScene::occluded(const glm::vec3& org, const glm::vec3& dir, float tFa
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     RTCRay ray = makeRay(org, dir, tFar);
+    if (mLog != nullptr)
+        mLog->local().push_back({ray, false});
     rtcOccluded1(mScene, &context, &ray);
     // Embree sets tfar to -inf when the ray is occluded.
     return ray.tfar < 0.0f;
@@ -183,6 +187,9 @@ void EmbreeScene::occluded(RTCRay* rays, unsigned count, bool coherent) const
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
     context.flags = coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    if (mLog != nullptr)
+        for (unsigned i = 0; i < count; ++i)
+            mLog->local().push_back({rays[i], false});
     rtcOccluded1M(mScene, &context, rays, count, sizeof(RTCRay));
 }
 

@@ -7,8 +7,11 @@
 #include <embree3/rtcore.h>
 #include <glm/vec3.hpp>
 
+#include <tbb/enumerable_thread_specific.h>
+
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 namespace rtlab::reference {
 
@@ -19,6 +22,14 @@ struct RayHit {
     float v = 0.0f;                  //!< barycentric of vertex 2
     glm::vec3 geometricNormal{0.0f}; //!< unnormalised, Embree's orientation
 };
+
+//! A ray as an estimator traced it: the query (closest hit or occlusion) and the ray.
+struct LoggedRay {
+    RTCRay ray;
+    bool closest = false;
+};
+//! The rays each thread traced, in its order (EmbreeScene::setRayLog).
+using RayLog = tbb::enumerable_thread_specific<std::vector<LoggedRay>>;
 
 class EmbreeScene {
 public:
@@ -34,9 +45,14 @@ public:
     bool intersect(const glm::vec3& org, const glm::vec3& dir, float tFar, RayHit& hit) const;
     //! Whether anything lies along org + t dir, 0 <= t <= tFar.
     bool occluded(const glm::vec3& org, const glm::vec3& dir, float tFar) const;
-    //! The same for a stream of rays (rtcOccluded1M), traced together: `coherent` when they
-    //! share an origin (Embree then traces them as packets). An occluded ray's tfar becomes -inf.
+    //! The same for a stream of rays (rtcOccluded1M), traced together: `coherent` makes Embree
+    //! trace them as packets, which suits rays that stay together (not a hemisphere's). An
+    //! occluded ray's tfar becomes -inf.
     void occluded(RTCRay* rays, unsigned count, bool coherent) const;
+    //! While `log` is set, every ray traced through this scene is appended to the calling
+    //! thread's list in `log` (measureRayThroughput replays them through bare Embree calls);
+    //! nullptr stops logging.
+    void setRayLog(RayLog* log) const { mLog = log; }
 
     RTCScene getHandle() const { return mScene; }
     //! Length of the diagonal of the triangles' bounding box.
@@ -48,6 +64,7 @@ private:
     RTCDevice mDevice = nullptr;
     RTCScene mScene = nullptr;
     double mSceneScale = 0.0;
+    mutable RayLog* mLog = nullptr;
 };
 
 //! The largest float tFar Embree accepts as "no limit".

@@ -139,11 +139,11 @@ glm::dvec3 LightPathTracer::estimateDirect(int vertex, const Vertex& v)
         const glm::dvec3 w = mLights.skyLobes.sample(get2D(vertex, kPairSky));
         const double cosSurface = glm::dot(w, v.shadingNormal);
         if (cosSurface > 0.0 && glm::dot(w, v.geometricNormal) > 0.0) {
-            const double pdfSky = mLights.skyLobes.pdf(w);
+            glm::dvec3 radiance;
+            const double pdfSky = mLights.skyLobes.evaluate(w, mLights.getSky(), radiance);
             const double weight = balanceHeuristic(pdfSky, cosSurface / kPi);
             if (pdfSky > 0.0 && isVisible(v.origin, w, std::numeric_limits<double>::infinity()))
-                sum += glm::dvec3(mLights.getSky().radiance(w)) *
-                       (cosSurface / (kPi * pdfSky) * weight);
+                sum += radiance * (cosSurface / (kPi * pdfSky) * weight);
         }
     }
     return sum;
@@ -187,10 +187,13 @@ glm::dvec3 LightPathTracer::trace(const SurfacePoint& point)
         RayHit hit;
         if (!mEmbree.intersect(v.origin, glm::vec3(w), kInfiniteDistance, hit)) {
             if (record) {
-                const double weight = mLights.skyLobes.active()
-                                          ? balanceHeuristic(pdfBsdf, mLights.skyLobes.pdf(w))
-                                          : 1.0;
-                sum += throughput * glm::dvec3(mLights.getSky().radiance(w)) * weight;
+                if (mLights.skyLobes.active()) {
+                    glm::dvec3 radiance;
+                    const double pdfSky = mLights.skyLobes.evaluate(w, mLights.getSky(), radiance);
+                    sum += throughput * radiance * balanceHeuristic(pdfBsdf, pdfSky);
+                } else {
+                    sum += throughput * glm::dvec3(mLights.getSky().radiance(w));
+                }
             }
             break;
         }

@@ -184,19 +184,26 @@ struct RayThroughput {
     double referenceMraysPerSecond = 0.0;    //!< computeReference's estimator, everything included
     double rawIntersectMraysPerSecond = 0.0; //!< rtcIntersect1 alone on the same rays
     double rawOccludedMraysPerSecond = 0.0;  //!< rtcOccluded1 alone on the same rays
+    //! The estimator's own rays (logged in an untimed round: its paths' bounces, shadow rays,
+    //! streams), each through the bare call it was traced with (rtcIntersect1 or rtcOccluded1).
+    double replayMraysPerSecond = 0.0;
     std::uint64_t referenceRays = 0;
     std::uint64_t rawRays = 0;
+    std::uint64_t replayRays = 0;
     double referenceSeconds = 0.0;
     double rawIntersectSeconds = 0.0;
     double rawOccludedSeconds = 0.0;
+    double replaySeconds = 0.0;
     int threads = 0;
     int repeats = 0; //!< timed rounds; each figure is the median over them
 };
 
 //! Traces samplesPerPixel samples of settings.quantity per surface pixel (no cache, no early
 //! stop) and, in the same run on the same scene and thread count, the same number of cosine-
-//! distributed rays from the same origins through bare rtcIntersect1 and rtcOccluded1 calls.
-//! After one untimed round of each, `repeats` rounds alternate the three; medians are reported.
+//! distributed rays from the same origins through bare rtcIntersect1 and rtcOccluded1 calls, and
+//! the estimator's own rays (its bounces and shadow rays, logged in an untimed round) through the
+//! bare calls it made. After one untimed round of each, `repeats` rounds alternate the four;
+//! medians are reported.
 RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,
                                    const ReferenceSettings& settings, int samplesPerPixel,
                                    int repeats = 5);

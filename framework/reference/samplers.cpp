@@ -204,10 +204,14 @@ SkyLobeSampler::SkyLobeSampler(const scene::Sky& sky)
     for (const auto& peak : sky.lobes)
         weights.push_back(std::max(0.0, computeLuminance(glm::dvec3(peak))) * integral);
     mLobes = DiscreteDistribution(weights);
-    for (const auto& axis : scene::getConeDirections())
+    for (const auto& axis : scene::getConeDirections()) {
         mFrames.push_back(Frame::fromNormal(glm::normalize(axis)));
-    if (mLobes.empty())
+        mAxes.push_back(axis);
+    }
+    if (mLobes.empty()) {
         mFrames.clear();
+        mAxes.clear();
+    }
 }
 
 glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
@@ -215,6 +219,24 @@ glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
     double ux = 0.0;
     const std::size_t lobe = mLobes.sample(u.x, &ux);
     return glm::normalize(mFrames[lobe].toWorld(sampleSphericalGaussian({ux, u.y}, mSharpness, mExpm1)));
+}
+
+double SkyLobeSampler::evaluate(const glm::dvec3& direction, const scene::Sky& sky,
+                                glm::dvec3& radiance) const
+{
+    // The exponentials as scene::Sky::radiance takes them (its axes, its sharpness), so that the
+    // radiance keeps its bits; the pdf's axes agree with the normalised frames' to an ulp.
+    double p = 0.0;
+    glm::dvec3 sum(0.0);
+    const double k = double(sky.sharpness);
+    for (std::size_t i = 0; i < mAxes.size(); ++i) {
+        const double e = std::exp(k * (glm::dot(direction, mAxes[i]) - 1.0));
+        sum += glm::dvec3(sky.lobes[i]) * e;
+        if (mLobes.pmf(i) > 0.0)
+            p += mLobes.pmf(i) * (mNormalise * e);
+    }
+    radiance = glm::dvec3(glm::vec3(sum));
+    return p;
 }
 
 double SkyLobeSampler::pdf(const glm::dvec3& direction) const

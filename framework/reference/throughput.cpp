@@ -95,13 +95,45 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         // One untimed round wakes the arena's threads and warms the caches for all three; then
         // the three alternate, and each keeps its median (a 16-sample run lasts tens of ms,
         // where one thread start-up or preemption would decide the ratio).
+        // The estimator's own rays: logged per thread in one untimed round, then traced in the
+        // same per-thread order and chunks through the bare call each was made with.
+        RayLog log;
+        prepared.getEmbree().setRayLog(&log);
         traceReference();
+        prepared.getEmbree().setRayLog(nullptr);
+        std::vector<LoggedRay> logged;
+        for (const std::vector<LoggedRay>& rays : log)
+            logged.insert(logged.end(), rays.begin(), rays.end());
+        log.clear();
+        result.replayRays = logged.size();
+        std::vector<RTCRayHit> replayWork(logged.size());
+        const auto traceReplay = [&] {
+            for (std::size_t i = 0; i < logged.size(); ++i) {
+                replayWork[i].ray = logged[i].ray;
+                replayWork[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+                replayWork[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+            }
+            const auto start = std::chrono::steady_clock::now();
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, replayWork.size(), 1024),
+                              [&](const tbb::blocked_range<std::size_t>& r) {
+                                  RTCIntersectContext context;
+                                  rtcInitIntersectContext(&context);
+                                  for (std::size_t i = r.begin(); i != r.end(); ++i)
+                                      if (logged[i].closest)
+                                          rtcIntersect1(handle, &context, &replayWork[i]);
+                                      else
+                                          rtcOccluded1(handle, &context, &replayWork[i].ray);
+                              });
+            return getSecondsSince(start);
+        };
         traceRaw(true);
-        std::vector<double> reference, intersect, occluded;
+        traceReplay();
+        std::vector<double> reference, intersect, occluded, replay;
         for (int r = 0; r < std::max(1, repeats); ++r) {
             reference.push_back(traceReference());
             intersect.push_back(traceRaw(true));
             occluded.push_back(traceRaw(false));
+            replay.push_back(traceReplay());
         }
         const auto median = [](std::vector<double> v) {
             std::sort(v.begin(), v.end());
@@ -110,6 +142,7 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         result.referenceSeconds = median(reference);
         result.rawIntersectSeconds = median(intersect);
         result.rawOccludedSeconds = median(occluded);
+        result.replaySeconds = median(replay);
         result.repeats = int(reference.size());
     });
     auto rate = [](std::uint64_t rays, double seconds) {
@@ -118,6 +151,7 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
     result.referenceMraysPerSecond = rate(result.referenceRays, result.referenceSeconds);
     result.rawIntersectMraysPerSecond = rate(result.rawRays, result.rawIntersectSeconds);
     result.rawOccludedMraysPerSecond = rate(result.rawRays, result.rawOccludedSeconds);
+    result.replayMraysPerSecond = rate(result.replayRays, result.replaySeconds);
     return result;
 }
 

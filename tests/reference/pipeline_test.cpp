@@ -362,6 +362,21 @@ TEST(ReferencePipeline, ThroughputReportsBothRates)
     EXPECT_GT(t.referenceMraysPerSecond, 0.0);
     EXPECT_GT(t.rawIntersectMraysPerSecond, 0.0);
     EXPECT_GT(t.rawOccludedMraysPerSecond, 0.0);
+    // The replay traces every ray the estimator traced, once.
+    EXPECT_EQ(t.replayRays, t.referenceRays);
+    EXPECT_GT(t.replayMraysPerSecond, 0.0);
+}
+
+// For a path-traced quantity the estimator's rays (bounces, shadow rays to the lights, sky
+// samples) are what the replay traces: as many as the estimator counts, more than one per sample.
+TEST(ReferencePipeline, ThroughputReplaysTheEstimatorsOwnRays)
+{
+    const Room room;
+    ReferenceSettings s = makeQuickSettings(Quantity::Full);
+    const RayThroughput t = measureRayThroughput(room.scene, room.gbuffer, s, 4, 1);
+    EXPECT_EQ(t.replayRays, t.referenceRays);
+    EXPECT_GT(t.replayRays, t.rawRays);
+    EXPECT_GT(t.replayMraysPerSecond, 0.0);
 }
 
 } // namespace
