@@ -22,6 +22,25 @@ double getSecondsSince(std::chrono::steady_clock::time_point start)
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// Bare Embree calls over `work` in chunks of 1024 on the arena's threads: rtcIntersect1 where
+// closest(i), else rtcOccluded1. Returns the seconds.
+template <class Closest>
+double traceBare(RTCScene handle, std::vector<RTCRayHit>& work, const Closest& closest)
+{
+    const auto start = std::chrono::steady_clock::now();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
+                      [&](const tbb::blocked_range<std::size_t>& r) {
+                          RTCIntersectContext context;
+                          rtcInitIntersectContext(&context);
+                          for (std::size_t i = r.begin(); i != r.end(); ++i)
+                              if (closest(i))
+                                  rtcIntersect1(handle, &context, &work[i]);
+                              else
+                                  rtcOccluded1(handle, &context, &work[i].ray);
+                      });
+    return getSecondsSince(start);
+}
+
 } // namespace
 
 RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene::GBuffer& gbuffer,
@@ -79,22 +98,8 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         std::vector<RTCRayHit> work;
         const auto traceRaw = [&](bool closest) {
             work = rays;
-            const auto start = std::chrono::steady_clock::now();
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, work.size(), 1024),
-                              [&](const tbb::blocked_range<std::size_t>& r) {
-                                  RTCIntersectContext context;
-                                  rtcInitIntersectContext(&context);
-                                  for (std::size_t i = r.begin(); i != r.end(); ++i)
-                                      if (closest)
-                                          rtcIntersect1(handle, &context, &work[i]);
-                                      else
-                                          rtcOccluded1(handle, &context, &work[i].ray);
-                              });
-            return getSecondsSince(start);
+            return traceBare(handle, work, [closest](std::size_t) { return closest; });
         };
-        // One untimed round wakes the arena's threads and warms the caches for all three; then
-        // the three alternate, and each keeps its median (a 16-sample run lasts tens of ms,
-        // where one thread start-up or preemption would decide the ratio).
         // The estimator's own rays: logged per thread in one untimed round, then traced in the
         // same per-thread order and chunks through the bare call each was made with.
         RayLog log;
@@ -102,8 +107,8 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         traceReference();
         prepared.getEmbree().setRayLog(nullptr);
         std::vector<LoggedRay> logged;
-        for (const std::vector<LoggedRay>& rays : log)
-            logged.insert(logged.end(), rays.begin(), rays.end());
+        for (const std::vector<LoggedRay>& threadRays : log)
+            logged.insert(logged.end(), threadRays.begin(), threadRays.end());
         log.clear();
         result.replayRays = logged.size();
         std::vector<RTCRayHit> replayWork(logged.size());
@@ -113,19 +118,12 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
                 replayWork[i].hit.geomID = RTC_INVALID_GEOMETRY_ID;
                 replayWork[i].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
             }
-            const auto start = std::chrono::steady_clock::now();
-            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, replayWork.size(), 1024),
-                              [&](const tbb::blocked_range<std::size_t>& r) {
-                                  RTCIntersectContext context;
-                                  rtcInitIntersectContext(&context);
-                                  for (std::size_t i = r.begin(); i != r.end(); ++i)
-                                      if (logged[i].closest)
-                                          rtcIntersect1(handle, &context, &replayWork[i]);
-                                      else
-                                          rtcOccluded1(handle, &context, &replayWork[i].ray);
-                              });
-            return getSecondsSince(start);
+            return traceBare(handle, replayWork, [&](std::size_t i) { return logged[i].closest; });
         };
+        // One untimed round wakes the arena's threads and warms the caches for all four (the
+        // estimator's was the logged round); then the four alternate, and each keeps its median
+        // (a 16-sample run lasts tens of ms, where one thread start-up or preemption would decide
+        // the ratio).
         traceRaw(true);
         traceReplay();
         std::vector<double> reference, intersect, occluded, replay;

@@ -207,6 +207,23 @@ bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu, std::st
     return gatheredOnGpu && !context->getDeviceInfo().isCpu;
 }
 
+void appendGatherCounters(std::vector<std::pair<std::string, double>>& counters, bool gatheredOnGpu,
+                          std::optional<double> gatherGpuMs, std::size_t gatherUploadBytes,
+                          double combineMs, bool combinedOnGpu, const ConeCombineGpu& combiner)
+{
+    const double none = std::nan("");
+    counters.emplace_back("gather_on_gpu", gatheredOnGpu ? 1.0 : 0.0);
+    counters.emplace_back("gather_gpu_ms", gatheredOnGpu && gatherGpuMs ? *gatherGpuMs : none);
+    counters.emplace_back("gather_upload_bytes", gatheredOnGpu ? double(gatherUploadBytes) : 0.0);
+    counters.emplace_back("combine_ms", combineMs);
+    counters.emplace_back("combine_on_gpu", combinedOnGpu ? 1.0 : 0.0);
+    counters.emplace_back("combine_gpu_ms", combinedOnGpu && combiner.getLastGpuMs()
+                                                ? *combiner.getLastGpuMs()
+                                                : none);
+    counters.emplace_back("combine_upload_bytes",
+                          combinedOnGpu ? double(combiner.getLastUploadBytes()) : 0.0);
+}
+
 Image<glm::vec3> gatherConesReducedOnGpu(
     gpu::Context& context, ConeCombineGpu& combiner, const scene::GBuffer& full, int traceStep,
     double coneHalfAngle, const std::vector<Image<float>>* visibility,

@@ -10,7 +10,10 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace rtlab::voxelgi {
 
@@ -56,6 +59,13 @@ private:
 //! 10 capsules; cone_combine_gpu_test's DISABLED_Timing).
 bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu,
                         std::string_view setting = "auto");
+
+//! Appends the counters of a cone-traced gather's two steps, the same in every technique:
+//! gather_on_gpu, gather_gpu_ms, gather_upload_bytes (the cones), combine_ms (the reduction and
+//! the combine, wall time), combine_on_gpu, combine_gpu_ms, combine_upload_bytes.
+void appendGatherCounters(std::vector<std::pair<std::string, double>>& counters, bool gatheredOnGpu,
+                          std::optional<double> gatherGpuMs, std::size_t gatherUploadBytes,
+                          double combineMs, bool combinedOnGpu, const ConeCombineGpu& combiner);
 
 //! gatherConesReduced (upsample.h) with the cones kept on the device: `traceCones(reduced)` runs
 //! a Vulkan pixel cone dispatch without reading back and returns its output buffer

@@ -116,18 +116,9 @@ public:
         std::vector<std::pair<std::string, double>> c = {
             {"voxel_size", mStructure->getLeafSize()},
             {"leaves", double(mStructure->getLeaves().size())},
-            {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mStructure->getMeanStepsPerCone()},
-            {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
-            {"gather_gpu_ms",
-             mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
-            {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
-            {"combine_ms", mCombineMs},
-            {"combine_on_gpu", mCombinedOnGpu ? 1.0 : 0.0},
-            {"combine_gpu_ms", mCombinedOnGpu && mCombineGpu.getLastGpuMs()
-                                   ? *mCombineGpu.getLastGpuMs()
-                                   : std::nan("")},
-            {"combine_upload_bytes",
-             mCombinedOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0}};
+            {"steps_per_cone", mGatheredOnGpu ? std::nan("") : mStructure->getMeanStepsPerCone()}};
+        appendGatherCounters(c, mGatheredOnGpu, mGpu.getLastGpuMs(), mGpu.getLastUploadBytes(),
+                             mCombineMs, mCombinedOnGpu, mCombineGpu);
         for (auto& extra : structureCounters())
             c.push_back(std::move(extra));
         return c;

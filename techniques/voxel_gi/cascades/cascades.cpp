@@ -377,45 +377,36 @@ public:
         std::size_t surface = 0;
         for (int i = 0; i < mVolume->getLevelCount(); ++i)
             surface += mVolume->getLevel(i).grid.surfaceVoxels.size();
-        return {{"voxel_size", mVolume->getSettings().voxelSize},
-                {"levels_voxelized", double(c.levelsVoxelized)},
-                {"levels_lit", double(c.levelsLit)},
-                {"surface_voxels", double(surface)},
-                {"steps_per_cone", mGatheredOnGpu ? std::nan("") : c.meanStepsPerCone},
-                {"gather_on_gpu", mGatheredOnGpu ? 1.0 : 0.0},
-                {"gather_gpu_ms",
-                 mGatheredOnGpu && mGpu.getLastGpuMs() ? *mGpu.getLastGpuMs() : std::nan("")},
-                {"gather_upload_bytes", mGatheredOnGpu ? double(mGpu.getLastUploadBytes()) : 0.0},
-                {"combine_ms", mCombineMs},
-                {"combine_on_gpu", mCombinedOnGpu ? 1.0 : 0.0},
-                {"combine_gpu_ms", mCombinedOnGpu && mCombineGpu.getLastGpuMs()
-                                       ? *mCombineGpu.getLastGpuMs()
-                                       : std::nan("")},
-                {"combine_upload_bytes",
-                 mCombinedOnGpu ? double(mCombineGpu.getLastUploadBytes()) : 0.0},
-                {"far_cones_traced", double(c.farConesTraced)},
-                {"far_cones_ms", c.farConesMs},
-                {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
-                {"far_voxels_cached", double(c.farVoxelsCached)},
-                {"inject_on_gpu", mInjectedOnGpu ? 1.0 : 0.0},
-                {"inject_cones_ms", c.injectConesMs},
-                {"inject_gpu_ms", mInjectedOnGpu && mInjectGpu.getCounters().timed &&
-                                          mInjectGpu.getCounters().dispatches > 0
-                                      ? mInjectGpu.getCounters().gpuMs
-                                      : std::nan("")},
-                {"inject_upload_bytes",
-                 mInjectedOnGpu ? double(mInjectGpu.getCounters().uploadBytes) : 0.0},
-                {"inject_dispatch_ms",
-                 mInjectedOnGpu ? mInjectGpu.getCounters().submitMs : std::nan("")},
-                {"inject_device_call_ms",
-                 mInjectedOnGpu ? mInjectGpu.getCounters().callMs : std::nan("")},
-                {"voxelize_on_gpu", mVoxelizedOnGpu ? 1.0 : 0.0},
-                {"voxelize_dispatch_ms",
-                 mVoxelizedOnGpu ? mVoxelizer.getCounters().submitMs : std::nan("")},
-                {"voxelize_device_call_ms",
-                 mVoxelizedOnGpu ? mVoxelizer.getCounters().callMs : std::nan("")},
-                {"voxelize_fallbacks",
-                 mVoxelizedOnGpu ? double(mVoxelizer.getCounters().fallbacks) : 0.0}};
+        std::vector<std::pair<std::string, double>> counters = {
+            {"voxel_size", mVolume->getSettings().voxelSize},
+            {"levels_voxelized", double(c.levelsVoxelized)},
+            {"levels_lit", double(c.levelsLit)},
+            {"surface_voxels", double(surface)},
+            {"steps_per_cone", mGatheredOnGpu ? std::nan("") : c.meanStepsPerCone}};
+        voxelgi::appendGatherCounters(counters, mGatheredOnGpu, mGpu.getLastGpuMs(),
+                                      mGpu.getLastUploadBytes(), mCombineMs, mCombinedOnGpu,
+                                      mCombineGpu);
+        const auto& inject = mInjectGpu.getCounters();
+        const auto& voxelizer = mVoxelizer.getCounters();
+        counters.insert(
+            counters.end(),
+            {{"far_cones_traced", double(c.farConesTraced)},
+             {"far_cones_ms", c.farConesMs},
+             {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
+             {"far_voxels_cached", double(c.farVoxelsCached)},
+             {"inject_on_gpu", mInjectedOnGpu ? 1.0 : 0.0},
+             {"inject_cones_ms", c.injectConesMs},
+             {"inject_gpu_ms", mInjectedOnGpu && inject.timed && inject.dispatches > 0
+                                   ? inject.gpuMs
+                                   : std::nan("")},
+             {"inject_upload_bytes", mInjectedOnGpu ? double(inject.uploadBytes) : 0.0},
+             {"inject_dispatch_ms", mInjectedOnGpu ? inject.submitMs : std::nan("")},
+             {"inject_device_call_ms", mInjectedOnGpu ? inject.callMs : std::nan("")},
+             {"voxelize_on_gpu", mVoxelizedOnGpu ? 1.0 : 0.0},
+             {"voxelize_dispatch_ms", mVoxelizedOnGpu ? voxelizer.submitMs : std::nan("")},
+             {"voxelize_device_call_ms", mVoxelizedOnGpu ? voxelizer.callMs : std::nan("")},
+             {"voxelize_fallbacks", mVoxelizedOnGpu ? double(voxelizer.fallbacks) : 0.0}});
+        return counters;
     }
 
 private:
