@@ -25,7 +25,7 @@ struct CombineConstants {
 };
 static_assert(sizeof(CombineConstants) == 64, "must match cone_combine.comp");
 
-constexpr std::uint32_t kBindings = 10;
+constexpr std::uint32_t kBindings = 9;
 
 } // namespace
 
@@ -67,12 +67,6 @@ void ConeCombineGpu::prepare(gpu::Context& context)
         desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
     desc.pushConstantSize = sizeof(CombineConstants);
     mPipeline = context.createPipeline(desc);
-    std::vector<glm::vec4> directions(kConeCount);
-    const auto& d = scene::getConeDirections();
-    for (int k = 0; k < kConeCount; ++k)
-        directions[std::size_t(k)] = glm::vec4(glm::vec3(d[std::size_t(k)]), 0.0f);
-    reserve(mCones, directions.size() * sizeof(glm::vec4), "voxel_gi.combine.cones");
-    mCones.uploadSpan<glm::vec4>(directions);
 }
 
 Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const ConeCombineInputs& in)
@@ -180,8 +174,7 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
                                                 gpu::Binding::storageBuffer(5, mMaterials),
                                                 gpu::Binding::storageBuffer(6, mVisibility),
                                                 gpu::Binding::storageBuffer(7, mCapsules),
-                                                gpu::Binding::storageBuffer(8, mCones),
-                                                gpu::Binding::storageBuffer(9, mOutput)};
+                                                gpu::Binding::storageBuffer(8, mOutput)};
     Image<glm::vec3> out(w, h, glm::vec3(0.0f));
     if (pixels == 0)
         return out;

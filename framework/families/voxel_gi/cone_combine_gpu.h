@@ -40,14 +40,15 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
-    // The pipeline and the cone directions on `context` (everything anew for another context).
+    // The pipeline on `context`, the cone directions compiled in (everything anew for another
+    // context).
     void prepare(gpu::Context& context);
     gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name);
 
     gpu::Context* mContext = nullptr;
     gpu::ComputePipeline mPipeline;
     gpu::Buffer mRepresentative, mPositions, mNormals, mDepths, mMaterials, mVisibility, mCapsules,
-        mCones, mOutput, mUploadedCones;
+        mOutput, mUploadedCones;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;
 };

@@ -25,11 +25,10 @@ layout(std430, binding = 6) readonly buffer VisibilityBuffer { float visibility[
 // Per capsule, 4 vec4, relative to the anchor: (a, radius), (b - a, 1 / |b - a|^2 or 0),
 // (centre of the segment, radius of the sphere around the capsule), (near^2, reach^2, 0, 0).
 layout(std430, binding = 7) readonly buffer CapsuleBuffer { vec4 capsules[]; };
-layout(std430, binding = 8) readonly buffer DirectionBuffer { vec4 coneBuffer[16]; };
+layout(std430, binding = 8) writeonly buffer OutputBuffer { vec4 irradiance[]; }; // [full pixel]
 // The 16 directions as constants (scene/sky.h getConeDirections, defined by the caller), so that
 // the unrolled loops over the cones read immediates rather than memory.
 const vec3 kCones[16] = vec3[16](CONE_DIRECTIONS);
-layout(std430, binding = 9) writeonly buffer OutputBuffer { vec4 irradiance[]; }; // [full pixel]
 
 layout(push_constant) uniform Constants {
     ivec4 size;   // full width, height; low width, height
