@@ -61,28 +61,30 @@
 // Not yet: the volumetric G-buffer and the light buffers kept on the GPU between updates.
 //
 // Parameters
+// clang-format off
 // | name           | type  | default           | range / choices                       | unit   |
 // |----------------|-------|-------------------|---------------------------------------|--------|
 // | levels         | int   | 6                 | [1, 10]                               |        |
 // | resolution     | int   | 32                | [4, 128], even                        | voxels |
 // | voxel_size     | float | 0 (auto)          | [0, 1e6]                              | world  |
-// | supersampling  | int   | 4                 | [1, 16]                               | rays per
-// voxel side | | bounces        | int   | 2                 | [1, 3] |        | | schedule       |
-// enum  | three_pass        | three_pass, one_pass                  |        | | update         |
-// enum  | one_level_per_frame | one_level_per_frame, all_levels     |        | | cone_angle     |
-// float | 29                | [5, 60]                               | degrees (half-angle) | |
-// start_offset   | float | 1                 | [0, 4]                                | voxels | |
-// step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel
-// size sampled | | precombine     | bool  | true              | |        | | solid          | bool
-// | true              |                                       |        | | device         | enum  |
-// vulkan            | vulkan, cpu (pixel gather)            |        | | combine_device | enum  |
-// auto              | auto, vulkan, cpu (full-resolution combine) |  | | inject_device  | enum  |
-// cpu               | cpu, vulkan (light injection's cones) |        | | voxelize_device| enum  |
-// cpu               | cpu, vulkan (resolution <= 128)       |        | | trace_step     | int   | 4
-// | [1, 8]                                | pixels | | far_start      | float | 0 (whole cones)   |
-// 0 or [start_offset, 64]               | voxels of the pixel's start level | | extrapolate    |
-// bool  | false             | needs bounces >= 2                    |        | | level_noise    |
-// float | 0                 | [0, 0.5]                              | of a level's radius |
+// | supersampling  | int   | 4                 | [1, 16]                               | rays per voxel side |
+// | bounces        | int   | 2                 | [1, 3]                                |        |
+// | schedule       | enum  | three_pass        | three_pass, one_pass                  |        |
+// | update         | enum  | one_level_per_frame | one_level_per_frame, all_levels     |        |
+// | cone_angle     | float | 29                | [5, 60]                               | degrees (half-angle) |
+// | start_offset   | float | 1                 | [0, 4]                                | voxels |
+// | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
+// | precombine     | bool  | true              |                                       |        |
+// | solid          | bool  | true              |                                       |        |
+// | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
+// | combine_device | enum  | auto              | auto, vulkan, cpu (full-res. combine) |        |
+// | inject_device  | enum  | cpu               | cpu, vulkan (light injection's cones) |        |
+// | voxelize_device| enum  | cpu               | cpu, vulkan (resolution <= 128)       |        |
+// | trace_step     | int   | 4                 | [1, 8]                                | pixels |
+// | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]               | voxels of the pixel's start level |
+// | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
+// | level_noise    | float | 0                 | [0, 0.5]                              | of a level's radius |
+// clang-format on
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
 // The talk's split is "about a meter" at its 0.4 m finest voxels: far_start about 2.5.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
