@@ -140,22 +140,38 @@ AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::v
         throw Error("adaptive voxel tree: " + std::to_string(tree.mLevelBegin.back()) +
                     " elements do not fit 32-bit indices");
 
-    tree.mNodes.resize(tree.mLevelBegin[std::size_t(depth)]);
+    // Node records for the root cells and the elements with children, in element order; the
+    // rank words mark which elements those are.
+    const std::size_t upper = tree.mLevelBegin[std::size_t(depth)];
+    tree.mRanks.assign((upper + 63) / 64, VoxelTreeRank{});
+    tree.mNodes.reserve(upper);
     for (int level = 0; level < depth; ++level) {
         const auto& parents = keys[std::size_t(level)];
         const auto& children = keys[std::size_t(level) + 1];
         std::size_t j = 0;
         for (std::size_t i = 0; i < parents.size(); ++i) {
-            VoxelTreeNode& node = tree.mNodes[tree.mLevelBegin[std::size_t(level)] + i];
-            node.offset = std::uint32_t(tree.mLevelBegin[std::size_t(level) + 1] + j);
+            const std::uint32_t first = std::uint32_t(tree.mLevelBegin[std::size_t(level) + 1] + j);
             std::uint64_t mask = 0;
             while (j < children.size() && (children[j] >> 6) == parents[i]) {
                 mask |= std::uint64_t(1) << (children[j] & 63u);
                 ++j;
             }
-            node.maskLo = std::uint32_t(mask);
-            node.maskHi = std::uint32_t(mask >> 32);
+            if (mask == 0 && level > 0)
+                continue; // implicit; root cells keep their record (the dense first level)
+            const std::size_t e = tree.mLevelBegin[std::size_t(level)] + i;
+            VoxelTreeRank& word = tree.mRanks[e >> 6];
+            if ((e & 63u) < 32)
+                word.bitsLo |= 1u << (e & 31u);
+            else
+                word.bitsHi |= 1u << (e & 31u);
+            tree.mNodes.push_back({std::uint32_t(mask), std::uint32_t(mask >> 32), first});
         }
+    }
+    tree.mNodes.shrink_to_fit();
+    std::uint32_t before = 0;
+    for (VoxelTreeRank& word : tree.mRanks) {
+        word.base = before;
+        before += std::uint32_t(std::popcount(word.getBits()));
     }
     tree.mLeafCount = keys[std::size_t(depth)].size();
     return tree;
@@ -169,11 +185,17 @@ std::vector<glm::ivec4> AdaptiveVoxelTree::listElementCells() const
         for (int y = 0; y < roots.y; ++y)
             for (int x = 0; x < roots.x; ++x)
                 cells[std::size_t(x + roots.x * (y + roots.y * z))] = glm::ivec4(x, y, z, 0);
-    // Nodes are in breadth-first order, so a node's cell is known before its children's.
-    for (std::size_t i = 0; i < mNodes.size(); ++i) {
+    // Elements are in breadth-first order, so an element's cell is known before its children's;
+    // node records are in element order.
+    std::size_t record = 0;
+    const std::size_t upper = mLevelBegin[std::size_t(mLayout.depth)];
+    for (std::size_t i = 0; i < upper; ++i) {
+        if (((mRanks[i >> 6].getBits() >> (i & 63u)) & 1u) == 0)
+            continue;
         const glm::ivec4 parent = cells[i];
-        std::uint64_t mask = mNodes[i].getMask();
-        std::uint32_t child = mNodes[i].offset;
+        const VoxelTreeNode& node = mNodes[record++];
+        std::uint64_t mask = node.getMask();
+        std::uint32_t child = node.offset;
         while (mask != 0) {
             const int bit = std::countr_zero(mask);
             mask &= mask - 1;
@@ -192,12 +214,12 @@ AdaptiveVoxelTree::Deepest AdaptiveVoxelTree::findDeepest(const glm::ivec3& leaf
     std::uint32_t index = std::uint32_t(
         root.x + mLayout.rootCells.x * (root.y + mLayout.rootCells.y * root.z));
     for (int l = 1; l <= depth; ++l) {
-        const VoxelTreeNode& node = mNodes[index];
-        const std::uint64_t mask = node.getMask();
+        const VoxelTreeNode* node = getNode(index);
+        const std::uint64_t mask = node != nullptr ? node->getMask() : 0;
         const int bit = getChildBit(c >> (2 * (depth - l)));
         if (((mask >> bit) & 1u) == 0)
             return {l - 1, std::int64_t(index), mask != 0};
-        index = node.offset + std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
+        index = node->offset + std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
     }
     return {depth, std::int64_t(index), false};
 }

@@ -13,6 +13,16 @@
 //  * Partial dilation of the upper levels: a level l (1 <= l < depth) node exists for each of the
 //    27 cells around the parent of every level l + 1 element, so the trilinear neighbourhood of
 //    any point (interpolate() below) needs at most the level of the point and the one above it.
+//  * Below the root cells (which all have a node record: the dense first level, record = cell),
+//    only elements with children have a node record. An element without children (a dilated
+//    cell) is implicit like a leaf: it is a bit in its parent's mask and a payload index. A
+//    record is found by rank (Jacobson, "Space-efficient static trees and graphs", FOCS 1989):
+//    one bit per upper-level element saying whether it has a record, and the count of records
+//    before each 64-bit word, so that element e's record is
+//        base[e / 64] + popcount(bits[e / 64] & ((1 << (e % 64)) - 1)).
+//    That costs 12 bytes per 64 upper-level elements, where a record per dilated cell cost 12
+//    bytes each: the talk's "partial dilation increases the total memory only by a few percent"
+//    then holds for the topology as well.
 //
 // Element coordinates are integer cells of their level: level l has rootCells * 4^l cells per
 // axis, and level `depth` cells are the leaves.
@@ -36,6 +46,16 @@ struct VoxelTreeNode {
     std::uint64_t getMask() const { return std::uint64_t(maskLo) | (std::uint64_t(maskHi) << 32); }
 };
 static_assert(sizeof(VoxelTreeNode) == 12);
+
+//! 64 upper-level elements: which of them have a node record (bit e % 64), and how many elements
+//! before this word have one (the index of the first one's record). 12 bytes.
+struct VoxelTreeRank {
+    std::uint32_t bitsLo = 0;
+    std::uint32_t bitsHi = 0;
+    std::uint32_t base = 0;
+    std::uint64_t getBits() const { return std::uint64_t(bitsLo) | (std::uint64_t(bitsHi) << 32); }
+};
+static_assert(sizeof(VoxelTreeRank) == 12);
 
 //! The child bit of cell c (integer coordinates of the child's level) inside its parent.
 inline int getChildBit(const glm::ivec3& c)
@@ -63,14 +83,34 @@ public:
 
     const VoxelTreeLayout& getLayout() const { return mLayout; }
     int getDepth() const { return mLayout.depth; }
+    //! The node records of the root cells and the elements with children, in element order.
     const std::vector<VoxelTreeNode>& getNodes() const { return mNodes; }
+    //! The rank words over the upper-level elements [0, getLevelBegin(depth)).
+    const std::vector<VoxelTreeRank>& getRanks() const { return mRanks; }
+    //! Node records: the root cells and the elements with children.
     std::size_t getNodeCount() const { return mNodes.size(); }
     std::size_t getLeafCount() const { return mLeafCount; }
-    //! Nodes and leaves: the length of a payload array.
-    std::size_t getElementCount() const { return mNodes.size() + mLeafCount; }
+    //! Every element (root cells, upper-level cells with or without children, leaves): the
+    //! length of a payload array.
+    std::size_t getElementCount() const { return mLevelBegin.back(); }
     //! First element index of each level (levelBegin[depth + 1] = element count).
     std::size_t getLevelBegin(int level) const { return mLevelBegin[std::size_t(level)]; }
     bool isDilated() const { return mDilated; }
+
+    //! The node record of element e, or nullptr when e has none (a leaf, a childless cell below
+    //! the roots; a root cell always has one, its mask 0 when it has no children).
+    const VoxelTreeNode* getNode(std::uint32_t e) const
+    {
+        if (e >= mLevelBegin[std::size_t(mLayout.depth)])
+            return nullptr;
+        const VoxelTreeRank& word = mRanks[e >> 6];
+        const std::uint64_t bits = word.getBits();
+        const unsigned b = e & 63u;
+        if (((bits >> b) & 1u) == 0)
+            return nullptr;
+        return &mNodes[word.base +
+                       std::uint32_t(std::popcount(bits & ((std::uint64_t(1) << b) - 1)))];
+    }
 
     //! Index of the element at cell c of `level`, or kAbsent (also for c outside the grid).
     //! Inline: it is the lookup every use of the tree spends its time in.
@@ -84,8 +124,9 @@ public:
         if (rx >= roots.x || ry >= roots.y || rz >= roots.z)
             return kAbsent;
         std::uint32_t index = std::uint32_t(rx + roots.x * (ry + roots.y * rz));
+        std::uint32_t record = index; // the dense first level: every root cell has a record
         for (int s = shift - 2; s >= 0; s -= 2) {
-            const VoxelTreeNode& node = mNodes[index];
+            const VoxelTreeNode& node = mNodes[record];
             const std::uint64_t mask = node.getMask();
             const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
             if (((mask >> bit) & 1u) == 0)
@@ -93,6 +134,16 @@ public:
             // The talk's child index: offset + the set bits below this one (one POPCNT).
             index = node.offset +
                     std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
+            if (s > 0) {
+                // The child's node record by rank; no record: no children at all.
+                const VoxelTreeRank& word = mRanks[index >> 6];
+                const std::uint64_t bits = word.getBits();
+                const unsigned b = index & 63u;
+                if (((bits >> b) & 1u) == 0)
+                    return kAbsent;
+                record =
+                    word.base + std::uint32_t(std::popcount(bits & ((std::uint64_t(1) << b) - 1)));
+            }
         }
         return std::int64_t(index);
     }
@@ -108,12 +159,17 @@ public:
     };
     Deepest findDeepest(const glm::ivec3& leaf) const;
 
-    //! Topology bytes: the nodes (the root cells are nodes, so there is no other table).
-    std::size_t getTopologyBytes() const { return mNodes.size() * sizeof(VoxelTreeNode); }
+    //! Topology bytes: the node records and the rank words (the dense first level is addressed
+    //! by them too, so there is no other table).
+    std::size_t getTopologyBytes() const
+    {
+        return mNodes.size() * sizeof(VoxelTreeNode) + mRanks.size() * sizeof(VoxelTreeRank);
+    }
 
 private:
     VoxelTreeLayout mLayout;
     std::vector<VoxelTreeNode> mNodes;
+    std::vector<VoxelTreeRank> mRanks;
     std::size_t mLeafCount = 0;
     std::vector<std::size_t> mLevelBegin;
     bool mDilated = true;

@@ -95,6 +95,32 @@ void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<gl
     }
     EXPECT_EQ(total, tree.getElementCount()) << what;
     EXPECT_EQ(tree.getLeafCount(), expected.back().size()) << what;
+
+    // Node records exactly for the root cells and the elements with an expected child, each
+    // holding its children's bits; the topology is those records and one rank word per 64
+    // upper-level elements.
+    std::size_t inner = 0, wrongRecords = 0;
+    for (std::size_t e = 0; e < tree.getElementCount(); ++e) {
+        const int l = cells[e].w;
+        std::uint64_t want = 0;
+        if (l < layout.depth)
+            for (int bit = 0; bit < 64; ++bit) {
+                const glm::ivec3 child =
+                    glm::ivec3(cells[e]) * 4 + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4);
+                if (expected[std::size_t(l) + 1].count(key(child)) != 0)
+                    want |= std::uint64_t(1) << bit;
+            }
+        const VoxelTreeNode* node = tree.getNode(std::uint32_t(e));
+        const bool record = want != 0 || l == 0; // every root cell has one
+        inner += record ? 1 : 0;
+        if ((node != nullptr) != record || (node != nullptr && node->getMask() != want))
+            ++wrongRecords;
+    }
+    EXPECT_EQ(wrongRecords, 0u) << what;
+    EXPECT_EQ(tree.getNodeCount(), inner) << what;
+    EXPECT_EQ(tree.getTopologyBytes(),
+              12 * inner + 12 * ((tree.getLevelBegin(layout.depth) + 63) / 64))
+        << what;
 }
 
 TEST(VoxelTree, RandomisedLookupsAgreeWithDenseGridsAtEveryLevel)
@@ -126,6 +152,9 @@ TEST(VoxelTree, OneVoxel)
     const AdaptiveVoxelTree tree = AdaptiveVoxelTree::build(layout, {glm::ivec3(17, 3, 9)}, false);
     EXPECT_EQ(tree.getLeafCount(), 1u);
     EXPECT_EQ(tree.getNodeCount(), 3u); // two root cells and the leaf's parent
+    EXPECT_EQ(tree.getElementCount(), 4u);
+    ASSERT_NE(tree.getNode(0), nullptr); // x = 17 lies in root cell 1: cell 0 has no children
+    EXPECT_EQ(tree.getNode(0)->getMask(), 0u);
     EXPECT_NE(tree.find(2, {17, 3, 9}), AdaptiveVoxelTree::kAbsent);
     EXPECT_EQ(tree.find(2, {17, 3, 8}), AdaptiveVoxelTree::kAbsent);
     expectMatchesDenseGrids(layout, {glm::ivec3(17, 3, 9)}, true, "one voxel");

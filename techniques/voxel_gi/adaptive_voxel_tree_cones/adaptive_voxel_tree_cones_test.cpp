@@ -215,7 +215,7 @@ namespace {
 // The Vulkan gather against the C++ one on the same tree and G-buffer (positions relative to the
 // lattice's centre in the shader), with the tolerance stated in voxel_gi_gpu_parity.h. Two root
 // cells along x, so that the dense first level is indexed too.
-void compareGpu(glm::vec3 offset)
+void compareGpu(glm::vec3 offset, int resolution, int depth)
 {
     const scene::RenderScene s = makeOpenRoom(offset);
     scene::Camera camera;
@@ -223,19 +223,31 @@ void compareGpu(glm::vec3 offset)
     camera.target = offset + glm::vec3(-0.5f, -0.7f, -0.5f);
     camera.nearPlane = 1e-3f;
     const scene::GBuffer g = reference::castGBuffer(s, camera, 48, 32);
-    VoxelTreeCones tree({.depth = 2, .supersampling = 2});
+    VoxelTreeCones tree({.depth = depth, .supersampling = 2});
     glm::dvec3 origin;
     double leaf = 0.0;
     glm::ivec3 roots;
-    VoxelTreeCones::computeLattice(glm::dvec3(s.boundsMin), glm::dvec3(s.boundsMax), 32, 2, 0.0, origin, leaf, roots);
+    VoxelTreeCones::computeLattice(glm::dvec3(s.boundsMin), glm::dvec3(s.boundsMax), resolution,
+                                   depth, 0.0, origin, leaf, roots);
     ASSERT_GT(roots.x * roots.y * roots.z, 1);
     LeafLattice lattice;
     lattice.origin = origin;
     lattice.leafSize = leaf;
-    lattice.cells = roots * 16;
+    lattice.cells = roots * (1 << (2 * depth));
     lattice.supersampling = 2;
     tree.build(origin, leaf, roots, voxelizeSurfaceLeaves(s, lattice, "test"));
     tree.injectLight(s);
+    // At depth 3 the pixel cones sample the leaves' parents (never the leaves), found through
+    // a level-1 element's node record, by rank: the lookup meets records in both halves of the
+    // 64-bit rank word. (Below its root cells an undilated tree has no element without children.)
+    if (depth == 3) {
+        const AdaptiveVoxelTree& t = *tree.getTree();
+        int withRecord[2] = {0, 0};
+        for (std::uint32_t e = std::uint32_t(t.getLevelBegin(1)); e < t.getLevelBegin(2) && e < 64;
+             ++e)
+            withRecord[e / 32u] += t.getNode(e) != nullptr ? 1 : 0;
+        EXPECT_GT(std::min(withRecord[0], withRecord[1]), 0);
+    }
     std::vector<glm::vec3> cpuCones, gpuCones;
     tree.gatherCones(g, cpuCones);
     gpu::Context context;
@@ -251,10 +263,11 @@ void compareGpu(glm::vec3 offset)
 
 TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesTheCppGather)
 {
-    compareGpu(glm::vec3(0.0f));
+    compareGpu(glm::vec3(0.0f), 32, 2);
+    compareGpu(glm::vec3(0.0f), 128, 3);
 }
 
 TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesFarFromTheOrigin)
 {
-    compareGpu(glm::vec3(1e5f, 0.0f, -1e5f));
+    compareGpu(glm::vec3(1e5f, 0.0f, -1e5f), 32, 2);
 }

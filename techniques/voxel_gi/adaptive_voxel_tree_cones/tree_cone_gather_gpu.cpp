@@ -12,10 +12,13 @@ struct GatherConstants {
     glm::ivec4 size{0};  // width, height, depth, max steps
     glm::vec4 march{0};  // leaf size, tan(half-angle), start offset, step scale
     glm::vec4 box{0};    // min corner relative to the centre
-    glm::ivec4 roots{0}; // root cells per axis
+    glm::ivec4 roots{
+        0}; // xyz: root cells per axis, w: the first node record's uint in the topology buffer
 };
 static_assert(sizeof(GatherConstants) == 64, "must match tree_cone_gather.comp");
 static_assert(sizeof(VoxelTreeNode) == 3 * sizeof(std::uint32_t), "the shader reads 3 uints per node");
+static_assert(sizeof(VoxelTreeRank) == 3 * sizeof(std::uint32_t),
+              "the shader reads 3 uints per rank word");
 
 } // namespace
 
@@ -65,14 +68,23 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
     }
     mLastUploadBytes = 0;
     if (mUploadedStamp != tree.getStamp()) {
+        // One topology buffer: the rank words, then the node records.
+        const auto& ranks = t->getRanks();
         const auto& nodes = t->getNodes();
+        std::vector<std::uint32_t> topology;
+        topology.reserve(3 * (ranks.size() + nodes.size()));
+        for (const VoxelTreeRank& r : ranks)
+            topology.insert(topology.end(), {r.bitsLo, r.bitsHi, r.base});
+        for (const VoxelTreeNode& n : nodes)
+            topology.insert(topology.end(), {n.maskLo, n.maskHi, n.offset});
+        const std::size_t nodeBytes = topology.size() * sizeof(std::uint32_t);
         const auto& gathered = tree.getGathered();
-        const std::size_t nodeBytes = nodes.size() * sizeof(VoxelTreeNode);
         if (!mNodes.isValid() || mNodes.getSize() < nodeBytes)
-            mNodes = mDispatch.makeBuffer(nodeBytes, "adaptive_voxel_tree_cones.nodes");
+            mNodes = mDispatch.makeBuffer(nodeBytes, "adaptive_voxel_tree_cones.topology");
         if (!mGathered.isValid() || mGathered.getSize() < gathered.size() * sizeof(glm::vec4))
             mGathered = mDispatch.makeBuffer(gathered.size() * sizeof(glm::vec4), "adaptive_voxel_tree_cones.gathered");
-        mNodes.uploadSpan<VoxelTreeNode>(nodes);
+        mNodes.uploadSpan<std::uint32_t>(topology);
+        mNodeStart = std::uint32_t(3 * ranks.size());
         mGathered.uploadSpan<glm::vec4>(gathered);
         mLastUploadBytes += nodeBytes + gathered.size() * sizeof(glm::vec4);
         mUploadedStamp = tree.getStamp();
@@ -85,7 +97,7 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
     constants.march = {float(tree.getLeafSize()), float(tree.getCones().tanHalfAngle), float(s.startOffset),
                        float(s.stepScale)};
     constants.box = glm::vec4(glm::vec3(tree.getOrigin() - anchor), 0.0f);
-    constants.roots = glm::ivec4(t->getLayout().rootCells, 0);
+    constants.roots = glm::ivec4(t->getLayout().rootCells, int(mNodeStart));
     mLastGpuMs = mDispatch.run(mNodes, mGathered, gpu::PushConstants(constants), out);
 }
 

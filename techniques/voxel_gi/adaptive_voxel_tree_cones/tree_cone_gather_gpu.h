@@ -1,8 +1,8 @@
 #pragma once
 // The pixel gather of the adaptive voxel tree on Vulkan (shaders/tree_cone_gather.comp): the
-// tree's nodes (mask low, mask high, offset) and the gathered light of every element in two
-// storage buffers, uploaded again only when the tree or its light changed; positions go up
-// relative to the lattice's centre.
+// tree's topology (its rank words, then its node records: mask low, mask high, offset; 3 uints
+// each) and the gathered light of every element in two storage buffers, uploaded again only when
+// the tree or its light changed; positions go up relative to the lattice's centre.
 
 #include "voxel_tree_cones.h"
 
@@ -39,6 +39,7 @@ private:
     PixelConeDispatch mDispatch;
     gpu::Buffer mNodes, mGathered;
     gpu::Buffer mZeros; //!< the radiances of an empty tree, when kept on the device
+    std::uint32_t mNodeStart = 0; //!< uint index of the first node record in mNodes
     std::uint64_t mUploadedStamp = 0;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;

@@ -96,13 +96,13 @@ void VoxelTreeCones::filterUp(const Get& get)
 {
     // Level by level from the leaves' parents up; a node's 64 children are offset + popcount of
     // the mask bits below theirs, bit = x + 4 (y + 4 z), filterParentFaces<4>'s order.
-    const auto& nodes = mTree->getNodes();
     for (int level = mSettings.depth - 1; level >= 0; --level) {
         const std::size_t begin = mTree->getLevelBegin(level), end = mTree->getLevelBegin(level + 1);
         tbb::parallel_for(begin, end, [&](std::size_t n) {
             std::array<std::int64_t, 64> children;
-            const std::uint64_t mask = nodes[n].getMask();
-            std::uint32_t next = nodes[n].offset;
+            const VoxelTreeNode* node = mTree->getNode(std::uint32_t(n));
+            const std::uint64_t mask = node != nullptr ? node->getMask() : 0;
+            std::uint32_t next = node != nullptr ? node->offset : 0;
             for (int bit = 0; bit < 64; ++bit)
                 children[std::size_t(bit)] = ((mask >> bit) & 1u) ? std::int64_t(next++) : -1;
             filterParentFaces<4>(children.data(), n, mPayload.gathered, get);

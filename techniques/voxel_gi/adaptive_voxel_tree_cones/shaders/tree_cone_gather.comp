@@ -2,7 +2,9 @@
 // The pixel gather of the adaptive voxel tree on Vulkan: per G-buffer pixel, the 16 fixed cones
 // above the surface marched front to back through the tree's gathered light, each sample
 // trilinear at the two levels around the cone footprint (4x apart) and linear between them; every
-// corner found by a descent from its dense root cell. The child index is Quantum Break's offset +
+// corner found by a descent from its dense root cell (whose node record is the cell's); below the
+// roots an element's node record found by rank (voxel_tree.h: base of its 64-element word + the
+// set bits below it). The child index is Quantum Break's offset +
 // popcount of the mask bits below the child's (Silvennoinen & Timonen, SIGGRAPH 2015, "Adaptive
 // Voxel Tree"), the 64-bit popcount as two 32-bit bitCounts. The same algorithm as
 // VoxelTreeCones::gatherCones (voxel_tree_cones.cpp, cone_tracing.h marchCone), in float.
@@ -10,8 +12,10 @@
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
-// [node * 3 + 0, 1, 2]: child mask low and high 32 bits, offset of the first child.
-layout(std430, binding = 0) readonly buffer NodeBuffer { uint nodes[]; };
+// [word * 3 + 0, 1, 2]: which of 64 upper-level elements have children (low, high 32 bits), and
+// how many before the word do; then from pc.roots.w [node * 3 + 0, 1, 2]: child mask low and
+// high 32 bits, offset of the first child.
+layout(std430, binding = 0) readonly buffer TopologyBuffer { uint topology[]; };
 // [element * 6 + face]: rgb = gathered light premultiplied by the occupancy, a = occupancy.
 layout(std430, binding = 1) readonly buffer GatheredBuffer { vec4 gathered[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
@@ -23,7 +27,7 @@ layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, depth (levels below the roots), max steps
     vec4 march;  // leaf size, tan(half-angle), start offset (leaves), step scale
     vec4 box;    // xyz: min corner relative to the centre
-    ivec4 roots; // xyz: root cells per axis
+    ivec4 roots; // xyz: root cells per axis, w: the first node record's uint in topology[]
 } pc;
 
 // The element at cell c of `level`, or -1 (outside the lattice or an empty region).
@@ -34,8 +38,10 @@ int findElement(int level, ivec3 c)
         return -1;
     const ivec3 r = c >> shift;
     uint index = uint(r.x + pc.roots.x * (r.y + pc.roots.y * r.z));
+    uint record = index; // the dense first level: every root cell has a node record
     for (int s = shift - 2; s >= 0; s -= 2) {
-        const uint lo = nodes[3u * index], hi = nodes[3u * index + 1u], offset = nodes[3u * index + 2u];
+        const uint at = uint(pc.roots.w) + 3u * record;
+        const uint lo = topology[at], hi = topology[at + 1u], offset = topology[at + 2u];
         const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
         uint below;
         if (bit < 32) {
@@ -49,6 +55,21 @@ int findElement(int level, ivec3 c)
             below = uint(bitCount(lo)) + uint(bitCount(hi & ((1u << b) - 1u)));
         }
         index = offset + below;
+        if (s > 0) {
+            // The child's node record by rank; an element without one has no children.
+            const uint word = 3u * (index >> 6u), b = index & 63u;
+            const uint rankLo = topology[word], rankHi = topology[word + 1u];
+            record = topology[word + 2u];
+            if (b < 32u) {
+                if (((rankLo >> b) & 1u) == 0u)
+                    return -1;
+                record += uint(bitCount(rankLo & ((1u << b) - 1u)));
+            } else {
+                if (((rankHi >> (b - 32u)) & 1u) == 0u)
+                    return -1;
+                record += uint(bitCount(rankLo)) + uint(bitCount(rankHi & ((1u << (b - 32u)) - 1u)));
+            }
+        }
     }
     return int(index);
 }
