@@ -102,11 +102,9 @@ std::vector<SurfaceLeaf> voxelizeSurfaceLeaves(const scene::RenderScene& geometr
         region.resolution = C;
         // The solid fill only decides which voxels form the inner layer: spans that leave the
         // block's neighbourhood are not closed there, and the surface voxels' coverage would
-        // count them, so the surface voxels come from the grid without the fill (the same rays,
-        // counted without the spans).
-        VoxelGrid grid;
-        const VoxelGrid filled = voxelizeTriangles(
-            part, region, {.supersampling = lattice.supersampling, .solid = true}, nullptr, &grid);
+        // count them, so the surface voxels come from a voxelization without the fill.
+        const VoxelGrid filled =
+            voxelizeTriangles(part, region, {.supersampling = lattice.supersampling, .solid = true});
         // Face steps from the block's surface voxels through its solid voxels, up to `layers`.
         std::vector<std::uint8_t> steps(region.getVoxelCount(), std::uint8_t(255));
         std::vector<glm::ivec3> front;
@@ -152,6 +150,8 @@ std::vector<SurfaceLeaf> voxelizeSurfaceLeaves(const scene::RenderScene& geometr
                         l.faces[std::size_t(f)] = filled.face(v, f);
                     solid.push_back(l);
                 }
+        const VoxelGrid grid =
+            voxelizeTriangles(part, region, {.supersampling = lattice.supersampling, .solid = false});
         auto& out = perBlock[i];
         out.reserve(grid.surfaceVoxels.size());
         for (const std::uint32_t v : grid.surfaceVoxels) {

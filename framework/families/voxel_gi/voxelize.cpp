@@ -64,7 +64,6 @@ bool isTopLeft(glm::dvec2 e)
 // Per-voxel accumulators of the three axis passes.
 struct Accumulators {
     std::vector<std::uint32_t> hits;    // [voxel * 3 + axis]: rays of that axis covered inside
-    std::vector<std::uint32_t> surfaceHits; // the same counting surfaces only (the unfilled grid)
     std::vector<std::uint32_t> surfaceRays; // [voxel * 3 + axis]: of those, rays meeting a surface
     std::vector<glm::dvec3> albedo;     // [voxel * 6 + face]
     std::vector<glm::dvec3> emission;   // [voxel * 6 + face]
@@ -101,11 +100,8 @@ void getVoxelizeBox(const VoxelRegion& region, const VoxelizeOptions& options, g
 }
 
 VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& region,
-                            const VoxelizeOptions& options, VoxelizeStats* stats,
-                            VoxelGrid* unfilled)
+                            const VoxelizeOptions& options, VoxelizeStats* stats)
 {
-    if (!options.solid)
-        unfilled = nullptr; // the grid itself is the unfilled one
     checkVoxelizeArguments(region, options);
     const int R = region.resolution;
     const int S = options.supersampling;
@@ -142,8 +138,6 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
 
     Accumulators acc;
     acc.hits.assign(voxelCount * 3, 0);
-    if (unfilled != nullptr)
-        acc.surfaceHits.assign(voxelCount * 3, 0);
     acc.surfaceRays.assign(voxelCount * 3, 0);
     acc.albedo.assign(voxelCount * kFaceCount, glm::dvec3(0.0));
     acc.emission.assign(voxelCount * kFaceCount, glm::dvec3(0.0));
@@ -306,11 +300,7 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
                     }
                     for (const int k : touched) {
                         coord[a] = k;
-                        const std::size_t at =
-                            region.index(coord.x, coord.y, coord.z) * 3 + std::size_t(a);
-                        ++acc.hits[at];
-                        if (unfilled != nullptr && (covered[std::size_t(k)] & 1))
-                            ++acc.surfaceHits[at];
+                        ++acc.hits[region.index(coord.x, coord.y, coord.z) * 3 + std::size_t(a)];
                         covered[std::size_t(k)] = 0;
                     }
                     touched.clear();
@@ -320,61 +310,50 @@ VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& 
     for (const std::size_t n : fragmentsPerRow)
         local.fragments += n;
 
-    // The grid from the rays' counts: `hits` covered rays per voxel and axis; `votes` for solid
-    // voxels (none in the unfilled grid).
-    const auto resolve = [&](const std::vector<std::uint32_t>& hits, bool withVotes) {
-        VoxelGrid grid;
-        grid.region = region;
-        grid.faces.assign(voxelCount * kFaceCount, glm::vec4(0.0f));
-        grid.emission.assign(voxelCount * kFaceCount, glm::vec3(0.0f));
-        grid.normal.assign(voxelCount, glm::vec3(0.0f));
-        grid.flags.assign(voxelCount, 0);
-        const double raysPerColumn = double(S) * double(S);
-        for (std::size_t vox = 0; vox < voxelCount; ++vox) {
-            bool surface = false;
-            glm::dvec3 meanAlbedo(0.0), meanEmission(0.0);
-            double meanCount = 0.0;
-            for (int a = 0; a < 3; ++a)
-                if (const std::uint32_t n = acc.surfaceRays[vox * 3 + std::size_t(a)]; n > 0) {
-                    surface = true;
-                    for (int face = 2 * a; face <= 2 * a + 1; ++face) {
-                        meanAlbedo += acc.albedo[vox * kFaceCount + std::size_t(face)];
-                        meanEmission += acc.emission[vox * kFaceCount + std::size_t(face)];
-                        meanCount += n;
-                    }
-                }
-            for (int a = 0; a < 3; ++a) {
-                const std::uint32_t n = hits[vox * 3 + std::size_t(a)];
-                if (n == 0 || !surface)
-                    continue;
-                const std::uint32_t m = acc.surfaceRays[vox * 3 + std::size_t(a)];
-                const float occupancy = float(std::min(1.0, n / raysPerColumn));
+    VoxelGrid grid;
+    grid.region = region;
+    grid.faces.assign(voxelCount * kFaceCount, glm::vec4(0.0f));
+    grid.emission.assign(voxelCount * kFaceCount, glm::vec3(0.0f));
+    grid.normal.assign(voxelCount, glm::vec3(0.0f));
+    grid.flags.assign(voxelCount, 0);
+    const double raysPerColumn = double(S) * double(S);
+    for (std::size_t vox = 0; vox < voxelCount; ++vox) {
+        bool surface = false;
+        glm::dvec3 meanAlbedo(0.0), meanEmission(0.0);
+        double meanCount = 0.0;
+        for (int a = 0; a < 3; ++a)
+            if (const std::uint32_t n = acc.surfaceRays[vox * 3 + std::size_t(a)]; n > 0) {
+                surface = true;
                 for (int face = 2 * a; face <= 2 * a + 1; ++face) {
-                    const std::size_t i = vox * kFaceCount + std::size_t(face);
-                    // Rays that only run through the solid part see the voxel's mean surface.
-                    const glm::dvec3 albedo =
-                        m > 0 ? acc.albedo[i] / double(m) : meanAlbedo / meanCount;
-                    const glm::dvec3 emission =
-                        m > 0 ? acc.emission[i] / double(m) : meanEmission / meanCount;
-                    grid.faces[i] = glm::vec4(glm::vec3(albedo), occupancy);
-                    grid.emission[i] = glm::vec3(emission);
+                    meanAlbedo += acc.albedo[vox * kFaceCount + std::size_t(face)];
+                    meanEmission += acc.emission[vox * kFaceCount + std::size_t(face)];
+                    meanCount += n;
                 }
             }
-            if (surface) {
-                grid.flags[vox] = kVoxelSurface;
-                const double len = glm::length(acc.normal[vox]);
-                if (len > 1e-9)
-                    grid.normal[vox] = glm::vec3(acc.normal[vox] / len);
-            } else if (withVotes && acc.votes[vox] >= 2) {
-                grid.flags[vox] = kVoxelSolid;
+        for (int a = 0; a < 3; ++a) {
+            const std::uint32_t n = acc.hits[vox * 3 + std::size_t(a)];
+            if (n == 0 || !surface)
+                continue;
+            const std::uint32_t m = acc.surfaceRays[vox * 3 + std::size_t(a)];
+            const float occupancy = float(std::min(1.0, n / raysPerColumn));
+            for (int face = 2 * a; face <= 2 * a + 1; ++face) {
+                const std::size_t i = vox * kFaceCount + std::size_t(face);
+                // Rays that only run through the solid part see the voxel's mean surface.
+                const glm::dvec3 albedo = m > 0 ? acc.albedo[i] / double(m) : meanAlbedo / meanCount;
+                const glm::dvec3 emission =
+                    m > 0 ? acc.emission[i] / double(m) : meanEmission / meanCount;
+                grid.faces[i] = glm::vec4(glm::vec3(albedo), occupancy);
+                grid.emission[i] = glm::vec3(emission);
             }
         }
-        return grid;
-    };
-    VoxelGrid grid = resolve(acc.hits, true);
-    if (unfilled != nullptr) {
-        *unfilled = resolve(acc.surfaceHits, false);
-        finalizeVoxelGrid(*unfilled);
+        if (surface) {
+            grid.flags[vox] = kVoxelSurface;
+            const double len = glm::length(acc.normal[vox]);
+            if (len > 1e-9)
+                grid.normal[vox] = glm::vec3(acc.normal[vox] / len);
+        } else if (acc.votes[vox] >= 2) {
+            grid.flags[vox] = kVoxelSolid;
+        }
     }
     local.solidVoxels = finalizeVoxelGrid(grid);
     local.surfaceVoxels = grid.surfaceVoxels.size();

@@ -106,12 +106,8 @@ void getVoxelizeBox(const VoxelRegion& region, const VoxelizeOptions& options, g
 
 //! Voxelizes every triangle of `scene` that meets `region` (its box). Throws rtlab::Error for a
 //! region with resolution < 1 or a non-positive or non-finite voxel size, or a bad option.
-//! With options.solid and `unfilled`, also writes there the grid the same call with solid = false
-//! gives, bit for bit, from the same rays (counted once more without the spans): one
-//! rasterization for both.
 VoxelGrid voxelizeTriangles(const scene::RenderScene& scene, const VoxelRegion& region,
-                            const VoxelizeOptions& options, VoxelizeStats* stats = nullptr,
-                            VoxelGrid* unfilled = nullptr);
+                            const VoxelizeOptions& options, VoxelizeStats* stats = nullptr);
 
 //! The steps that look across voxels, after the grid's voxels were set (voxelizeTriangles does
 //! this; call it again after pasting parts of grids together): solid voxels' faces opaque with

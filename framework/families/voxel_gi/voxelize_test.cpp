@@ -67,47 +67,6 @@ TEST(Voxelize, BoxHasAShellOfSurfaceVoxelsAndASolidInterior)
     EXPECT_NEAR(inside.r, 0.7f, 1e-6f);
 }
 
-void expectSameGrid(const VoxelGrid& a, const VoxelGrid& b, const std::string& what)
-{
-    EXPECT_EQ(a.flags, b.flags) << what;
-    EXPECT_EQ(a.surfaceVoxels, b.surfaceVoxels) << what;
-    ASSERT_EQ(a.faces.size(), b.faces.size()) << what;
-    std::size_t differing = 0;
-    for (std::size_t i = 0; i < a.faces.size(); ++i)
-        differing += (a.faces[i] != b.faces[i] || a.emission[i] != b.emission[i]) ? 1 : 0;
-    for (std::size_t v = 0; v < a.normal.size(); ++v)
-        differing += a.normal[v] != b.normal[v] ? 1 : 0;
-    EXPECT_EQ(differing, 0u) << what;
-}
-
-TEST(Voxelize, TheUnfilledGridOfASolidCallEqualsAnUnfilledCall)
-{
-    // Closed boxes (spans to fill), one reaching out of the region (spans that leave it), an open
-    // room and an emitter, over the whole region and over a sub-box of it.
-    scene::RenderScene s = makeOpenRoom(glm::vec3(0.0f));
-    const auto glow = addMaterial(s, glm::vec3(0.2f), glm::vec3(3.0f, 2.0f, 1.0f));
-    addBox(s, glm::vec3(0.3f, -0.9f, 0.2f), glm::vec3(0.9f, 0.4f, 2.0f), glow);
-    const VoxelRegion region{glm::dvec3(-1.3), 2.6 / 24.0, 24};
-    for (const glm::ivec3 end : {glm::ivec3(-1), glm::ivec3(17, 24, 9)}) {
-        const VoxelizeOptions solid{
-            .supersampling = 3, .solid = true, .boxBegin = glm::ivec3(2, 0, 1), .boxEnd = end};
-        VoxelizeOptions open = solid;
-        open.solid = false;
-        VoxelGrid unfilled;
-        const VoxelGrid filled = voxelizeTriangles(s, region, solid, nullptr, &unfilled);
-        const VoxelGrid separate = voxelizeTriangles(s, region, open);
-        ASSERT_GT(separate.surfaceVoxels.size(), 0u);
-        expectSameGrid(unfilled, separate, "unfilled grid");
-        // The fill is there, and only in the filled grid.
-        std::size_t solidVoxels = 0;
-        for (const std::uint8_t f : filled.flags)
-            solidVoxels += (f & kVoxelSolid) ? 1 : 0;
-        EXPECT_GT(solidVoxels, 0u);
-        // And the filled grid is what the call without `unfilled` gives.
-        expectSameGrid(filled, voxelizeTriangles(s, region, solid), "filled grid");
-    }
-}
-
 TEST(Voxelize, CoverageIsTheShareOfRaysThatHit)
 {
     scene::RenderScene s;
