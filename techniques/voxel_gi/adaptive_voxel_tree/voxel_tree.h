@@ -103,13 +103,8 @@ public:
     {
         if (e >= mLevelBegin[std::size_t(mLayout.depth)])
             return nullptr;
-        const VoxelTreeRank& word = mRanks[e >> 6];
-        const std::uint64_t bits = word.getBits();
-        const unsigned b = e & 63u;
-        if (((bits >> b) & 1u) == 0)
-            return nullptr;
-        return &mNodes[word.base +
-                       std::uint32_t(std::popcount(bits & ((std::uint64_t(1) << b) - 1)))];
+        const std::int64_t record = findRecord(e);
+        return record < 0 ? nullptr : &mNodes[std::size_t(record)];
     }
 
     //! Index of the element at cell c of `level`, or kAbsent (also for c outside the grid).
@@ -135,14 +130,11 @@ public:
             index = node.offset +
                     std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
             if (s > 0) {
-                // The child's node record by rank; no record: no children at all.
-                const VoxelTreeRank& word = mRanks[index >> 6];
-                const std::uint64_t bits = word.getBits();
-                const unsigned b = index & 63u;
-                if (((bits >> b) & 1u) == 0)
+                // The child's node record; none: no children at all.
+                const std::int64_t next = findRecord(index);
+                if (next < 0)
                     return kAbsent;
-                record =
-                    word.base + std::uint32_t(std::popcount(bits & ((std::uint64_t(1) << b) - 1)));
+                record = std::uint32_t(next);
             }
         }
         return std::int64_t(index);
@@ -159,14 +151,25 @@ public:
     };
     Deepest findDeepest(const glm::ivec3& leaf) const;
 
-    //! Topology bytes: the node records and the rank words (the dense first level is addressed
-    //! by them too, so there is no other table).
+    //! Topology bytes: the node records and the rank words (the root cells' records are the
+    //! dense first level, so there is no other table).
     std::size_t getTopologyBytes() const
     {
         return mNodes.size() * sizeof(VoxelTreeNode) + mRanks.size() * sizeof(VoxelTreeRank);
     }
 
 private:
+    //! The node record of upper-level element e by rank, or -1 when it has none.
+    std::int64_t findRecord(std::uint32_t e) const
+    {
+        const VoxelTreeRank& word = mRanks[e >> 6];
+        const std::uint64_t bits = word.getBits();
+        const unsigned b = e & 63u;
+        if (((bits >> b) & 1u) == 0)
+            return -1;
+        return std::int64_t(word.base) + std::popcount(bits & ((std::uint64_t(1) << b) - 1));
+    }
+
     VoxelTreeLayout mLayout;
     std::vector<VoxelTreeNode> mNodes;
     std::vector<VoxelTreeRank> mRanks;
