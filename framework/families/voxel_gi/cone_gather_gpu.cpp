@@ -103,7 +103,8 @@ std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& se
     const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
         cmd.dispatch(mPipeline, bindings, constants,
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(starts.width), 8),
-                                     gpu::computeGroupCount(std::uint64_t(starts.height), 8), 1},
+                                     gpu::computeGroupCount(std::uint64_t(starts.height), 8),
+                                     std::uint32_t(kConeCount)},
                      mLabel.c_str());
     });
     if (out != nullptr) {

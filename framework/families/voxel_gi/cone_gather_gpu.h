@@ -3,8 +3,10 @@
 // G-buffer (cascades, svo): a compute pipeline whose bindings are 0 and 1 the structure's two
 // buffers, 2 the pixels' positions (relative to an anchor, w = 1 for a surface), 3 their normals,
 // 4 the output [pixel * 16 + cone], 5 the 16 cone directions, and from 6 on the structure's extra
-// buffers, if any; the per-pixel buffers, the dispatch over 8 x 8 groups, and the read-back of the
-// cone radiances.
+// buffers, if any; the per-pixel buffers, the dispatch, and the read-back of the cone radiances.
+// The dispatch is 8 x 8 groups of pixels times 16 in z: one invocation per pixel and cone
+// (gl_GlobalInvocationID.z the cone), so that a GPU has 16 times the invocations of a pixel per
+// invocation to hide its memory latency with, and a warp marches one direction.
 
 #include "families/voxel_gi/cone_tracing.h"
 #include "gpu/context.h"

@@ -119,24 +119,24 @@ vec4 marchCone(vec3 origin, vec3 dir, int k, float t0, float tMax, out bool esca
 
 void main()
 {
+    // One cone per invocation (z: the cone), so that a warp holds neighbouring pixels' cones of
+    // one direction: 16 times the parallelism of a pixel per invocation, and coherent steps.
     const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y)
+    const int k = int(gl_GlobalInvocationID.z);
+    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y || k >= 16)
         return;
     const int index = pixel.y * pc.size.x + pixel.x;
-    for (int k = 0; k < 16; ++k)
-        coneRadiance[index * 16 + k] = vec4(0.0);
+    coneRadiance[index * 16 + k] = vec4(0.0);
     if (pc.flags.z == 1) {
-        // Far cones ("Split Cone Trace"): all 16 cones from a voxel centre, from far start voxels
+        // Far cones ("Split Cone Trace"): the 16 cones from a voxel centre, from far start voxels
         // of its level on (CascadeVolume::prepareFarCones).
         const vec4 centre = positions[index];
         if (centre.w == 0.0)
             return;
         const float t0 = pc.noise.y * normals[index].w;
-        for (int k = 0; k < 16; ++k) {
-            bool escaped;
-            const vec3 light = marchCone(centre.xyz, cones[k].xyz, k, t0, 1e30, escaped).rgb;
-            coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
-        }
+        bool escaped;
+        const vec3 light = marchCone(centre.xyz, cones[k].xyz, k, t0, 1e30, escaped).rgb;
+        coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
         return;
     }
     const vec4 position = positions[index];
@@ -161,32 +161,30 @@ void main()
     const float frac = start - float(l0);
     const bool two = frac > 0.0 && l0 + 1 < pc.size.z && levels[l0 + 1].centre.w > 0.0;
     const float split0 = farStart * levels[l0].origin.w;
-    for (int k = 0; k < 16; ++k) {
-        if (dot(cones[k].xyz, n) <= 0.0)
-            continue;
-        const vec3 dir = cones[k].xyz;
-        bool escaped;
-        vec3 light;
-        if (farStart <= 0.0) {
-            light = marchCone(origin, dir, k, startDistance, 1e30, escaped).rgb;
-        } else {
-            const vec4 a = marchCone(origin, dir, k, startDistance, split0, escaped);
-            vec3 la = a.rgb;
-            if (!escaped)
-                la += a.a * sampleFar(l0, origin, k);
-            light = la;
-            if (two) {
-                vec3 lb = a.rgb;
-                if (!escaped) {
-                    bool escapedB;
-                    const vec4 b = marchCone(origin, dir, k, split0, 2.0 * split0, escapedB);
-                    lb += a.a * b.rgb;
-                    if (!escapedB)
-                        lb += a.a * b.a * sampleFar(l0 + 1, origin, k);
-                }
-                light = la + frac * (lb - la);
+    if (dot(cones[k].xyz, n) <= 0.0)
+        return;
+    const vec3 dir = cones[k].xyz;
+    bool escaped;
+    vec3 light;
+    if (farStart <= 0.0) {
+        light = marchCone(origin, dir, k, startDistance, 1e30, escaped).rgb;
+    } else {
+        const vec4 a = marchCone(origin, dir, k, startDistance, split0, escaped);
+        vec3 la = a.rgb;
+        if (!escaped)
+            la += a.a * sampleFar(l0, origin, k);
+        light = la;
+        if (two) {
+            vec3 lb = a.rgb;
+            if (!escaped) {
+                bool escapedB;
+                const vec4 b = marchCone(origin, dir, k, split0, 2.0 * split0, escapedB);
+                lb += a.a * b.rgb;
+                if (!escapedB)
+                    lb += a.a * b.a * sampleFar(l0 + 1, origin, k);
             }
+            light = la + frac * (lb - la);
         }
-        coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
     }
+    coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
 }

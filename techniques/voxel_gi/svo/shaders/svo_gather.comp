@@ -74,12 +74,14 @@ bool insideCube(vec3 p)
 
 void main()
 {
+    // One cone per invocation (z: the cone), so that a warp holds neighbouring pixels' cones of
+    // one direction: 16 times the parallelism of a pixel per invocation, and coherent steps.
     const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
-    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y)
+    const int k = int(gl_GlobalInvocationID.z);
+    if (pixel.x >= pc.size.x || pixel.y >= pc.size.y || k >= 16)
         return;
     const int index = pixel.y * pc.size.x + pixel.x;
-    for (int k = 0; k < 16; ++k)
-        coneRadiance[index * 16 + k] = vec4(0.0);
+    coneRadiance[index * 16 + k] = vec4(0.0);
     const vec4 position = positions[index];
     const vec3 n = normals[index].xyz;
     if (position.w == 0.0 || dot(n, n) < 0.5 || !insideCube(position.xyz))
@@ -88,36 +90,34 @@ void main()
     const int depth = pc.size.z;
     const vec3 origin = position.xyz + n * (0.5 * pc.march.z * leaf);
     const float startDistance = pc.march.z * leaf;
-    for (int k = 0; k < 16; ++k) {
-        if (dot(cones[k].xyz, n) <= 0.0)
-            continue;
-        const vec3 dir = cones[k].xyz;
-        float occupied = 0.0;
-        vec3 light = vec3(0.0);
-        float t = startDistance;
-        for (int step = 0; step < pc.size.w; ++step) {
-            const vec3 q = origin + t * dir;
-            if (!insideCube(q))
-                break; // left the cube: no indirect light from beyond
-            const float diameter = 2.0 * t * pc.march.y;
-            const float m = min(float(depth), diameter > leaf ? log2(diameter / leaf) : 0.0);
-            const int m0 = int(floor(m));
-            const float frac = m - float(m0);
-            vec4 s = (1.0 - frac) * sampleLevel(depth - m0, q, dir);
-            if (frac > 0.0 && m0 < depth)
-                s += frac * sampleLevel(depth - m0 - 1, q, dir);
-            const float voxelSize = leaf * exp2(m);
-            const float dt = pc.march.w * voxelSize;
-            const float a = clamp(s.a, 0.0, 1.0);
-            if (a > 0.0) {
-                const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
-                light += ((1.0 - occupied) * corrected / a) * s.rgb;
-                occupied += (1.0 - occupied) * corrected;
-                if (occupied >= 0.99)
-                    break;
-            }
-            t += dt;
+    if (dot(cones[k].xyz, n) <= 0.0)
+        return;
+    const vec3 dir = cones[k].xyz;
+    float occupied = 0.0;
+    vec3 light = vec3(0.0);
+    float t = startDistance;
+    for (int step = 0; step < pc.size.w; ++step) {
+        const vec3 q = origin + t * dir;
+        if (!insideCube(q))
+            break; // left the cube: no indirect light from beyond
+        const float diameter = 2.0 * t * pc.march.y;
+        const float m = min(float(depth), diameter > leaf ? log2(diameter / leaf) : 0.0);
+        const int m0 = int(floor(m));
+        const float frac = m - float(m0);
+        vec4 s = (1.0 - frac) * sampleLevel(depth - m0, q, dir);
+        if (frac > 0.0 && m0 < depth)
+            s += frac * sampleLevel(depth - m0 - 1, q, dir);
+        const float voxelSize = leaf * exp2(m);
+        const float dt = pc.march.w * voxelSize;
+        const float a = clamp(s.a, 0.0, 1.0);
+        if (a > 0.0) {
+            const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
+            light += ((1.0 - occupied) * corrected / a) * s.rgb;
+            occupied += (1.0 - occupied) * corrected;
+            if (occupied >= 0.99)
+                break;
         }
-        coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+        t += dt;
     }
+    coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
 }
