@@ -133,6 +133,11 @@ const std::string& Buffer::getName() const
     return getState().name;
 }
 
+bool Buffer::isHostMapped() const
+{
+    return getState().direct;
+}
+
 namespace {
 
 void checkRange(const detail::BufferState& state, std::size_t size, std::size_t offset,
@@ -153,7 +158,7 @@ void Buffer::upload(const void* data, std::size_t size, std::size_t offset)
     if (size == 0)
         return;
     detail::DeviceState& device = *state.device;
-    if (!device.stagingUploads && state.raw.mapped != nullptr) {
+    if (state.direct) {
         std::memcpy(static_cast<std::byte*>(state.raw.mapped) + offset, data, size);
         detail::flushMapped(device, state.raw);
         return;
@@ -171,7 +176,7 @@ void Buffer::download(void* data, std::size_t size, std::size_t offset) const
     if (size == 0)
         return;
     detail::DeviceState& device = *state.device;
-    if (!device.stagingUploads && state.raw.mapped != nullptr) {
+    if (state.direct) {
         detail::invalidateMapped(device, state.raw);
         std::memcpy(data, static_cast<const std::byte*>(state.raw.mapped) + offset, size);
         return;
@@ -189,14 +194,17 @@ Buffer Context::createBuffer(const BufferDesc& desc)
     auto state = std::make_unique<detail::BufferState>();
     state->device = mDevice;
     state->name = desc.name.empty() ? std::string("buffer") : desc.name;
-    const auto kind = mDevice->stagingUploads ? detail::DeviceState::MemoryKind::DeviceLocal
-                                              : detail::DeviceState::MemoryKind::DeviceLocalMapped;
+    using Kind = detail::DeviceState::MemoryKind;
+    const Kind kind = !mDevice->stagingUploads ? Kind::DeviceLocalMapped
+                      : desc.hostVisible       ? Kind::HostStaging
+                                               : Kind::DeviceLocal;
     VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     if (desc.vertexIndexUsage)
         usage |= VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT;
     state->raw = mDevice->createRawBuffer(desc.size, usage, kind, state->name);
     state->vertexIndexUsage = desc.vertexIndexUsage;
+    state->direct = state->raw.mapped != nullptr;
     return Buffer(std::move(state));
 }
 

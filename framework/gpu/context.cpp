@@ -149,7 +149,9 @@ Context::Context(const ContextOptions& options)
     mDevice = std::make_shared<detail::DeviceState>();
     mDevice->instance = std::move(instance);
     createLogicalDevice(*mDevice, choice);
-    mDevice->stagingUploads = options.forceStagingUploads || !canMapDeviceMemory(*mDevice);
+    // RTLAB_VK_STAGING=1: a discrete GPU's transfers on any device (to test them on lavapipe).
+    mDevice->stagingUploads = options.forceStagingUploads || readFlagFromEnv("RTLAB_VK_STAGING") ||
+                              !canMapDeviceMemory(*mDevice);
     mDevice->keepStaging = options.keepStagingBuffers;
     mDevice->timestampsEnabled = mDevice->info.timestampsSupported && !options.disableTimestamps;
     mRun = std::make_unique<detail::RunState>(mDevice);

@@ -101,7 +101,8 @@ struct ContextOptions {
     //! a Context it does not own, such as the one runSmokeTest() creates).
     std::shared_ptr<ValidationLog> validationLog;
     //! Move buffer data through staging buffers even where device memory is host-visible
-    //! (tests use this to cover the path that discrete GPUs take).
+    //! (tests use this to cover the path that discrete GPUs take). The environment variable
+    //! RTLAB_VK_STAGING=1 does the same for every context of a process.
     bool forceStagingUploads = false;
     //! Keep one host staging buffer per direction between transfers (grown to the largest
     //! transfer up to 64 MiB) instead of allocating one per upload or download. False: the

@@ -32,6 +32,12 @@ struct BufferDesc {
     std::string name;     //!< shown in errors and debug tools
     //! Also usable as vertex and index buffer of draws (gpu/graphics.h).
     bool vertexIndexUsage = false;
+    //! Data that crosses the bus once per use: inputs the host writes for one dispatch (per
+    //! frame G-buffer pixels) or outputs it reads back. Where device memory cannot be mapped (a
+    //! discrete GPU) the buffer lives in host-visible memory that shaders read and write over
+    //! the bus, so upload() and download() are a memcpy rather than a staging copy and a queue
+    //! submission each. Elsewhere (lavapipe, unified memory) it changes nothing.
+    bool hostVisible = false;
 };
 
 //! A storage buffer (also usable as transfer source and destination, and as vertex and index
@@ -49,6 +55,10 @@ public:
     std::size_t getSize() const;
     //! The name from BufferDesc ("buffer" when none was given).
     const std::string& getName() const;
+    //! True when upload() and download() copy straight into and out of the buffer's memory (no
+    //! staging buffer, no queue submission): always on unified memory, and for
+    //! BufferDesc::hostVisible buffers everywhere.
+    bool isHostMapped() const;
 
     //! Copies `size` bytes from `data` to the buffer at byte `offset`.
     void upload(const void* data, std::size_t size, std::size_t offset = 0);

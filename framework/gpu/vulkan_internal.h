@@ -153,6 +153,7 @@ struct BufferState {
     RawBuffer raw;
     std::string name;
     bool vertexIndexUsage = false; //!< created with BufferDesc::vertexIndexUsage
+    bool direct = false;           //!< raw.mapped is the buffer's own memory: transfers are memcpys
     ~BufferState();
 };
 

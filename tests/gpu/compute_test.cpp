@@ -43,7 +43,9 @@ protected:
             sizeof(SaxpyParams));
     }
 
-    void runSaxpyAndCheck()
+    //! With `hostVisible` x and y are BufferDesc::hostVisible buffers: the shader reads and
+    //! writes them where the host maps them.
+    void runSaxpyAndCheck(bool hostVisible = false)
     {
         constexpr std::uint32_t kCount = 100003; // not a multiple of the group size 64
         constexpr float kA = 1.7f;
@@ -54,9 +56,13 @@ protected:
             expected[i] = referenceSaxpy(kA, x[i], y[i]);
         }
         const ComputePipeline saxpy = createSaxpy();
-        Buffer xBuffer = getContext().createBuffer({kCount * sizeof(float), "x"});
+        Buffer xBuffer = getContext().createBuffer(
+            {.size = kCount * sizeof(float), .name = "x", .hostVisible = hostVisible});
         // One float of padding that the shader must not touch.
-        Buffer yBuffer = getContext().createBuffer({(kCount + 1) * sizeof(float), "y"});
+        Buffer yBuffer = getContext().createBuffer(
+            {.size = (kCount + 1) * sizeof(float), .name = "y", .hostVisible = hostVisible});
+        EXPECT_EQ(xBuffer.isHostMapped(), hostVisible || !getContext().usesStagingUploads());
+        EXPECT_EQ(yBuffer.isHostMapped(), hostVisible || !getContext().usesStagingUploads());
         xBuffer.uploadSpan<float>(x);
         yBuffer.uploadSpan<float>(y);
         const float sentinel = 12345.5f;
@@ -108,6 +114,19 @@ TEST_F(StagedComputeTest, SaxpyMatchesTheCpuExactlyThroughStagingBuffers)
 {
     EXPECT_TRUE(getContext().usesStagingUploads());
     runSaxpyAndCheck();
+}
+
+TEST_F(StagedComputeTest, HostVisibleBuffersSkipTheStagingBuffers)
+{
+    // Where device memory is not mapped, hostVisible buffers are: the shader reads x from and
+    // writes y to host memory, and the transfers are memcpys.
+    EXPECT_TRUE(getContext().usesStagingUploads());
+    runSaxpyAndCheck(true);
+}
+
+TEST_F(ComputeTest, HostVisibleBuffersWorkOnUnifiedMemory)
+{
+    runSaxpyAndCheck(true);
 }
 
 TEST_F(StagedComputeTest, KeptStagingBuffersCarryEveryTransferWhateverItsSizeAndOrder)

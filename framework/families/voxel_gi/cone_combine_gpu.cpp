@@ -39,7 +39,7 @@ gpu::Buffer& ConeCombineGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, con
 {
     bytes = std::max<std::size_t>(bytes, 16);
     if (!buffer.isValid() || buffer.getSize() < bytes)
-        buffer = mContext->createBuffer({bytes, name});
+        buffer = mContext->createBuffer({.size = bytes, .name = name, .hostVisible = true});
     return buffer;
 }
 

@@ -43,6 +43,8 @@ private:
     // The pipeline on `context`, the cone directions compiled in (everything anew for another
     // context).
     void prepare(gpu::Context& context);
+    // A buffer of at least `bytes`; every one here is written or read once per frame, so all are
+    // gpu::BufferDesc::hostVisible.
     gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name);
 
     gpu::Context* mContext = nullptr;

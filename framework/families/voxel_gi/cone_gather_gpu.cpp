@@ -31,17 +31,20 @@ void PixelConeDispatch::create(gpu::Context& context, const std::filesystem::pat
     mCones.uploadSpan<glm::vec4>(directions);
 }
 
-gpu::Buffer PixelConeDispatch::makeBuffer(std::size_t bytes, const char* name)
+gpu::Buffer PixelConeDispatch::makeBuffer(std::size_t bytes, const char* name, bool hostVisible)
 {
-    return mContext->createBuffer({std::max<std::size_t>(bytes, 16), name});
+    return mContext->createBuffer(
+        {.size = std::max<std::size_t>(bytes, 16), .name = name, .hostVisible = hostVisible});
 }
 
 void PixelConeDispatch::reserve(Starts& starts, std::size_t entries, const char* what)
 {
     if (starts.capacity != entries) {
         const std::string name = std::string("cone_gather.") + what;
-        starts.positions = makeBuffer(entries * sizeof(glm::vec4), (name + ".positions").c_str());
-        starts.normals = makeBuffer(entries * sizeof(glm::vec4), (name + ".normals").c_str());
+        // Uploaded for every dispatch: read by the shader where the host wrote them.
+        starts.positions =
+            makeBuffer(entries * sizeof(glm::vec4), (name + ".positions").c_str(), true);
+        starts.normals = makeBuffer(entries * sizeof(glm::vec4), (name + ".normals").c_str(), true);
         starts.output = makeBuffer(entries * kConeCount * sizeof(glm::vec4), (name + ".cone_radiance").c_str());
         starts.capacity = entries;
     }

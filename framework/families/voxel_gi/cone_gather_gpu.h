@@ -45,8 +45,9 @@ public:
                               const std::vector<gpu::Buffer*>& extra = {}, bool points = false);
     //! The cone radiances of the last run over pixels, [pixel * 16 + cone] as vec4.
     const gpu::Buffer& getOutput() const { return mPixels.output; }
-    //! A storage buffer of at least `bytes` (16 at least) named `name`.
-    gpu::Buffer makeBuffer(std::size_t bytes, const char* name);
+    //! A storage buffer of at least `bytes` (16 at least) named `name`; `hostVisible` for data
+    //! uploaded anew for each dispatch (gpu::BufferDesc::hostVisible).
+    gpu::Buffer makeBuffer(std::size_t bytes, const char* name, bool hostVisible = false);
 
 private:
     gpu::Context* mContext = nullptr;

@@ -88,7 +88,8 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
         }
     }
     if (!mLevels.isValid() || mLevels.getSize() < levels.size() * sizeof(GpuCascadeLevel))
-        mLevels = mDispatch.makeBuffer(levels.size() * sizeof(GpuCascadeLevel), "cascades.levels");
+        mLevels =
+            mDispatch.makeBuffer(levels.size() * sizeof(GpuCascadeLevel), "cascades.levels", true);
     mLevels.uploadSpan<GpuCascadeLevel>(levels);
     return anchor;
 }

@@ -34,8 +34,11 @@ scene::Camera makeRoomCamera(const glm::vec3& offset)
 }
 
 // The C++ and Vulkan cones of the open room seen from a camera, checked against each other.
-std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>> compare(const glm::vec3& offset,
-                                                                  const CascadeSettings& settings)
+// With `staged`, buffers take a discrete GPU's paths (gpu::ContextOptions::forceStagingUploads):
+// the structure's through staging buffers, the per-frame pixels, levels and the combine's
+// inputs and output in host-visible memory (gpu::BufferDesc::hostVisible).
+std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>>
+compare(const glm::vec3& offset, const CascadeSettings& settings, bool staged = false)
 {
     const scene::RenderScene s = makeOpenRoom(offset);
     const scene::Camera camera = makeRoomCamera(offset);
@@ -45,7 +48,10 @@ std::pair<std::vector<glm::vec3>, std::vector<glm::vec3>> compare(const glm::vec
     volume.injectLight(s, "l", 0, false);
     std::vector<glm::vec3> cpuCones, gpuCones;
     volume.gatherCones(g, cpuCones); // with split cones, this traces the far cones the GPU reads
-    gpu::Context context;
+    gpu::ContextOptions options;
+    options.forceStagingUploads = staged;
+    gpu::Context context(options);
+    EXPECT_TRUE(!staged || context.usesStagingUploads());
     CascadeGatherGpu gather;
     gather.gatherCones(context, volume, g, gpuCones);
     expectGpuConesMatchCpu(cpuCones, gpuCones, g, volume.getCones().halfAngle);
@@ -91,6 +97,11 @@ CascadeSettings testSettings()
 TEST(CascadesGpu, VulkanGatherMatchesTheCppGather)
 {
     compare(glm::vec3(0.0f), testSettings());
+}
+
+TEST(CascadesGpu, VulkanGatherMatchesThroughADiscreteGpusTransfers)
+{
+    compare(glm::vec3(0.0f), testSettings(), true);
 }
 
 TEST(CascadesGpu, VulkanGatherMatchesFarFromTheOrigin)
