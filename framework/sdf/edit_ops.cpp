@@ -139,6 +139,25 @@ glm::dvec3 normalizeOrZero(const glm::dvec3& g, bool kink)
     return g / len;
 }
 
+bool isSingleConvexPrimitive(const std::vector<Op>& ops)
+{
+    if (ops.size() != 1 || (ops[0].kind != OpKind::Add && ops[0].kind != OpKind::Set))
+        return false;
+    switch (ops[0].edit->shape) {
+    case scene::CsgShape::Sphere:
+    case scene::CsgShape::Box:
+    case scene::CsgShape::RoundedBox:
+    case scene::CsgShape::Cylinder:
+    case scene::CsgShape::Cone:
+    case scene::CsgShape::Capsule:
+        return true;
+    case scene::CsgShape::Torus:     // not convex
+    case scene::CsgShape::Ellipsoid: // a bound, not the distance
+        return false;
+    }
+    return false;
+}
+
 double getMaxAbs(const glm::dvec3& v)
 {
     return std::max({std::abs(v.x), std::abs(v.y), std::abs(v.z)});

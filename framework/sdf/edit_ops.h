@@ -47,6 +47,11 @@ inline double applyOp(OpKind kind, double d, double s, double blend)
 //! The pruned field at p.
 double evaluateOps(const std::vector<Op>& ops, const glm::dvec3& p);
 
+//! True when the list is one primitive, added (to nothing) or set, of a convex shape with an
+//! exact distance (sphere, box, rounded box, cylinder, cone, capsule; rigid frames only): its
+//! field is the signed distance to a convex solid, which is a convex function.
+bool isSingleConvexPrimitive(const std::vector<Op>& ops);
+
 //! Value (bit-identical to evaluateOps) and gradient (central differences of each primitive with
 //! step h, chained through the CSG operations); `kink` is set where the gradient is undefined.
 double evaluateOpsWithGradient(const std::vector<Op>& ops, const glm::dvec3& p, double h,

@@ -296,9 +296,9 @@ private:
                         applyOp(op.kind, values[j], e.evaluatePrimitive(positions[j]), e.blend);
             }
         } else {
-            evaluated =
-                evaluateLipschitzLeaf(n, ops, positions, {band, grid.spacing + margin, reach},
-                                      seeds, values, work.bound, work.known);
+            evaluated = evaluateLipschitzLeaf(n, ops, positions,
+                                              {band, grid.spacing + margin, reach, margin}, seeds,
+                                              values, work.bound, work.known);
         }
         c.sampleEvaluations += evaluated * ops.size();
         c.samplesEvaluated += evaluated;

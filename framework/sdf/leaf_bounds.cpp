@@ -58,6 +58,7 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
     std::array<std::size_t, 8> corner{};
     std::array<glm::ivec3, 8> cornerAt{};
     int corners = 0;
+    bool provenOutside = false; // a corner a sibling proved outside: only a lower bound there
     for (int k = 0; k < 8; ++k) {
         const glm::ivec3 at((k & 1) ? n.x - 1 : 0, (k & 2) ? n.y - 1 : 0, (k & 4) ? n.z - 1 : 0);
         const std::size_t i = std::size_t(at.x) * strides[0] + std::size_t(at.y) * strides[1] +
@@ -77,9 +78,27 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
             bound[i] = std::abs(values[i]);
             ++evaluated;
         }
+        provenOutside = provenOutside || (proven && values[i] > 0.0);
         corner[std::size_t(corners)] = i;
         cornerAt[std::size_t(corners++)] = at;
     }
+    // A convex field (one convex primitive) is at most the trilinear interpolation of any upper
+    // bounds of its values at the leaf's corners: a sample's trilinear weights are a convex
+    // combination of the corners that reproduces its position, so f(sample) <= sum w_k f(c_k)
+    // (Jensen). An evaluated corner gives its value; a corner a sibling proved inside gives its
+    // stored -bound >= f; one proved outside gives no upper bound, and then nothing is proven
+    // this way. This proves the samples inside a face tilted against the grid, which the
+    // Lipschitz balls and one-spacing chains leave to evaluation (csg_gallery's rotated cube).
+    const bool useUpper = !provenOutside && isSingleConvexPrimitive(ops);
+    std::array<double, 8> upper{};
+    for (int k = 0; k < 8; ++k)
+        upper[std::size_t(k)] = values[std::size_t((k & 1) ? n.x - 1 : 0) * strides[0] +
+                                       std::size_t((k & 2) ? n.y - 1 : 0) * strides[1] +
+                                       std::size_t((k & 4) ? n.z - 1 : 0) * strides[2]];
+    // The trilinear weights of each axis's samples (0 where the leaf is one sample thin).
+    const auto weight = [&](int axis, int at) {
+        return n[axis] > 1 ? double(at) / double(n[axis] - 1) : 0.0;
+    };
     // Sweep each axis from the side whose corners are farther from the surface.
     int direction[3];
     for (int axis = 0; axis < 3; ++axis) {
@@ -139,6 +158,20 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
                     values[i] = sign * lowest;
                     bound[i] = lowest;
                     continue;
+                }
+                if (useUpper) {
+                    const double tx = weight(0, at.x), ty = weight(1, at.y), tz = weight(2, at.z);
+                    const auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
+                    const double y0 =
+                        lerp(lerp(upper[0], upper[1], tx), lerp(upper[2], upper[3], tx), ty);
+                    const double y1 =
+                        lerp(lerp(upper[4], upper[5], tx), lerp(upper[6], upper[7], tx), ty);
+                    const double above = lerp(y0, y1, tz); // f(sample) <= above
+                    if (above < -(band + limits.margin)) {
+                        values[i] = above;
+                        bound[i] = -above;
+                        continue;
+                    }
                 }
                 values[i] = evaluate(i);
                 bound[i] = std::abs(values[i]);

@@ -36,6 +36,8 @@ struct LeafBand {
     double step = 0.0; //!< the grid spacing, rounded up by the evaluator's margin
     //! By squared offset between two samples of a leaf (in samples): their distance, rounded up.
     const std::vector<double>& reach;
+    //! The evaluator's rounding margin (world units), kept between a bound and the band.
+    double margin = 0.0;
 };
 
 //! The leaf's values where its pruned list holds exact distances only; returns the samples
@@ -49,8 +51,10 @@ struct LeafBand {
 //! are then visited in scan order, each
 //! axis swept away from the corners of larger |value| (outside in), and take the best of the
 //! corners' balls and of their three neighbours one spacing back along the sweep (chained
-//! through skipped samples). Evaluated samples run the same ops in the same order as the
-//! edit-major loop, so every value stays bit-identical.
+//! through skipped samples). Where the pruned list is one convex primitive
+//! (isSingleConvexPrimitive) a sample is also proven inside by its corners: a convex field lies
+//! below the trilinear interpolation of its corner values. Evaluated samples run the same ops in
+//! the same order as the edit-major loop, so every value stays bit-identical.
 //!
 //! `n` is the leaf's sample count per axis; positions and values are in x-fastest order, values
 //! filled with the exact value of the evaluated samples and +-(a bound above the band) for the

@@ -289,6 +289,77 @@ TEST(SdfEvaluator, LeavesProveTheirOutOfBandSamplesWhicheverSideTheSurfaceFaces)
     }
 }
 
+TEST(SdfEvaluator, ConvexPrimitivesProveTheirInsideSamplesByTheirCorners)
+{
+    // One convex primitive (exact distance) tilted against the grid: its field is convex, so a
+    // leaf's samples lie below the trilinear interpolation of its corner values, which proves
+    // samples inside a tilted face that the Lipschitz bounds leave to evaluation. Values stay
+    // bit-identical to brute force. Samples evaluated out of the band on this grid, measured
+    // without that bound and with it: box 13,832 -> 10,867, rounded box 12,791 -> 10,064,
+    // cylinder 13,046 -> 10,341, cone 8,847 -> 7,178, capsule 8,109 -> 6,618, sphere 13,827 ->
+    // 10,926 (0.78-0.82x). The expectation, at most 0.9x the count without the bound, fails if the
+    // bound stops proving and leaves room for small changes of the other bounds.
+    const GridSpec grid = makeCubeGrid(-1.0, 1.0, 96);
+    const glm::dquat tilt = glm::angleAxis(0.52, glm::normalize(glm::dvec3(1, 1, 0))) *
+                            glm::angleAxis(0.35, glm::dvec3(0, 0, 1));
+    struct Case {
+        CsgShape shape;
+        glm::dvec3 size;
+        double rounding;
+        std::uint64_t outOfBandWithout; // measured without the corners' bound
+    };
+    const Case cases[] = {
+        {CsgShape::Box, glm::dvec3(0.45, 0.5, 0.4), 0.0, 13832},
+        {CsgShape::RoundedBox, glm::dvec3(0.45, 0.5, 0.4), 0.1, 12791},
+        {CsgShape::Cylinder, glm::dvec3(0.45, 0.55, 0.0), 0.0, 13046},
+        {CsgShape::Cone, glm::dvec3(0.5, 0.6, 0.0), 0.0, 8847},
+        {CsgShape::Capsule, glm::dvec3(0.3, 0.4, 0.0), 0.0, 8109},
+        {CsgShape::Sphere, glm::dvec3(0.6), 0.0, 13827},
+    };
+    for (const Case& c : cases) {
+        SdfModel m;
+        m.name = scene::toString(c.shape);
+        CsgEdit e;
+        e.shape = c.shape;
+        e.size = c.size;
+        e.rounding = c.rounding;
+        e.rotation = tilt;
+        e.center = glm::dvec3(0.03, -0.02, 0.01);
+        m.edits.push_back(e);
+        EvaluationOptions o;
+        o.computeHermite = false;
+        const EvaluationResult r = evaluateModel(m, grid, kAllFrames, o);
+        ASSERT_GE(r.stats.samplesEvaluated, r.stats.samplesInBand) << m.name;
+        EXPECT_LE(double(r.stats.samplesEvaluated - r.stats.samplesInBand),
+                  0.9 * double(c.outOfBandWithout))
+            << m.name;
+        expectMatchesBruteForce(m, grid, kAllFrames, o, m.name);
+        // With Hermite data (the cells' lists exact one sample further) too.
+        o.computeHermite = true;
+        expectMatchesBruteForce(m, grid, kAllFrames, o, m.name + ", Hermite");
+    }
+    // A torus is not convex and the subtraction of a convex shape is concave: the bound is not
+    // used there, and the values stay exact.
+    SdfModel torus;
+    torus.name = "torus";
+    CsgEdit t;
+    t.shape = CsgShape::Torus;
+    t.size = glm::dvec3(0.5, 0.2, 0.0);
+    t.rotation = tilt;
+    torus.edits.push_back(t);
+    expectMatchesBruteForce(torus, grid, kAllFrames, {}, "torus");
+    SdfModel hollow = torus;
+    hollow.name = "box minus sphere";
+    hollow.edits[0].shape = CsgShape::Box;
+    hollow.edits[0].size = glm::dvec3(0.7);
+    CsgEdit hole;
+    hole.shape = CsgShape::Sphere;
+    hole.op = CsgOp::Subtract;
+    hole.size = glm::dvec3(0.5);
+    hollow.edits.push_back(hole);
+    expectMatchesBruteForce(hollow, grid, kAllFrames, {}, "box minus sphere");
+}
+
 TEST(SdfEvaluator, PrimitiveBoundsContainValues)
 {
     std::mt19937 rng(7);
