@@ -1,5 +1,6 @@
 #include "sdf/leaf_bounds.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace rtlab::sdf::detail {
@@ -76,6 +77,7 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
         if (!proven) {
             values[i] = evaluate(i);
             bound[i] = std::abs(values[i]);
+            known[i] = 2; // exact
             ++evaluated;
         }
         provenOutside = provenOutside || (proven && values[i] > 0.0);
@@ -89,7 +91,8 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
     // stored -bound >= f; one proved outside gives no upper bound, and then nothing is proven
     // this way. This proves the samples inside a face tilted against the grid, which the
     // Lipschitz balls and one-spacing chains leave to evaluation (csg_gallery's rotated cube).
-    const bool useUpper = !provenOutside && isSingleConvexPrimitive(ops);
+    const bool convex = isSingleConvexPrimitive(ops);
+    const bool useUpper = convex && !provenOutside;
     std::array<double, 8> upper{};
     for (int k = 0; k < 8; ++k)
         upper[std::size_t(k)] = values[std::size_t((k & 1) ? n.x - 1 : 0) * strides[0] +
@@ -173,8 +176,32 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
                         continue;
                     }
                 }
+                if (convex) {
+                    // Along a sweep axis, a convex field lies above the line through the two
+                    // exact samples behind: f(i) >= 2 f(i - 1) - f(i - 2). Where a face is
+                    // tilted this proves the samples outside it that a whole spacing's
+                    // Lipschitz step leaves to evaluation.
+                    double below = -kInf; // f(sample) >= below
+                    for (int axis = 0; axis < 3; ++axis) {
+                        if (sweep[axis] < 2)
+                            continue;
+                        glm::ivec3 back = at;
+                        back[axis] -= direction[axis];
+                        const std::size_t j1 = index(back);
+                        back[axis] -= direction[axis];
+                        const std::size_t j2 = index(back);
+                        if (known[j1] == 2 && known[j2] == 2)
+                            below = std::max(below, 2.0 * values[j1] - values[j2]);
+                    }
+                    if (below > band + limits.margin) {
+                        values[i] = below;
+                        bound[i] = below;
+                        continue;
+                    }
+                }
                 values[i] = evaluate(i);
                 bound[i] = std::abs(values[i]);
+                known[i] = 2;
                 ++evaluated;
             }
     return evaluated;

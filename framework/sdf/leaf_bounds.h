@@ -52,8 +52,9 @@ struct LeafBand {
 //! axis swept away from the corners of larger |value| (outside in), and take the best of the
 //! corners' balls and of their three neighbours one spacing back along the sweep (chained
 //! through skipped samples). Where the pruned list is one convex primitive
-//! (isSingleConvexPrimitive) a sample is also proven inside by its corners: a convex field lies
-//! below the trilinear interpolation of its corner values. Evaluated samples run the same ops in
+//! (isSingleConvexPrimitive) the field is convex: it lies below the trilinear interpolation of
+//! the corner values (proving samples inside) and above the line through two exact samples
+//! behind a sample along the sweep (proving samples outside). Evaluated samples run the same ops in
 //! the same order as the edit-major loop, so every value stays bit-identical.
 //!
 //! `n` is the leaf's sample count per axis; positions and values are in x-fastest order, values

@@ -292,13 +292,15 @@ TEST(SdfEvaluator, LeavesProveTheirOutOfBandSamplesWhicheverSideTheSurfaceFaces)
 TEST(SdfEvaluator, ConvexPrimitivesProveTheirInsideSamplesByTheirCorners)
 {
     // One convex primitive (exact distance) tilted against the grid: its field is convex, so a
-    // leaf's samples lie below the trilinear interpolation of its corner values, which proves
-    // samples inside a tilted face that the Lipschitz bounds leave to evaluation. Values stay
-    // bit-identical to brute force. Samples evaluated out of the band on this grid, measured
-    // without that bound and with it: box 13,832 -> 10,867, rounded box 12,791 -> 10,064,
-    // cylinder 13,046 -> 10,341, cone 8,847 -> 7,178, capsule 8,109 -> 6,618, sphere 13,827 ->
-    // 10,926 (0.78-0.82x). The expectation, at most 0.9x the count without the bound, fails if the
-    // bound stops proving and leaves room for small changes of the other bounds.
+    // leaf's samples lie below the trilinear interpolation of its corner values (proving samples
+    // inside a tilted face) and above the line through two exact samples behind them along a
+    // sweep (outside it), where the Lipschitz bounds leave them to evaluation. Values stay
+    // bit-identical to brute force. Samples evaluated out of the band on this grid, without the
+    // convex bounds, with the corners' bound alone, and with both: box 13,832 / 10,867 / 10,396,
+    // rounded box 12,791 / 10,064 / 9,633, cylinder 13,046 / 10,341 / 9,850, cone 8,847 / 7,178 /
+    // 6,806, capsule 8,109 / 6,618 / 6,290, sphere 13,827 / 10,926 / 10,357 (0.75-0.78x with
+    // both). The expectation, at most 0.9x the count without them, fails if the corners' bound
+    // stops proving and leaves room for small changes of the other bounds.
     const GridSpec grid = makeCubeGrid(-1.0, 1.0, 96);
     const glm::dquat tilt = glm::angleAxis(0.52, glm::normalize(glm::dvec3(1, 1, 0))) *
                             glm::angleAxis(0.35, glm::dvec3(0, 0, 1));
