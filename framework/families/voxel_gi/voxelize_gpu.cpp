@@ -56,11 +56,12 @@ std::filesystem::path VoxelizerGpu::getShaderDir()
                               std::filesystem::path(RTLAB_VOXEL_GI_SHADER_DIR));
 }
 
-gpu::Buffer& VoxelizerGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name)
+gpu::Buffer& VoxelizerGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name,
+                                   bool hostVisible)
 {
     bytes = std::max<std::size_t>(bytes, 16);
     if (!buffer.isValid() || buffer.getSize() < bytes)
-        buffer = mContext->createBuffer({bytes, name});
+        buffer = mContext->createBuffer({.size = bytes, .name = name, .hostVisible = hostVisible});
     return buffer;
 }
 
@@ -190,10 +191,12 @@ VoxelGrid VoxelizerGpu::voxelize(gpu::Context& context, const scene::RenderScene
     reserve(mCounts, voxels * 9 * sizeof(std::uint32_t), "voxelize.counts");
     reserve(mFaceSums, voxels * kFaceCount * 2 * sizeof(glm::vec4), "voxelize.face_sums");
     reserve(mNormalSums, voxels * 3 * sizeof(glm::vec4), "voxelize.normal_sums");
-    reserve(mStats, 4 * sizeof(std::uint32_t), "voxelize.stats");
-    reserve(mFaces, voxels * kFaceCount * sizeof(glm::vec4), "voxelize.faces");
-    reserve(mEmission, voxels * kFaceCount * sizeof(glm::vec4), "voxelize.emission");
-    reserve(mNormals, voxels * sizeof(glm::vec4), "voxelize.normals");
+    // Written once by the resolve and read back: host-visible. The accumulators above take the
+    // atomics and the inputs are read once per ray of the columns: device memory.
+    reserve(mStats, 4 * sizeof(std::uint32_t), "voxelize.stats", true);
+    reserve(mFaces, voxels * kFaceCount * sizeof(glm::vec4), "voxelize.faces", true);
+    reserve(mEmission, voxels * kFaceCount * sizeof(glm::vec4), "voxelize.emission", true);
+    reserve(mNormals, voxels * sizeof(glm::vec4), "voxelize.normals", true);
 
     ColumnConstants columnConstants;
     columnConstants.size = {R, S, options.solid ? 1 : 0, 0};

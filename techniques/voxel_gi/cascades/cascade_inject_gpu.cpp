@@ -29,11 +29,12 @@ constexpr int kFieldsPerFace = 3; // (emission, occupancy), direct, first bounce
 
 } // namespace
 
-gpu::Buffer& CascadeInjectGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name)
+gpu::Buffer& CascadeInjectGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name,
+                                       bool hostVisible)
 {
     bytes = std::max<std::size_t>(bytes, 16);
     if (!buffer.isValid() || buffer.getSize() < bytes)
-        buffer = mContext->createBuffer({bytes, name});
+        buffer = mContext->createBuffer({.size = bytes, .name = name, .hostVisible = hostVisible});
     return buffer;
 }
 
@@ -83,7 +84,7 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
     }
     const glm::dvec3 anchor = getGpuAnchor(volume);
     const std::vector<GpuCascadeLevel> levels = describeGpuLevels(volume, anchor, false);
-    reserve(mLevels, levels.size() * sizeof(GpuCascadeLevel), "cascades.inject.levels")
+    reserve(mLevels, levels.size() * sizeof(GpuCascadeLevel), "cascades.inject.levels", true)
         .uploadSpan<GpuCascadeLevel>(levels);
     // The light buffers of the levels that changed since they went up.
     std::vector<glm::vec4> packed;
@@ -113,11 +114,13 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
         voxels[2 * s] = glm::vec4(glm::vec3(level.region.getVoxelCentre(x, y, z) - anchor), 0.0f);
         voxels[2 * s + 1] = glm::vec4(level.grid.normal[v], 0.0f);
     }
-    reserve(mVoxels, voxels.size() * sizeof(glm::vec4), "cascades.inject.voxels").uploadSpan<glm::vec4>(voxels);
+    reserve(mVoxels, voxels.size() * sizeof(glm::vec4), "cascades.inject.voxels", true)
+        .uploadSpan<glm::vec4>(voxels);
     std::vector<glm::vec4> sky(kConeCount, glm::vec4(0.0f));
     for (int k = 0; k < kConeCount; ++k)
         sky[std::size_t(k)] = glm::vec4(lights.skyPerCone[std::size_t(k)], 0.0f);
-    reserve(mSky, sky.size() * sizeof(glm::vec4), "cascades.inject.sky").uploadSpan<glm::vec4>(sky);
+    reserve(mSky, sky.size() * sizeof(glm::vec4), "cascades.inject.sky", true)
+        .uploadSpan<glm::vec4>(sky);
     std::vector<glm::vec4> pointLights;
     if (lights.pointLights != nullptr)
         for (const scene::PointLight& l : *lights.pointLights) {
@@ -125,12 +128,14 @@ void CascadeInjectGpu::gatherIrradiance(gpu::Context& context, const CascadeVolu
             pointLights.emplace_back(l.intensity, 0.0f);
         }
     if (!pointLights.empty())
-        reserve(mLights, pointLights.size() * sizeof(glm::vec4), "cascades.inject.lights")
+        reserve(mLights, pointLights.size() * sizeof(glm::vec4), "cascades.inject.lights", true)
             .uploadSpan<glm::vec4>(pointLights);
     else
-        reserve(mLights, 16, "cascades.inject.lights");
+        reserve(mLights, 16, "cascades.inject.lights", true);
     const std::size_t outCount = surface.size() * 3 * kFaceCount;
-    reserve(mOutput, outCount * sizeof(glm::vec4), "cascades.inject.irradiance");
+    // The per-call inputs above and this output cross the bus once: host-visible; the light
+    // fields, read by every cone step, stay in device memory.
+    reserve(mOutput, outCount * sizeof(glm::vec4), "cascades.inject.irradiance", true);
     mCounters.uploadBytes += voxels.size() * sizeof(glm::vec4) + sky.size() * sizeof(glm::vec4) +
                              pointLights.size() * sizeof(glm::vec4);
 

@@ -46,7 +46,10 @@ private:
     std::vector<std::uint64_t> mUploadedRevision; //!< per level: Level::lightRevision uploaded
     Counters mCounters;
 
-    gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name);
+    // A buffer of at least `bytes`; `hostVisible` for data that crosses the bus once per call
+    // (gpu::BufferDesc::hostVisible).
+    gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name,
+                         bool hostVisible = false);
 };
 
 } // namespace rtlab::voxelgi
