@@ -58,7 +58,7 @@ private:
 //! Where a gather's combine runs for `setting` "vulkan", "cpu" or "auto" (without a device, in
 //! C++). "auto": on Vulkan when the cones were traced there and the device is a GPU; in C++ when
 //! they were traced in C++ or the device is a CPU implementation such as lavapipe, where the C++
-//! combine is the faster (at 1280x720 on 2 cores: 78 against 249 ms, and 92 against 805 ms with
+//! combine is the faster (at 1280x720 on 2 cores: 62 against 232-240 ms, and 77 against 808 ms with
 //! 10 capsules; cone_combine_gpu_test's DISABLED_Timing).
 bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu,
                         std::string_view setting = "auto");

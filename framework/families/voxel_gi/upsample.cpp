@@ -8,6 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -96,16 +97,21 @@ int findUpsampleSamples(const ReducedGBuffer& reduced, const scene::GBuffer& ful
     const float d = std::isfinite(full.depth.at(x, y)) ? full.depth.at(x, y) : 1.0f;
     // Geometric similarity of low-resolution sample s to the pixel: distance of s from the
     // pixel's tangent plane against 2 % of the view depth, and the normals' agreement (cos^8).
+    // The reduced G-buffer holds each representative's position and normal (reduceGBuffer
+    // copies them), so they are read there, contiguously and without dividing the pixel index.
     const auto similarity = [&](int s) {
-        const int r = reduced.representative[std::size_t(s)];
-        if (r < 0)
+        if (reduced.representative[std::size_t(s)] < 0)
             return 0.0f;
-        const int rx = r % full.width, ry = r / full.width;
         const float plane =
-            std::abs(glm::dot(n, full.position.at(rx, ry) - p)) / std::max(0.02f * d, 1e-6f);
-        const float c = std::max(0.0f, glm::dot(n, full.normal.at(rx, ry)));
+            std::abs(glm::dot(n, reduced.gbuffer.position.pixels[std::size_t(s)] - p)) /
+            std::max(0.02f * d, 1e-6f);
+        const float c = std::max(0.0f, glm::dot(n, reduced.gbuffer.normal.pixels[std::size_t(s)]));
         const float c2 = c * c, c4 = c2 * c2;
-        return std::exp(-plane * plane) * c4 * c4;
+        // expf is exactly 0 below -103.98 (under the smallest denormal); libm reaches that
+        // through its slow underflow path, a tenth of the combine's time on a scene of
+        // silhouettes, so it is skipped there (the same value).
+        const float q = plane * plane;
+        return (q < 104.0f ? std::exp(-q) : 0.0f) * c4 * c4;
     };
     if (f == 1) {
         samples[0] = y * lw + x;
@@ -330,14 +336,22 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
                 near.push_back(entry);
             }
             const auto w = computeIrradianceWeights(cones, n);
+            // Each cone's radiance upsampled: the samples' 16 cones are contiguous, so they are
+            // read sample by sample (the same sums, in the same order, per cone).
+            std::array<glm::dvec3, kConeCount> upsampled{};
+            for (int s = 0; s < count; ++s) {
+                const glm::vec3* row =
+                    in.coneRadiance->data() + std::size_t(samples[s]) * kConeCount;
+                const double ws = double(weights[s]);
+                for (int k = 0; k < kConeCount; ++k)
+                    if (w[std::size_t(k)] != 0.0)
+                        upsampled[std::size_t(k)] += ws * glm::dvec3(row[k]);
+            }
             glm::dvec3 e(0.0);
             for (int k = 0; k < kConeCount; ++k) {
                 if (w[std::size_t(k)] == 0.0)
                     continue;
-                glm::dvec3 radiance(0.0);
-                for (int s = 0; s < count; ++s)
-                    radiance += double(weights[s]) *
-                                glm::dvec3((*in.coneRadiance)[std::size_t(samples[s]) * kConeCount + std::size_t(k)]);
+                const glm::dvec3& radiance = upsampled[std::size_t(k)];
                 double visible = 1.0;
                 if (useVisibility)
                     visible = std::clamp(double((*in.visibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
