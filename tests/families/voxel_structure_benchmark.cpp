@@ -25,8 +25,10 @@
 //
 //   build/tests/families/voxel_structure_benchmark [--benchmark_filter=<regex>]
 //   build/tests/families/voxel_structure_benchmark --quick   # cornell_box at 32 and 64 (ctest)
-// Counters: voxels (active), topology_B (bytes per active voxel), payload_B, total_B, and
-// items_per_second = lookups per second for the lookup rows (ns per lookup = 1e9 / it).
+// Counters: voxels (active), topology_B (bytes per active voxel), payload_B, total_B,
+// mask_floor_B (adaptive_voxel_tree: its child masks at their combinatorial minimum, the part of
+// the topology no per-node mask code goes below), and items_per_second = lookups per second for
+// the lookup rows (ns per lookup = 1e9 / it).
 
 #include "sparse_voxel_octree.h" // techniques/voxel_gi/svo
 #include "voxel_tree.h"          // techniques/voxel_gi/adaptive_voxel_tree
@@ -41,6 +43,7 @@
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -120,6 +123,8 @@ public:
     virtual double lookupRandom(const std::vector<glm::ivec3>& q) const = 0;
     virtual double lookupCoherent(const std::vector<glm::ivec3>& q) const { return lookupRandom(q); }
     virtual bool canLookup() const { return true; }
+    //! Bytes of the child masks at their combinatorial minimum (NaN: no child masks).
+    virtual double getMaskFloorBytes() const { return std::nan(""); }
 };
 
 class DenseGrid final : public Structure {
@@ -204,6 +209,19 @@ public:
             sum += i >= 0 ? mPayload[std::size_t(i)].x : 0.0f;
         }
         return sum;
+    }
+    // A node with k of its 64 children present is one of C(64, k) masks: a code that knows k
+    // and nothing of the pattern spends log2 C(64, k) bits on it at best. The tree stores each
+    // mask as 64 bits (the talk's node, for a popcount per child lookup).
+    double getMaskFloorBytes() const override
+    {
+        double bits = 0.0;
+        for (const voxelgi::VoxelTreeNode& node : mTree.getNodes()) {
+            const int k = std::popcount(node.getMask());
+            bits +=
+                (std::lgamma(65.0) - std::lgamma(k + 1.0) - std::lgamma(65.0 - k)) / std::log(2.0);
+        }
+        return bits / 8.0;
     }
 
 private:
@@ -356,6 +374,8 @@ void setMemoryCounters(benchmark::State& state, const Structure& s, const Voxels
     state.counters["topology_B"] = double(f.topologyBytes) / n;
     state.counters["payload_B"] = double(f.payloadBytes) / n;
     state.counters["total_B"] = double(f.topologyBytes + f.payloadBytes) / n;
+    if (const double floor = s.getMaskFloorBytes(); !std::isnan(floor))
+        state.counters["mask_floor_B"] = floor / n;
 }
 
 void runBuild(benchmark::State& state, const std::string& sceneName, int resolution, const std::string& name)
