@@ -472,7 +472,7 @@ void CascadeVolume::updateCombined(Level& level)
                 const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, d[axis]));
                 c += w * glm::vec4(getGatheredLight(level, f), level.alpha[f]);
             }
-            level.combined[vox * kConeCount + std::size_t(k)] = c;
+            level.combined[std::size_t(k) * voxels + vox] = c;
         }
     });
 }
@@ -582,6 +582,9 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
     std::array<double, 8> weights;
     getTrilinear(level.region, p, voxels, weights);
     const bool combined = gathered && cone >= 0 && !level.combined.empty();
+    const glm::vec4* coneRow =
+        combined ? level.combined.data() + std::size_t(cone) * (level.combined.size() / kConeCount)
+                 : nullptr;
     for (int corner = 0; corner < 8; ++corner) {
         const double w = weights[std::size_t(corner)];
         if (w == 0.0)
@@ -589,7 +592,7 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
         const float fw = float(w) * weight;
         const std::size_t vox = voxels[std::size_t(corner)];
         if (combined) {
-            const glm::vec4& v = level.combined[vox * kConeCount + std::size_t(cone)];
+            const glm::vec4& v = coneRow[vox];
             out.alpha += fw * v.a;
             out.light[kDirect] += fw * glm::vec3(v);
             continue;

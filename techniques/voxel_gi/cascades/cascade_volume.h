@@ -63,7 +63,10 @@ public:
         VoxelGrid grid;
         std::vector<float> alpha;                                //!< [voxel * 6 + face]
         std::array<std::vector<glm::vec3>, kFieldCount> light;   //!< [voxel * 6 + face], premultiplied
-        std::vector<glm::vec4> combined; //!< [voxel * 16 + cone]: alpha, premultiplied gathered light
+        //! [cone * voxels + voxel]: alpha, premultiplied gathered light. Cone-major, so that a
+        //! trilinear sample's x neighbours share a cache line and a GPU warp marching one cone
+        //! from neighbouring pixels reads neighbouring entries.
+        std::vector<glm::vec4> combined;
         std::string geometryKey;         //!< of the voxelized geometry
         bool voxelized = false;
         std::uint64_t voxelStamp = 0; //!< when it was last voxelized (CascadeVolume's counter)

@@ -42,7 +42,9 @@ vec4 sampleLevel(int level, vec3 p, int cone)
     ivec3 i0;
     vec3 t;
     getTrilinear(level, p, R, i0, t);
-    const uint base = uint(level) * uint(R) * uint(R) * uint(R);
+    // Each level's buffer is cone-major ([cone][voxel], CascadeVolume::Level::combined).
+    const uint levelVoxels = uint(R) * uint(R) * uint(R);
+    const uint base = (uint(level) * 16u + uint(cone)) * levelVoxels;
     vec4 acc = vec4(0.0);
     for (int corner = 0; corner < 8; ++corner) {
         ivec3 d;
@@ -50,8 +52,7 @@ vec4 sampleLevel(int level, vec3 p, int cone)
         if (w == 0.0)
             continue;
         const ivec3 v = i0 + d;
-        const uint voxel = base + uint(v.x + R * (v.y + R * v.z));
-        acc += w * combined[voxel * 16u + uint(cone)];
+        acc += w * combined[base + uint(v.x + R * (v.y + R * v.z))];
     }
     return acc;
 }
