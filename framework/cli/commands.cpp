@@ -378,6 +378,10 @@ int reportCommand(const std::string& resultsDirectory, int timeFromFrame)
             report::writeStudyReport(resultsDirectory, plugin::builtinRegistry(), timeFromFrame);
         fmt::print("report: {} ({} plots in {}/plots, each .png and .pdf)\n", s.html,
                    s.plots.size(), resultsDirectory);
+        if (s.equalErrorRuns > 0)
+            fmt::print(
+                "equal-error speed-ups: {} ({} runs against their family's sampling baseline)\n",
+                s.equalError, s.equalErrorRuns);
         return kExitOk;
     } catch (const std::exception& e) {
         fmt::print(stderr, "rtlab report: {}\n", e.what());

@@ -107,6 +107,11 @@ struct FamilyReport {
     bool convergence = false; //!< error against cell size with fitted order (grid sweeps)
     std::vector<HistogramFigure> histograms; //!< per-technique histograms
     std::vector<AcrossScenesFigure> acrossScenes; //!< figures over all scenes of the study
+    //! The family's sampling baseline: a technique of its own that converges to the ground truth
+    //! as its sample count grows (Embree path tracing, ray-traced AO). Where a study has its
+    //! runs, the report gives every other run the baseline's time at the same error and the
+    //! speed-up (report_detail.h computeEqualError, equal_error.csv); empty for none.
+    std::string baseline;
 };
 
 } // namespace rtlab::plugin

@@ -119,6 +119,37 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
             h << "<td>" << r->frames.size() << "</td></tr>\n";
         }
         h << "</table></div>\n";
+        // The family's sampling baseline at the same error as each run.
+        const std::vector<EqualErrorRow> equal = computeEqualError(g);
+        if (!equal.empty()) {
+            h << "<h3>Equal-error speed-up against " << escapeHtml(columns.baseline)
+              << "</h3>\n<p>The baseline's time at each run's " << escapeHtml(columns.error)
+              << ": log time interpolated in log error between the two "
+              << escapeHtml(columns.baseline)
+              << " runs of its Pareto front around it (same ground truth), and the cheapest "
+              << escapeHtml(columns.baseline)
+              << " run whose error is at most the run's. Also in <a "
+                 "href=\"equal_error.csv\">equal_error.csv</a>.</p>\n"
+                 "<div "
+                 "class=\"scroll\"><table><tr><th>run</th><th>technique</th><th>parameters</th><th>"
+              << escapeHtml(columns.cost) << "</th><th>" << escapeHtml(columns.error)
+              << "</th><th>baseline at equal error (ms)</th><th>speed-up</th><th>cheapest baseline "
+                 "run "
+                 "reaching it</th><th>its time (ms)</th><th>speed-up against "
+                 "it</th><th>note</th></tr>\n";
+            for (const EqualErrorRow& e : equal)
+                h << "<tr><td>" << escapeHtml(e.run->runId) << "</td><td>"
+                  << escapeHtml(e.run->technique) << "</td><td>"
+                  << escapeHtml(describeEqualErrorRun(*e.run, g)) << "</td><td>"
+                  << formatNumber(e.time) << "</td><td>" << formatNumber(e.error) << "</td><td>"
+                  << formatNumber(e.baselineTime) << "</td><td>" << formatNumber(e.speedup)
+                  << "</td><td>"
+                  << (e.cheapest ? escapeHtml(describeEqualErrorRun(*e.cheapest, g)) : "")
+                  << "</td><td>" << (e.cheapest ? formatNumber(e.cheapest->get(columns.cost)) : "")
+                  << "</td><td>" << formatNumber(e.cheapestSpeedup) << "</td><td>"
+                  << escapeHtml(e.note) << "</td></tr>\n";
+            h << "</table></div>\n";
+        }
     }
     h << "<h2>Manifest</h2>\n<pre>" << escapeHtml(manifestJson.substr(0, 20000)) << "</pre>\n</body></html>\n";
 

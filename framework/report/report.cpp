@@ -350,6 +350,9 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
     } catch (const std::exception&) {
         manifest = "{}";
     }
+    summary.equalError = detail::writeEqualErrorCsv(directory, groups);
+    for (const auto& g : groups)
+        summary.equalErrorRuns += int(detail::computeEqualError(g).size());
     detail::writeHtml(directory, groups, figures, manifest);
     summary.html = directory + "/report.html";
     return summary;

@@ -12,6 +12,8 @@
 //   <dir>/plots/images_<scene>.png|pdf          reference | each technique's best run | error maps,
 //                                               with zoomed crops (screen-space families)
 //   <dir>/runs/<id>/frame<k>/*.png               each run's output, reference and error heat map
+//   <dir>/equal_error.csv                       each run against its family's sampling baseline at
+//                                               the same error (FamilyReport::baseline)
 //   <dir>/report.html                           one page: plots, image grids, tables, manifest
 
 #include "plugin/technique.h"
@@ -32,6 +34,8 @@ FamilyColumns getFamilyColumns(const plugin::Registry& registry, const std::stri
 struct ReportSummary {
     std::vector<std::string> plots;  //!< PNG paths written
     std::string html;                //!< the report's path
+    std::string equalError;          //!< equal_error.csv (the family baselines' speed-ups)
+    int equalErrorRuns = 0;          //!< its rows: runs compared with a baseline
 };
 
 //! Writes the plots and report.html of the study in `directory`, with the figures and columns

@@ -71,6 +71,32 @@ MatchedLines collectMatchedLines(const std::vector<RunSummary>& runs, const std:
                                  const std::string& errorColumn, const std::vector<std::string>& varyingParams,
                                  std::size_t maxLinesPerTechnique);
 
+//! A run against the family's sampling baseline (FamilyReport::baseline) at equal error: the
+//! baseline's time at the run's error, from the baseline runs of the same group that measure
+//! the same ground truth (equal `reference.*` settings: quantity, radius, bounces, ...).
+struct EqualErrorRow {
+    const RunSummary* run = nullptr;
+    double time = 0.0, error = 0.0; //!< the run's cost and error columns
+    //! The baseline's time at `error`: log time interpolated linearly in log error between the
+    //! two runs of the baseline's Pareto front that bracket it; NaN outside the front.
+    double baselineTime = 0.0;
+    double speedup = 0.0; //!< baselineTime / time
+    //! The cheapest baseline run whose error is at most `error` (null for none) and its time over
+    //! the run's: a speed-up the discrete sample counts can only overstate.
+    const RunSummary* cheapest = nullptr;
+    double cheapestSpeedup = 0.0;
+    std::string note; //!< why baselineTime is NaN, else empty
+};
+//! Every run of `group` that is not the baseline and has a finite, positive time and error,
+//! fastest speed-up first (NaN speed-ups last); empty without baseline runs.
+std::vector<EqualErrorRow> computeEqualError(const Group& group);
+//! A run's varying parameters, with its camera path and frame count where the group's runs
+//! differ in them (the equal-error table's "parameters").
+std::string describeEqualErrorRun(const RunSummary& run, const Group& group);
+//! directory/equal_error.csv: computeEqualError of every group, one line per row (a header
+//! only when no group has baseline runs). Returns its path.
+std::string writeEqualErrorCsv(const std::string& directory, const std::vector<Group>& groups);
+
 struct Figures {
     std::vector<std::string> plots;     //!< paths without extension
     std::vector<std::string> captions;  //!< one per plot

@@ -687,6 +687,7 @@ plugin::FamilyInfo describeOcclusionFamily()
                          "ao_thin.rmse", "ao_border.rmse", "bent.angle_error_deg",
                          "cone.aperture_abs_error_deg", "screen_truth.rmse",
                          "ao_vs_screen_truth.rmse", "flicker.rms"},
+        .baseline = "raytraced_ao",
     };
     info.runtime = std::make_shared<OcclusionFamily>();
     info.stressCases = occlusion::makeOcclusionStressCases;

@@ -531,53 +531,53 @@ plugin::FamilyInfo describeVoxelGiFamily()
                               "and light buffers)"}},
     };
     info.domain = plugin::FamilyDomain::Screen;
-    info.report = {.cost = "technique_ms",
-                   .costLabel = "time of voxelize + light injection + gather (ms, CPU; "
-                                "a bake excluded)",
-                   .error = "indirect.rmse",
-                   .errorLabel = "RMSE of indirect irradiance against ground truth",
-                   .passes = {"voxelize_ms", "light_injection_ms", "voxel_gather_ms"},
-                   .passTimeLabel = "time (ms, CPU)",
-                   .extraErrors = {{"indirect.flip", "HDR-FLIP of indirect irradiance"},
-                                   {"indirect.rel_mse", "relative MSE of indirect irradiance"},
-                                   {"indirect.gradient_excess",
-                                    "discontinuity: RMS error of neighbour differences above "
-                                    "the reference's noise"},
-                                   {"indirect.transition_gradient_rmse",
-                                    "level transitions: RMS error of neighbour differences "
-                                    "across a change of lookup level"},
-                                   {"indirect_flicker.rms",
-                                    "flicker: RMS frame-to-frame change of the indirect error"}},
-                   .paramErrors = {{"indirect.transition_ratio",
-                                    "level transitions: neighbour-difference error across / "
-                                    "within a level (1: not visible)"}},
-                   .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse",
-                                    "indirect.flip", "indirect.transition_ratio",
-                                    "split.cone_rmse", "split.voxel_rmse",
-                                    "split.voxel_mean_signed_error", "memory.payload_bytes",
-                                    "counter.surface_voxels", "counter.steps_per_cone"},
-                   .acrossScenes = {
-                       {.x = "scene.wall_voxels",
-                        .xLabel = "wall thickness (level-0 voxels)",
-                        .y = "indirect.mean_signed_error",
-                        .yLabel = "mean indirect irradiance inside (truth 0)",
-                        .name = "voxel_gi_leak",
-                        .title = "leak test: light inside a closed room lit from outside",
-                        .caption = "Leak test (scenes/leak_room_*.yaml): a closed room lit only "
-                                   "from outside; the ground truth inside is 0, so the mean "
-                                   "indirect irradiance there is light that leaked through walls "
-                                   "of the given thickness.",
-                        .seriesBy = {"param.anti_leak"}},
-                       {.x = "param.resolution",
-                        .xLabel = "resolution (cascades: voxels per level and axis; "
-                                  "adaptive_voxel_tree: leaves along the box)",
-                        .y = "memory.payload_bytes",
-                        .yLabel = "payload (bytes)",
-                        .name = "voxel_gi_memory",
-                        .title = "memory against resolution",
-                        .caption = "Memory of the structure (cascades' payload: volumetric "
-                                   "G-buffer, light and pre-combined buffers; the tree's: its "
-                                   "probes) against its resolution, every scene."}}};
+    info.report = {
+        .cost = "technique_ms",
+        .costLabel = "time of voxelize + light injection + gather (ms, CPU; "
+                     "a bake excluded)",
+        .error = "indirect.rmse",
+        .errorLabel = "RMSE of indirect irradiance against ground truth",
+        .passes = {"voxelize_ms", "light_injection_ms", "voxel_gather_ms"},
+        .passTimeLabel = "time (ms, CPU)",
+        .extraErrors = {{"indirect.flip", "HDR-FLIP of indirect irradiance"},
+                        {"indirect.rel_mse", "relative MSE of indirect irradiance"},
+                        {"indirect.gradient_excess",
+                         "discontinuity: RMS error of neighbour differences above "
+                         "the reference's noise"},
+                        {"indirect.transition_gradient_rmse",
+                         "level transitions: RMS error of neighbour differences "
+                         "across a change of lookup level"},
+                        {"indirect_flicker.rms",
+                         "flicker: RMS frame-to-frame change of the indirect error"}},
+        .paramErrors = {{"indirect.transition_ratio",
+                         "level transitions: neighbour-difference error across / "
+                         "within a level (1: not visible)"}},
+        .tableColumns = {"indirect.mean_signed_error", "indirect.rel_mse", "indirect.flip",
+                         "indirect.transition_ratio", "split.cone_rmse", "split.voxel_rmse",
+                         "split.voxel_mean_signed_error", "memory.payload_bytes",
+                         "counter.surface_voxels", "counter.steps_per_cone"},
+        .acrossScenes = {{.x = "scene.wall_voxels",
+                          .xLabel = "wall thickness (level-0 voxels)",
+                          .y = "indirect.mean_signed_error",
+                          .yLabel = "mean indirect irradiance inside (truth 0)",
+                          .name = "voxel_gi_leak",
+                          .title = "leak test: light inside a closed room lit from outside",
+                          .caption = "Leak test (scenes/leak_room_*.yaml): a closed room lit only "
+                                     "from outside; the ground truth inside is 0, so the mean "
+                                     "indirect irradiance there is light that leaked through walls "
+                                     "of the given thickness.",
+                          .seriesBy = {"param.anti_leak"}},
+                         {.x = "param.resolution",
+                          .xLabel = "resolution (cascades: voxels per level and axis; "
+                                    "adaptive_voxel_tree: leaves along the box)",
+                          .y = "memory.payload_bytes",
+                          .yLabel = "payload (bytes)",
+                          .name = "voxel_gi_memory",
+                          .title = "memory against resolution",
+                          .caption = "Memory of the structure (cascades' payload: volumetric "
+                                     "G-buffer, light and pre-combined buffers; the tree's: its "
+                                     "probes) against its resolution, every scene."}},
+        .baseline = "path_traced"};
     info.runtime = std::make_shared<VoxelGiFamily>();
     info.stressCases = voxelgi::makeVoxelGiStressCases;
     return info;
