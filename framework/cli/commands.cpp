@@ -380,7 +380,7 @@ int reportCommand(const std::string& resultsDirectory, int timeFromFrame)
                    s.plots.size(), resultsDirectory);
         if (s.equalErrorRuns > 0)
             fmt::print(
-                "equal-error speed-ups: {} ({} runs against their family's sampling baseline)\n",
+                "equal-error speed-ups: {} ({} run(s) against their family's sampling baseline)\n",
                 s.equalError, s.equalErrorRuns);
         return kExitOk;
     } catch (const std::exception& e) {
