@@ -110,8 +110,15 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
         const double dt = s.stepScale * sample.voxelSize;
         const double stepAlpha = std::min(1.0, std::max(0.0, double(sample.alpha)));
         if (stepAlpha > 0.0) {
-            const double corrected =
-                1.0 - std::pow(1.0 - std::min(stepAlpha, 0.999999), dt / sample.voxelSize);
+            // The opacity of a step of dt through voxels of opacity alpha per voxel size:
+            // 1 - (1 - alpha)^(dt / size). The exponent is the step scale (0.5 by default, where
+            // the power is a square root: correctly rounded, where glibc's pow differs from it by
+            // an ulp for 0.09 % of arguments, at a fraction of pow's time).
+            const double transparent = 1.0 - std::min(stepAlpha, 0.999999);
+            const double exponent = dt / sample.voxelSize;
+            const double corrected = 1.0 - (exponent == 0.5   ? std::sqrt(transparent)
+                                            : exponent == 1.0 ? transparent
+                                                              : std::pow(transparent, exponent));
             const double weight = (1.0 - occupied) * corrected / stepAlpha;
             for (int f = 0; f < kFieldCount; ++f)
                 r.light[std::size_t(f)] += float(weight) * sample.light[std::size_t(f)];

@@ -529,7 +529,11 @@ double CascadeVolume::selectLevel(const glm::dvec3& p, double diameter, bool noi
             continue;
         // A sphere inside the level, one voxel in from its faces (trilinear footprint).
         const double radius = (0.5 * level.region.resolution - 1.0) * level.region.voxelSize;
-        const double r = glm::length(p - level.centre) / radius;
+        const glm::dvec3 offset = p - level.centre;
+        const double d2 = glm::dot(offset, offset);
+        if (d2 > 1.001 * (radius * radius))
+            continue; // outside by more than rounding: the test below would fail too
+        const double r = std::sqrt(d2) / radius;
         if (r <= 1.0) {
             // From half the radius on, blend toward the next level ("Cascade selection"), with
             // the talk's "3D noise offset" on the blend (the containment test stays exact).
