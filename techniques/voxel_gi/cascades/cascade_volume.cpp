@@ -149,7 +149,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
             why = "culling off";
         else
             continue;
-        const Level old = std::move(level);
+        Level old = std::move(level);
         level = Level{};
         level.region = region;
         level.centre = region.origin + 0.5 * double(region.resolution) * region.voxelSize;
@@ -170,6 +170,20 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 glm::ivec3(glm::floor((old.changedMax - region.origin) / region.voxelSize)) + 2,
                 dugBegin, glm::ivec3(R));
         }
+        if (onlyEdited && old.region == region && glm::any(glm::lessThanEqual(dugEnd, dugBegin))) {
+            // The change lies outside the level: its voxels, and so its light, are what they were.
+            // The level is kept as it is (no new voxel stamp: the light injection and the finer
+            // levels that read it have nothing to redo).
+            level = std::move(old);
+            level.geometryKey = geometryKey;
+            level.changedMin = glm::dvec3(1e300);
+            level.changedMax = glm::dvec3(-1e300);
+            what +=
+                (what.empty() ? "" : "; ") + std::string("level ") + std::to_string(i) + ": " +
+                why +
+                ": the change lies outside the level, nothing re-voxelized (voxels and light kept)";
+            continue;
+        }
         if (onlyEdited) {
             // "Voxelize ... any geometry that has just appeared or been changed" (the dug region).
             level.grid = shiftVoxelGrid(old.grid, region, glm::ivec3(0));
@@ -184,9 +198,8 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 pasteVoxelBox(voxelizeRegion(region, options), dugBegin, dugEnd, level.grid);
                 finalizeVoxelGrid(level.grid);
             }
-            why += boxVoxels > 0 ? ": re-voxelized the changed region (" + std::to_string(boxVoxels) +
-                                       " of " + std::to_string(region.getVoxelCount()) + " voxels)"
-                                 : ": the change lies outside the level, nothing re-voxelized";
+            why += ": re-voxelized the changed region (" + std::to_string(boxVoxels) + " of " +
+                   std::to_string(region.getVoxelCount()) + " voxels)";
         } else if (onlyScrolled) {
             // Keep the voxels the old region shares with the new one and voxelize only the new
             // slabs ("Voxelize if Cascade level has moved": the geometry at the edges).

@@ -247,6 +247,51 @@ TEST(Cascades, AnEditReVoxelizesOnlyTheChangedRegionAndEqualsAFullVoxelization)
     expectSameVoxels(edited, fresh);
 }
 
+// An edit outside a level (a box moved 1.5 m out, beyond level 0's 1 m but inside level 1's 2 m)
+// leaves that level's voxels and light as they were: when it comes due it is neither
+// re-voxelized nor re-lit, while level 1 re-voxelizes the change and is re-lit.
+TEST(Cascades, AnEditOutsideALevelLeavesItsVoxelsAndLight)
+{
+    const auto makeScene = [](float x) {
+        scene::RenderScene s;
+        const auto m = addMaterial(s, glm::vec3(0.5f), glm::vec3(0.2f));
+        addBox(s, glm::vec3(-0.3f, -0.5f, -0.3f), glm::vec3(0.3f, -0.4f, 0.3f),
+               m); // a floor in level 0
+        addBox(s, glm::vec3(x, -0.4f, -0.1f), glm::vec3(x + 0.2f, -0.2f, 0.1f), m);
+        return s;
+    };
+    const scene::RenderScene before = makeScene(0.7f), after = makeScene(0.72f);
+    CascadeSettings settings = furnaceSettings();
+    settings.levels = 2;
+    settings.resolution = 16;
+    settings.voxelSize = 1.0 / 16.0;
+    settings.oneLevelPerFrame = true;
+    CascadeVolume volume(settings);
+    volume.voxelize(before, before.computeContentHash(), glm::dvec3(0.0), 0, false);
+    volume.injectLight(before, "l", 0, false);
+    const std::vector<glm::vec3> light0 = volume.getLevel(0).light[kDirect];
+    ASSERT_EQ(volume.getDueLevels(1), std::vector<int>{0});
+    EXPECT_EQ(volume.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 1, false),
+              "level 0: geometry changed: the change lies outside the level, nothing re-voxelized "
+              "(voxels and light kept)");
+    EXPECT_EQ(volume.injectLight(after, "l", 1, false), "");
+    EXPECT_EQ(volume.getLevel(0).light[kDirect], light0);
+    // Level 1 holds the box: it re-voxelizes the change and is re-lit; then level 0, which reads
+    // level 1's light, is due again and re-lit.
+    const std::string what =
+        volume.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 2, false);
+    EXPECT_NE(what.find("level 1: geometry changed: re-voxelized the changed region"),
+              std::string::npos)
+        << what;
+    EXPECT_EQ(volume.injectLight(after, "l", 2, false), "level 1");
+    EXPECT_EQ(volume.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 3, false), "");
+    EXPECT_EQ(volume.injectLight(after, "l", 3, false), "level 0");
+    // Its voxels equal a fresh voxelization of the edited scene.
+    CascadeVolume fresh(settings);
+    fresh.voxelize(after, after.computeContentHash(), glm::dvec3(0.0), 0, false);
+    expectSameVoxels(volume, fresh);
+}
+
 // Three levels of 32^3 around makeOpenRoom (level 0 1.6 wide, level 2 6.4), and a G-buffer on
 // its floor: sky, point light and both bounces reach the pixels.
 CascadeSettings openRoomSettings()
