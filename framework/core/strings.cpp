@@ -3,6 +3,7 @@
 #include "core/error.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -62,6 +63,28 @@ std::string readTextFile(const std::string& path)
     std::ostringstream ss;
     ss << in.rdbuf();
     return ss.str();
+}
+
+void writeTextFileAtomically(const std::string& path, const std::string& text)
+{
+    {
+        std::ofstream out(path + ".tmp", std::ios::binary | std::ios::trunc);
+        out << text;
+        out.close();
+        if (!out)
+            throw Error(path + ": cannot write");
+    }
+    std::filesystem::rename(path + ".tmp", path);
+}
+
+std::string quoteCsvField(const std::string& text)
+{
+    if (text.find_first_of(",\"\n") == std::string::npos)
+        return text;
+    std::string quoted = "\"";
+    for (char c : text)
+        quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+    return quoted + "\"";
 }
 
 } // namespace rtlab

@@ -2,6 +2,7 @@
 
 #include "core/error.h"
 #include "core/json.h"
+#include "core/strings.h"
 
 #include <yaml-cpp/yaml.h>
 
@@ -26,16 +27,6 @@ std::string encodeCell(const Cell& cell)
         std::string operator()(bool b) const { return b ? "true" : "false"; }
     };
     return std::visit(Visitor{}, cell);
-}
-
-std::string csvQuote(const std::string& s)
-{
-    if (s.find_first_of(",\"\n") == std::string::npos)
-        return s;
-    std::string q = "\"";
-    for (char c : s)
-        q += (c == '"') ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
 }
 
 } // namespace
@@ -170,14 +161,14 @@ std::size_t ResultsStore::writeCsv() const
         if (!out)
             throw Error(tmp + ": cannot open for writing");
         for (std::size_t i = 0; i < columns.size(); ++i)
-            out << (i ? "," : "") << csvQuote(columns[i]);
+            out << (i ? "," : "") << quoteCsvField(columns[i]);
         out << "\n";
         for (const auto& row : rows) {
             std::vector<std::string> cells(columns.size());
             for (const auto& [k, v] : row)
                 cells[index[k]] = v;
             for (std::size_t i = 0; i < cells.size(); ++i)
-                out << (i ? "," : "") << csvQuote(cells[i]);
+                out << (i ? "," : "") << quoteCsvField(cells[i]);
             out << "\n";
         }
         if (!out)

@@ -4,12 +4,10 @@
 
 #include "report/report_detail.h"
 
-#include "core/error.h"
+#include "core/strings.h"
 
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <limits>
 #include <sstream>
 
@@ -37,14 +35,6 @@ std::map<std::string, std::string> getTruthDefinition(const RunSummary& run)
         if (column.rfind("reference.", 0) == 0 && !isMeasurementColumn(column))
             out[column] = value;
     return out;
-}
-
-std::string formatMs(double ms)
-{
-    std::ostringstream s;
-    s.precision(4);
-    s << ms << " ms";
-    return s.str();
 }
 
 struct Point {
@@ -124,10 +114,10 @@ std::vector<EqualErrorRow> computeEqualError(const Group& group)
             }
         if (row.error > front.front().error) {
             row.note = "less accurate than the cheapest baseline run (" +
-                       formatMs(front.front().time) + ")";
+                       formatNumber(front.front().time) + " ms" + ")";
         } else if (row.error < front.back().error) {
             row.note = "more accurate than every baseline run (the best takes " +
-                       formatMs(front.back().time) + ")";
+                       formatNumber(front.back().time) + " ms" + ")";
         } else {
             for (std::size_t i = 0; i < front.size(); ++i) {
                 const Point& a = front[i];
@@ -155,30 +145,6 @@ std::vector<EqualErrorRow> computeEqualError(const Group& group)
     return rows;
 }
 
-namespace {
-
-std::string csvField(const std::string& text)
-{
-    if (text.find_first_of(",\"\n") == std::string::npos)
-        return text;
-    std::string out = "\"";
-    for (char c : text)
-        out += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return out + "\"";
-}
-
-std::string csvNumber(double v)
-{
-    if (!std::isfinite(v))
-        return "";
-    std::ostringstream s;
-    s.precision(6);
-    s << v;
-    return s.str();
-}
-
-} // namespace
-
 std::string writeEqualErrorCsv(const std::string& directory, const std::vector<Group>& groups)
 {
     std::ostringstream csv;
@@ -187,22 +153,18 @@ std::string writeEqualErrorCsv(const std::string& directory, const std::vector<G
            "cheapest_run_id,cheapest_parameters,cheapest_ms,cheapest_speedup,note\n";
     for (const Group& g : groups)
         for (const EqualErrorRow& e : computeEqualError(g))
-            csv << csvField(g.key) << ',' << csvField(e.run->runId) << ','
-                << csvField(e.run->technique) << ',' << csvField(describeEqualErrorRun(*e.run, g))
-                << ',' << csvNumber(e.time) << ',' << csvField(g.columns.error) << ','
-                << csvNumber(e.error) << ',' << csvField(g.columns.baseline) << ','
-                << csvNumber(e.baselineTime) << ',' << csvNumber(e.speedup) << ','
-                << (e.cheapest ? csvField(e.cheapest->runId) : "") << ','
-                << (e.cheapest ? csvField(describeEqualErrorRun(*e.cheapest, g)) : "") << ','
-                << (e.cheapest ? csvNumber(e.cheapest->get(g.columns.cost)) : "") << ','
-                << csvNumber(e.cheapestSpeedup) << ',' << csvField(e.note) << '\n';
+            csv << quoteCsvField(g.key) << ',' << quoteCsvField(e.run->runId) << ','
+                << quoteCsvField(e.run->technique) << ','
+                << quoteCsvField(describeEqualErrorRun(*e.run, g)) << ',' << formatNumber(e.time, 6)
+                << ',' << quoteCsvField(g.columns.error) << ',' << formatNumber(e.error, 6) << ','
+                << quoteCsvField(g.columns.baseline) << ',' << formatNumber(e.baselineTime, 6)
+                << ',' << formatNumber(e.speedup, 6) << ','
+                << (e.cheapest ? quoteCsvField(e.cheapest->runId) : "") << ','
+                << (e.cheapest ? quoteCsvField(describeEqualErrorRun(*e.cheapest, g)) : "") << ','
+                << (e.cheapest ? formatNumber(e.cheapest->get(g.columns.cost), 6) : "") << ','
+                << formatNumber(e.cheapestSpeedup, 6) << ',' << quoteCsvField(e.note) << '\n';
     const std::string path = directory + "/equal_error.csv";
-    std::ofstream out(path + ".tmp", std::ios::trunc);
-    out << csv.str();
-    out.close();
-    if (!out)
-        throw Error(path + ": cannot write");
-    std::filesystem::rename(path + ".tmp", path);
+    writeTextFileAtomically(path, csv.str());
     return path;
 }
 

@@ -3,6 +3,7 @@
 #include "report/report_detail.h"
 
 #include "core/error.h"
+#include "core/strings.h"
 
 #include <algorithm>
 #include <cmath>
@@ -40,17 +41,17 @@ std::string getPageHead(const std::string& title)
            "pre{background:#f7f7f7;padding:1em;overflow-x:auto;font-size:0.8em}\n</style></head><body>\n";
 }
 
-namespace {
-
-std::string formatNumber(double v)
+std::string formatNumber(double v, int precision)
 {
     if (!std::isfinite(v))
         return "";
     std::ostringstream s;
-    s.precision(4);
+    s.precision(precision);
     s << v;
     return s.str();
 }
+
+namespace {
 
 std::string relativeTo(const std::string& path, const std::string& directory)
 {
@@ -153,13 +154,7 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
     }
     h << "<h2>Manifest</h2>\n<pre>" << escapeHtml(manifestJson.substr(0, 20000)) << "</pre>\n</body></html>\n";
 
-    const std::string path = directory + "/report.html";
-    std::ofstream out(path + ".tmp", std::ios::trunc);
-    out << h.str();
-    out.close();
-    if (!out)
-        throw Error(path + ": cannot write");
-    std::filesystem::rename(path + ".tmp", path);
+    writeTextFileAtomically(directory + "/report.html", h.str());
 }
 
 } // namespace rtlab::report::detail

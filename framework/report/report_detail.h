@@ -14,6 +14,8 @@ namespace rtlab::report::detail {
 
 //! `s` with &, <, >, " escaped for HTML text and attributes.
 std::string escapeHtml(const std::string& s);
+//! `v` with `precision` significant digits; empty for NaN and infinities (an empty table cell).
+std::string formatNumber(double v, int precision = 4);
 //! The doctype, head (title, the reports' style sheet) and the opening body tag of a page.
 std::string getPageHead(const std::string& title);
 
