@@ -358,6 +358,41 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
                                    group.title + "." + (key.empty() ? "" : key + "."));
     }
 
+    // 3b. The speed-up of each run against the family's sampling baseline at the same error
+    //     (computeEqualError), fastest first, up to 12 runs.
+    const std::vector<EqualErrorRow> equal = computeEqualError(group);
+    plot::StackedBarSpec speedups;
+    speedups.title = group.title + ": speed-up against " + columns.baseline + " at equal error";
+    speedups.yLabel = "time of " + columns.baseline + " at the run's error / the run's time";
+    speedups.passes = {"speed-up"};
+    speedups.colors = plot::ColorTable(speedups.passes);
+    speedups.totalDecimals = 1;
+    for (const EqualErrorRow& row : equal)
+        if (std::isfinite(row.speedup) && speedups.bars.size() < 12) {
+            const std::string label = describeEqualErrorRun(*row.run, group);
+            speedups.bars.push_back(row.run->technique + (label.empty() ? "" : "\n" + label));
+            speedups.values.push_back({row.speedup});
+        }
+    if (!speedups.bars.empty()) {
+        std::string key;
+        if (!plot::barLabelsFit(speedups))
+            for (std::size_t b = 0; b < speedups.bars.size(); ++b) {
+                std::string label = speedups.bars[b];
+                std::replace(label.begin(), label.end(), '\n', ' ');
+                key += (key.empty() ? " Bars: " : "; ") + std::to_string(b + 1) + " = " + label;
+                speedups.bars[b] = std::to_string(b + 1);
+            }
+        const std::string path = plots + "/equal_error_" + stem;
+        plot::writeStackedBars(speedups, path);
+        figures.plots.push_back(path);
+        figures.captions.push_back(
+            "How much longer " + columns.baseline + " takes at the error of each run on " +
+            group.title +
+            ": its time interpolated between its runs around that error (the table below, and "
+            "equal_error.csv, also give the cheapest " +
+            columns.baseline + " run reaching it)." + (key.empty() ? "" : key + "."));
+    }
+
     // 4. Images (families that write them, findRunImages): reference | each technique's
     //    lowest-error run, over their error maps, with crops around the worst error. A study of
     //    one technique shows up to 4 of its runs instead, lowest error first (its variants side

@@ -9,6 +9,8 @@
 //                                               (families that declare it, sweeping the grid)
 //   <dir>/plots/<histogram>_<scene>.png|pdf     per-technique histograms a family declares
 //   <dir>/plots/pass_times_<scene>.png|pdf      stacked per-pass time of the front runs
+//   <dir>/plots/equal_error_<scene>.png|pdf     each run's speed-up against its family's sampling
+//                                               baseline at the same error (equal_error.csv)
 //   <dir>/plots/images_<scene>.png|pdf          reference | each technique's best run | error maps,
 //                                               with zoomed crops (screen-space families)
 //   <dir>/runs/<id>/frame<k>/*.png               each run's output, reference and error heat map
