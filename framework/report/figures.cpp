@@ -76,6 +76,22 @@ plot::PixelRect findWorstRegion(const Image<float>& error)
             w, h};
 }
 
+// Bar labels that do not fit under their bars become numbers; returns the key for the caption
+// (" Bars: 1 = ...; 2 = ..."), empty when they fit.
+std::string numberBarsThatDoNotFit(plot::StackedBarSpec& bars)
+{
+    std::string key;
+    if (plot::barLabelsFit(bars))
+        return key;
+    for (std::size_t b = 0; b < bars.bars.size(); ++b) {
+        std::string label = bars.bars[b];
+        std::replace(label.begin(), label.end(), '\n', ' ');
+        key += (key.empty() ? " Bars: " : "; ") + std::to_string(b + 1) + " = " + label;
+        bars.bars[b] = std::to_string(b + 1);
+    }
+    return key;
+}
+
 } // namespace
 
 Figures writeGroupFigures(const Group& group, const std::string& directory,
@@ -342,15 +358,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             bars.bars.resize(16);
             bars.values.resize(16);
         }
-        // Labels that do not fit under their bars become numbers, with the key in the caption.
-        std::string key;
-        if (!plot::barLabelsFit(bars))
-            for (std::size_t b = 0; b < bars.bars.size(); ++b) {
-                std::string label = bars.bars[b];
-                std::replace(label.begin(), label.end(), '\n', ' ');
-                key += (key.empty() ? " Bars: " : "; ") + std::to_string(b + 1) + " = " + label;
-                bars.bars[b] = std::to_string(b + 1);
-            }
+        const std::string key = numberBarsThatDoNotFit(bars); // the key goes in the caption
         const std::string path = plots + "/pass_times_" + stem;
         plot::writeStackedBars(bars, path);
         figures.plots.push_back(path);
@@ -374,14 +382,7 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
             speedups.values.push_back({row.speedup});
         }
     if (!speedups.bars.empty()) {
-        std::string key;
-        if (!plot::barLabelsFit(speedups))
-            for (std::size_t b = 0; b < speedups.bars.size(); ++b) {
-                std::string label = speedups.bars[b];
-                std::replace(label.begin(), label.end(), '\n', ' ');
-                key += (key.empty() ? " Bars: " : "; ") + std::to_string(b + 1) + " = " + label;
-                speedups.bars[b] = std::to_string(b + 1);
-            }
+        const std::string key = numberBarsThatDoNotFit(speedups);
         const std::string path = plots + "/equal_error_" + stem;
         plot::writeStackedBars(speedups, path);
         figures.plots.push_back(path);
