@@ -145,14 +145,16 @@ std::vector<EqualErrorRow> computeEqualError(const Group& group)
     return rows;
 }
 
-std::string writeEqualErrorCsv(const std::string& directory, const std::vector<Group>& groups)
+std::string writeEqualErrorCsv(const std::string& directory, const std::vector<Group>& groups,
+                               const std::vector<std::vector<EqualErrorRow>>& equal)
 {
     std::ostringstream csv;
     csv << "group,run_id,technique,parameters,time_ms,error_column,error,baseline,baseline_ms,"
            "speedup,"
            "cheapest_run_id,cheapest_parameters,cheapest_ms,cheapest_speedup,note\n";
-    for (const Group& g : groups)
-        for (const EqualErrorRow& e : computeEqualError(g))
+    for (std::size_t i = 0; i < groups.size() && i < equal.size(); ++i) {
+        const Group& g = groups[i];
+        for (const EqualErrorRow& e : equal[i])
             csv << quoteCsvField(g.key) << ',' << quoteCsvField(e.run->runId) << ','
                 << quoteCsvField(e.run->technique) << ','
                 << quoteCsvField(describeEqualErrorRun(*e.run, g)) << ',' << formatNumber(e.time, 6)
@@ -163,6 +165,7 @@ std::string writeEqualErrorCsv(const std::string& directory, const std::vector<G
                 << (e.cheapest ? quoteCsvField(describeEqualErrorRun(*e.cheapest, g)) : "") << ','
                 << (e.cheapest ? formatNumber(e.cheapest->get(g.columns.cost), 6) : "") << ','
                 << formatNumber(e.cheapestSpeedup, 6) << ',' << quoteCsvField(e.note) << '\n';
+    }
     const std::string path = directory + "/equal_error.csv";
     writeTextFileAtomically(path, csv.str());
     return path;

@@ -94,8 +94,8 @@ std::string numberBarsThatDoNotFit(plot::StackedBarSpec& bars)
 
 } // namespace
 
-Figures writeGroupFigures(const Group& group, const std::string& directory,
-                          const std::vector<std::string>& techniques)
+Figures writeGroupFigures(const Group& group, const std::vector<EqualErrorRow>& equal,
+                          const std::string& directory, const std::vector<std::string>& techniques)
 {
     Figures figures;
     const FamilyColumns& columns = group.columns;
@@ -368,7 +368,6 @@ Figures writeGroupFigures(const Group& group, const std::string& directory,
 
     // 3b. The speed-up of each run against the family's sampling baseline at the same error
     //     (computeEqualError), fastest first, up to 12 runs.
-    const std::vector<EqualErrorRow> equal = computeEqualError(group);
     plot::StackedBarSpec speedups;
     speedups.title = group.title + ": speed-up against " + columns.baseline + " at equal error";
     speedups.yLabel = "time of " + columns.baseline + " at the run's error / the run's time";

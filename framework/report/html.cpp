@@ -60,8 +60,9 @@ std::string relativeTo(const std::string& path, const std::string& directory)
 
 } // namespace
 
-void writeHtml(const std::string& directory, const std::vector<Group>& groups, const std::vector<Figures>& figures,
-               const std::string& manifestJson)
+void writeHtml(const std::string& directory, const std::vector<Group>& groups,
+               const std::vector<std::vector<EqualErrorRow>>& equalRows,
+               const std::vector<Figures>& figures, const std::string& manifestJson)
 {
     std::ostringstream h;
     std::string title = std::filesystem::path(directory).filename().string();
@@ -121,7 +122,7 @@ void writeHtml(const std::string& directory, const std::vector<Group>& groups, c
         }
         h << "</table></div>\n";
         // The family's sampling baseline at the same error as each run.
-        const std::vector<EqualErrorRow> equal = computeEqualError(g);
+        const std::vector<EqualErrorRow>& equal = equalRows[gi];
         if (!equal.empty()) {
             h << "<h3>Equal-error speed-up against " << escapeHtml(columns.baseline)
               << "</h3>\n<p>The baseline's time at each run's " << escapeHtml(columns.error)

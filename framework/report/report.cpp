@@ -303,9 +303,16 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
     detail::writeRunImages(rows, 0.25f);
 
     ReportSummary summary;
-    std::vector<detail::Figures> figures;
+    // Each group's runs against its family's sampling baseline, for its chart, the CSV and the
+    // page.
+    std::vector<std::vector<detail::EqualErrorRow>> equal;
     for (const auto& g : groups) {
-        figures.push_back(detail::writeGroupFigures(g, directory, techniques));
+        equal.push_back(detail::computeEqualError(g));
+        summary.equalErrorRuns += int(equal.back().size());
+    }
+    std::vector<detail::Figures> figures;
+    for (std::size_t gi = 0; gi < groups.size(); ++gi) {
+        figures.push_back(detail::writeGroupFigures(groups[gi], equal[gi], directory, techniques));
         for (const auto& p : figures.back().plots)
             summary.plots.push_back(p + ".png");
     }
@@ -350,10 +357,8 @@ ReportSummary writeStudyReport(const std::string& directory, const plugin::Regis
     } catch (const std::exception&) {
         manifest = "{}";
     }
-    summary.equalError = detail::writeEqualErrorCsv(directory, groups);
-    for (const auto& g : groups)
-        summary.equalErrorRuns += int(detail::computeEqualError(g).size());
-    detail::writeHtml(directory, groups, figures, manifest);
+    summary.equalError = detail::writeEqualErrorCsv(directory, groups, equal);
+    detail::writeHtml(directory, groups, equal, figures, manifest);
     summary.html = directory + "/report.html";
     return summary;
 }

@@ -95,9 +95,10 @@ std::vector<EqualErrorRow> computeEqualError(const Group& group);
 //! A run's varying parameters, with its camera path and frame count where the group's runs
 //! differ in them (the equal-error table's "parameters").
 std::string describeEqualErrorRun(const RunSummary& run, const Group& group);
-//! directory/equal_error.csv: computeEqualError of every group, one line per row (a header
-//! only when no group has baseline runs). Returns its path.
-std::string writeEqualErrorCsv(const std::string& directory, const std::vector<Group>& groups);
+//! directory/equal_error.csv: `equal[i]` (computeEqualError of groups[i]) for every group, one
+//! line per row (a header only when no group has baseline runs). Returns its path.
+std::string writeEqualErrorCsv(const std::string& directory, const std::vector<Group>& groups,
+                               const std::vector<std::vector<EqualErrorRow>>& equal);
 
 struct Figures {
     std::vector<std::string> plots;     //!< paths without extension
@@ -105,8 +106,10 @@ struct Figures {
     std::vector<std::string> notes;     //!< one line per chart left out (no finite value to draw)
 };
 
-//! Writes every figure of `group` under directory/plots; returns them with captions.
-Figures writeGroupFigures(const Group& group, const std::string& directory, const std::vector<std::string>& techniques);
+//! Writes every figure of `group` under directory/plots (with `equal`, its computeEqualError
+//! rows, the speed-up chart); returns them with captions.
+Figures writeGroupFigures(const Group& group, const std::vector<EqualErrorRow>& equal,
+                          const std::string& directory, const std::vector<std::string>& techniques);
 
 //! `s` with every character but letters, digits, '_' and '-' replaced by '_'.
 std::string makeFileName(std::string s);
@@ -128,8 +131,9 @@ struct RunImages {
 };
 RunImages findRunImages(const experiment::Row& row);
 
-//! The HTML page.
+//! The HTML page; `equal[i]` and `figures[i]` belong to groups[i].
 void writeHtml(const std::string& directory, const std::vector<Group>& groups,
+               const std::vector<std::vector<EqualErrorRow>>& equal,
                const std::vector<Figures>& figures, const std::string& manifestJson);
 
 } // namespace rtlab::report::detail

@@ -123,7 +123,8 @@ TEST(EqualError, TheCsvHasARowPerRun)
     g.runs.push_back(makeRun("worse", "cascades", 1.0, 0.5));
     const auto dir = std::filesystem::temp_directory_path() / "rtlab_equal_error_test";
     std::filesystem::create_directories(dir);
-    const std::string path = detail::writeEqualErrorCsv(dir.string(), {g});
+    const std::string path =
+        detail::writeEqualErrorCsv(dir.string(), {g}, {detail::computeEqualError(g)});
     std::ifstream in(path);
     std::string header, first, second, extra;
     std::getline(in, header);

@@ -128,7 +128,8 @@ TEST(ReportLines, AnErrorColumnWithoutValuesIsANoteNotAnEmptyChart)
         group.runs.push_back(run);
     }
     const std::string directory = ::testing::TempDir() + "/report_notes";
-    const detail::Figures figures = detail::writeGroupFigures(group, directory, {"marching_cubes"});
+    const detail::Figures figures =
+        detail::writeGroupFigures(group, {}, directory, {"marching_cubes"});
     ASSERT_EQ(figures.notes.size(), 1u);
     EXPECT_NE(figures.notes[0].find("edge-Chamfer"), std::string::npos) << figures.notes[0];
     bool edgeChart = false, hausdorffChart = false;

@@ -196,8 +196,8 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 options.boxBegin = dugBegin;
                 options.boxEnd = dugEnd;
                 pasteVoxelBox(voxelizeRegion(region, options), dugBegin, dugEnd, level.grid);
-                finalizeVoxelGrid(level.grid);
             }
+            finalizeVoxelGrid(level.grid); // the list of surface voxels, which the copy lacks
             why += ": re-voxelized the changed region (" + std::to_string(boxVoxels) + " of " +
                    std::to_string(region.getVoxelCount()) + " voxels)";
         } else if (onlyScrolled) {
