@@ -19,7 +19,8 @@ namespace {
 
 struct CombineConstants {
     glm::ivec4 size{0};  // full width, height; low width, height
-    glm::ivec4 flags{0}; // factor, capsules, visibility given
+    glm::ivec4 flags{
+        0}; // factor, capsules, visibility given, 1 = the capsules at the traced pixels
     glm::vec4 angle{0.0f};
     glm::vec4 anchor{0.0f};
 };
@@ -178,7 +179,20 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
     Image<glm::vec3> out(w, h, glm::vec3(0.0f));
     if (pixels == 0)
         return out;
+    // The capsules at the traced pixels: a first dispatch over the reduced pixels multiplies the
+    // cone radiances in place, then the combine runs without capsules.
+    const bool traced = in.capsuleResolution == CapsuleResolution::Traced && !capsules.empty();
+    CombineConstants tracedConstants = constants;
+    tracedConstants.flags.w = 1;
+    if (traced)
+        constants.flags.y = 0;
     const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
+        if (traced)
+            cmd.dispatch(mPipeline, bindings, gpu::PushConstants(tracedConstants),
+                         gpu::GroupCount{
+                             gpu::computeGroupCount(std::uint64_t(reduced.gbuffer.width), 8),
+                             gpu::computeGroupCount(std::uint64_t(reduced.gbuffer.height), 8), 1},
+                         kDispatchLabel);
         cmd.dispatch(mPipeline, bindings, gpu::PushConstants(constants),
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), 8),
                                      gpu::computeGroupCount(std::uint64_t(h), 8), 1},
@@ -200,6 +214,13 @@ bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu, std::st
     return gatheredOnGpu && !context->getDeviceInfo().isCpu;
 }
 
+bool shouldGatherOnGpu(const gpu::Context* context, std::string_view setting)
+{
+    if (context == nullptr || setting == "cpu")
+        return false;
+    return setting == "vulkan" || !context->getDeviceInfo().isCpu;
+}
+
 void appendGatherCounters(std::vector<std::pair<std::string, double>>& counters, bool gatheredOnGpu,
                           std::optional<double> gatherGpuMs, std::size_t gatherUploadBytes,
                           double combineMs, bool combinedOnGpu, const ConeCombineGpu& combiner)
@@ -217,11 +238,13 @@ void appendGatherCounters(std::vector<std::pair<std::string, double>>& counters,
                           combinedOnGpu ? double(combiner.getLastUploadBytes()) : 0.0);
 }
 
-Image<glm::vec3> gatherConesReducedOnGpu(
-    gpu::Context& context, ConeCombineGpu& combiner, const scene::GBuffer& full, int traceStep,
-    double coneHalfAngle, const std::vector<Image<float>>* visibility,
-    const std::vector<scene::PosedCapsule>* capsules,
-    const std::function<const gpu::Buffer&(const scene::GBuffer&)>& traceCones, double* combineMs)
+Image<glm::vec3>
+gatherConesReducedOnGpu(gpu::Context& context, ConeCombineGpu& combiner, const scene::GBuffer& full,
+                        int traceStep, double coneHalfAngle,
+                        const std::vector<Image<float>>* visibility,
+                        const std::vector<scene::PosedCapsule>* capsules,
+                        const std::function<const gpu::Buffer&(const scene::GBuffer&)>& traceCones,
+                        double* combineMs, CapsuleResolution capsuleResolution)
 {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
@@ -235,6 +258,7 @@ Image<glm::vec3> gatherConesReducedOnGpu(
     in.visibility = visibility;
     in.capsules = capsules;
     in.coneHalfAngle = coneHalfAngle;
+    in.capsuleResolution = capsuleResolution;
     Image<glm::vec3> irradiance = combiner.combine(context, cones, in);
     if (combineMs != nullptr)
         *combineMs = std::chrono::duration<double, std::milli>((reducedAt - start) +

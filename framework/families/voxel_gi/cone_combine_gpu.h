@@ -22,7 +22,8 @@ public:
     static constexpr const char* kDispatchLabel = "voxel_gi.combine";
 
     //! combineCones(in) on `context`, with the cone radiances [low-res pixel * 16 + cone] (vec4)
-    //! in `coneRadiance` (in.coneRadiance is not read).
+    //! in `coneRadiance` (in.coneRadiance is not read). With the capsules at the traced pixels
+    //! (in.capsuleResolution) `coneRadiance` is multiplied by their visibility in place.
     Image<glm::vec3> combine(gpu::Context& context, const gpu::Buffer& coneRadiance,
                              const ConeCombineInputs& in);
     //! The same with in.coneRadiance uploaded first.
@@ -63,6 +64,12 @@ private:
 bool shouldCombineOnGpu(const gpu::Context* context, bool gatheredOnGpu,
                         std::string_view setting = "auto");
 
+//! Whether the pixel gather runs on Vulkan for the `device` setting of a cone-traced technique:
+//! "vulkan" wherever a Vulkan context is given, "cpu" never, "auto" on a GPU only (a context whose
+//! device is not a CPU implementation such as lavapipe, where the C++ gather is the faster:
+//! README, "Voxel GI").
+bool shouldGatherOnGpu(const gpu::Context* context, std::string_view setting);
+
 //! Appends the counters of a cone-traced gather's two steps, the same in every technique:
 //! gather_on_gpu, gather_gpu_ms, gather_upload_bytes (the cones), combine_ms (the reduction and
 //! the combine, wall time), combine_on_gpu, combine_gpu_ms, combine_upload_bytes.
@@ -73,13 +80,13 @@ void appendGatherCounters(std::vector<std::pair<std::string, double>>& counters,
 //! gatherConesReduced (upsample.h) with the cones kept on the device: `traceCones(reduced)` runs
 //! a Vulkan pixel cone dispatch without reading back and returns its output buffer
 //! ([low-res pixel * 16 + cone], vec4), and `combiner` brings it to full resolution on the same
-//! device. `combineMs`, when given, receives the wall time of the reduction and the combine.
-Image<glm::vec3>
-gatherConesReducedOnGpu(gpu::Context& context, ConeCombineGpu& combiner, const scene::GBuffer& full,
-                        int traceStep, double coneHalfAngle,
-                        const std::vector<Image<float>>* visibility,
-                        const std::vector<scene::PosedCapsule>* capsules,
-                        const std::function<const gpu::Buffer&(const scene::GBuffer&)>& traceCones,
-                        double* combineMs = nullptr);
+//! device, the capsules tested where `capsuleResolution` says. `combineMs`, when given, receives
+//! the wall time of the reduction and the combine.
+Image<glm::vec3> gatherConesReducedOnGpu(
+    gpu::Context& context, ConeCombineGpu& combiner, const scene::GBuffer& full, int traceStep,
+    double coneHalfAngle, const std::vector<Image<float>>* visibility,
+    const std::vector<scene::PosedCapsule>* capsules,
+    const std::function<const gpu::Buffer&(const scene::GBuffer&)>& traceCones,
+    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full);
 
 } // namespace rtlab::voxelgi

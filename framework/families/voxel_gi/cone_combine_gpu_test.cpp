@@ -98,9 +98,11 @@ Inputs makeInputs(int w, int h, int factor, const glm::dvec3& shift)
     return in;
 }
 
-ConeCombineInputs describe(const Inputs& in, bool visibility, bool capsules)
+ConeCombineInputs describe(const Inputs& in, bool visibility, bool capsules,
+                           CapsuleResolution resolution = CapsuleResolution::Full)
 {
     ConeCombineInputs c;
+    c.capsuleResolution = resolution;
     c.coneRadiance = &in.cones;
     c.reduced = &in.reduced;
     c.full = &in.full;
@@ -147,8 +149,10 @@ void expectParity(const glm::dvec3& shift, int factor)
     ConeCombineGpu combiner;
     int occluded = 0;
     for (const bool visibility : {false, true})
-        for (const bool capsules : {false, true}) {
-            const ConeCombineInputs c = describe(in, visibility, capsules);
+        for (const int capsules : {0, 1, 2}) { // none, at every pixel, at the traced pixels
+            const ConeCombineInputs c =
+                describe(in, visibility, capsules > 0,
+                         capsules == 2 ? CapsuleResolution::Traced : CapsuleResolution::Full);
             const Image<glm::vec3> cpu = combineCones(c);
             const Image<glm::vec3> gpu = combiner.combine(context, c);
             const Difference d = compare(cpu, gpu, in.full);
@@ -162,14 +166,14 @@ void expectParity(const glm::dvec3& shift, int factor)
             // drivers that round division, sqrt and exp differently (Vulkan allows a few ulps).
             EXPECT_LT(d.mean, 1e-6);
             EXPECT_LT(d.worst, 1e-4);
-            if (capsules) {
+            if (capsules > 0) {
                 // The capsules do change the result (the comparison covers their tests).
                 const Image<glm::vec3> open = combineCones(describe(in, visibility, false));
                 for (std::size_t i = 0; i < open.pixels.size(); ++i)
                     occluded += glm::length(open.pixels[i] - cpu.pixels[i]) > 1e-3f ? 1 : 0;
             }
         }
-    EXPECT_GT(occluded, 200);
+    EXPECT_GT(occluded, 400);
 }
 
 TEST(ConeCombineGpu, MatchesTheCppCombineAtEveryReduction)
@@ -221,6 +225,43 @@ TEST(ConeCombineGpu, RefusesVisibilityImagesOfAnotherSize)
                   std::string::npos)
             << e.what();
     }
+}
+
+// The capsules at the traced pixels multiply a device's cone buffer in place: the buffer then
+// holds what the C++ occludeTracedCones makes of the same cones (float against double: the
+// parity tolerance above).
+TEST(ConeCombineGpu, OccludesTheTracedConesInTheDeviceBuffer)
+{
+    const Inputs in = makeInputs(40, 24, 4, glm::dvec3(0.0));
+    gpu::Context context;
+    std::vector<glm::vec4> cones(in.cones.size());
+    for (std::size_t i = 0; i < cones.size(); ++i)
+        cones[i] = glm::vec4(in.cones[i], 0.0f);
+    gpu::Buffer buffer = context.createBuffer({cones.size() * sizeof(glm::vec4), "test.cones"});
+    buffer.uploadSpan<glm::vec4>(cones);
+    ConeCombineGpu combiner;
+    combiner.combine(context, buffer, describe(in, false, true, CapsuleResolution::Traced));
+    const std::vector<glm::vec4> after = buffer.downloadVector<glm::vec4>(cones.size());
+    std::vector<glm::vec3> expected = in.cones;
+    occludeTracedCones(in.reduced.gbuffer, expected, in.capsules, 0.52);
+    int changed = 0;
+    for (std::size_t i = 0; i < expected.size(); ++i) {
+        changed += expected[i] != in.cones[i] ? 1 : 0;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(after[i][c], expected[i][c], 1e-4 * std::max(1e-3f, expected[i][c])) << i;
+    }
+    EXPECT_GT(changed, 20); // the capsules hide part of some traced pixels' cones
+}
+
+// "auto" gathers on Vulkan only on a GPU; "vulkan" wherever there is a context.
+TEST(ConeCombineGpu, AutoGathersOnTheDeviceOnlyOnAGpu)
+{
+    gpu::Context context;
+    EXPECT_EQ(shouldGatherOnGpu(&context, "auto"), !context.getDeviceInfo().isCpu);
+    EXPECT_TRUE(shouldGatherOnGpu(&context, "vulkan"));
+    EXPECT_FALSE(shouldGatherOnGpu(&context, "cpu"));
+    EXPECT_FALSE(shouldGatherOnGpu(nullptr, "vulkan"));
+    EXPECT_FALSE(shouldGatherOnGpu(nullptr, "auto"));
 }
 
 // "auto" combines on Vulkan only where the cones were traced there and the device is a GPU.

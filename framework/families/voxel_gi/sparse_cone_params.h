@@ -3,6 +3,9 @@
 // names, ranges and meaning in both, so that a sweep over one sweeps the other like for like.
 
 #include "config/param.h"
+#include "families/voxel_gi/upsample.h"
+
+#include <string>
 
 namespace rtlab::voxelgi {
 
@@ -16,14 +19,23 @@ struct SparseConeParams {
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int traceStep = 4;        //!< pixels: one traced per trace_step^2 block, then upsampled
-    bool onGpu = true;        //!< device: the pixel gather on Vulkan or in C++
+    std::string device =
+        "auto"; //!< the pixel gather: vulkan, cpu or auto (cone_combine_gpu.h shouldGatherOnGpu)
+    CapsuleResolution capsules = CapsuleResolution::Traced; //!< capsule_resolution
     int innerLayers = 1;      //!< layers of solid leaves kept inside closed surfaces
 
     //! Declares resolution (described by `resolutionHelp`), voxel_size, supersampling, bounces,
-    //! cone_angle, start_offset, inject_offset, step_scale, trace_step, device and inner_layers.
+    //! cone_angle, start_offset, inject_offset, step_scale, trace_step, device,
+    //! capsule_resolution and inner_layers.
     static void declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault);
     static SparseConeParams read(const config::ParamSet& p);
     void write(config::ParamSet& p) const;
 };
+
+//! The `device` and `capsule_resolution` parameters of every cone-traced technique (cascades,
+//! svo, adaptive_voxel_tree_cones): where the pixel gather runs and where the capsules are tested.
+void declareGatherPlacement(config::ParamSchema& schema);
+CapsuleResolution readCapsuleResolution(const config::ParamSet& p);
+std::string toString(CapsuleResolution resolution);
 
 } // namespace rtlab::voxelgi

@@ -69,7 +69,7 @@ public:
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
-        mGatheredOnGpu = mParams.onGpu && input.gpu != nullptr;
+        mGatheredOnGpu = shouldGatherOnGpu(input.gpu, mParams.device);
         mCombinedOnGpu = shouldCombineOnGpu(input.gpu, mGatheredOnGpu);
         if (mCombinedOnGpu) {
             irradiance = gatherConesReducedOnGpu(
@@ -78,7 +78,7 @@ public:
                 [&](const scene::GBuffer& reduced) -> const gpu::Buffer& {
                     return mGpu.gatherConesOnDevice(*input.gpu, *mStructure, reduced);
                 },
-                &mCombineMs);
+                &mCombineMs, mParams.capsules);
             return;
         }
         irradiance = gatherConesReduced(
@@ -90,7 +90,7 @@ public:
                 else
                     mStructure->gatherCones(reduced, cones);
             },
-            &mCombineMs);
+            &mCombineMs, mParams.capsules);
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override

@@ -262,9 +262,31 @@ void SparseConeParams::declare(config::ParamSchema& schema, const char* resoluti
     schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
     schema.addInt("trace_step", 4, 1, 8, "pixels",
                   "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
-    schema.addEnum("device", "vulkan", {"vulkan", "cpu"}, "where the pixel gather runs");
+    declareGatherPlacement(schema);
     schema.addInt("inner_layers", innerLayersDefault, 1, 8, "leaves",
                   "layers of solid leaves kept inside closed surfaces (the rest of a solid is not stored)");
+}
+
+void declareGatherPlacement(config::ParamSchema& schema)
+{
+    schema.addEnum("device", "auto", {"auto", "vulkan", "cpu"},
+                   "where the pixel gather runs; auto: on Vulkan on a GPU, in C++ where Vulkan "
+                   "runs on the CPU (lavapipe)");
+    schema.addEnum("capsule_resolution", "traced", {"traced", "full"},
+                   "where the characters' capsules are tested against the 16 cones: at the traced "
+                   "pixels (one per trace_step^2 block, upsampled with the cones) or at every "
+                   "pixel");
+}
+
+CapsuleResolution readCapsuleResolution(const config::ParamSet& p)
+{
+    return p.getString("capsule_resolution") == "full" ? CapsuleResolution::Full
+                                                       : CapsuleResolution::Traced;
+}
+
+std::string toString(CapsuleResolution resolution)
+{
+    return resolution == CapsuleResolution::Full ? "full" : "traced";
 }
 
 SparseConeParams SparseConeParams::read(const config::ParamSet& p)
@@ -279,7 +301,8 @@ SparseConeParams SparseConeParams::read(const config::ParamSet& p)
     s.injectOffset = p.getFloat("inject_offset");
     s.stepScale = p.getFloat("step_scale");
     s.traceStep = int(p.getInt("trace_step"));
-    s.onGpu = p.getString("device") == "vulkan";
+    s.device = p.getString("device");
+    s.capsules = readCapsuleResolution(p);
     s.innerLayers = int(p.getInt("inner_layers"));
     return s;
 }
@@ -295,7 +318,8 @@ void SparseConeParams::write(config::ParamSet& p) const
     p.set("inject_offset", injectOffset);
     p.set("step_scale", stepScale);
     p.set("trace_step", std::int64_t(traceStep));
-    p.set("device", std::string(onGpu ? "vulkan" : "cpu"));
+    p.set("device", device);
+    p.set("capsule_resolution", toString(capsules));
     p.set("inner_layers", std::int64_t(innerLayers));
 }
 

@@ -195,34 +195,60 @@ struct ConeAngle {
     double half, cosHalf, sinHalf;
 };
 
-double occludeCone(const glm::dvec3& p, const glm::dvec3& dir, const ConeAngle& cone, const glm::vec3& a,
-                   const glm::vec3& b, float radius)
+// A capsule as seen from one point, for its tests against the point's cones: the segment's start
+// relative to the point (w0 = a - p), its direction u = b - a, and what every cone's test reuses.
+struct CapsuleFromPoint {
+    glm::dvec3 w0, u;
+    double uu, inverseLength2, uw, radius;
+};
+
+CapsuleFromPoint seeCapsule(const glm::dvec3& p, const glm::dvec3& a, const glm::dvec3& u,
+                            double radius)
 {
-    const glm::dvec3 A(a), u = glm::dvec3(b) - A;
-    const double uu = glm::dot(u, u);
-    const double r = double(radius);
-    const auto closestOnSegment = [&](const glm::dvec3& q) {
-        return uu > 0.0 ? A + std::clamp(glm::dot(q - A, u) / uu, 0.0, 1.0) * u : A;
-    };
-    // On or inside the capsule: its own character's surface is not occluded by it.
-    if (glm::length(p - closestOnSegment(p)) <= 1.05 * r)
-        return 0.0;
-    // The point of the segment nearest the cone's axis (closest points of a segment and a ray).
-    const glm::dvec3 w0 = A - p;
-    const double ud = glm::dot(u, dir), uw = glm::dot(u, w0), dw = glm::dot(dir, w0);
-    const double denom = uu - ud * ud;
-    double s = denom > 1e-12 * std::max(uu, 1e-300) ? std::clamp((ud * dw - uw) / denom, 0.0, 1.0) : 0.0;
-    const double t = std::max(0.0, glm::dot(A + s * u - p, dir));
-    const glm::dvec3 centre = closestOnSegment(p + t * dir);
-    const glm::dvec3 toCentre = centre - p;
-    const double distance = glm::length(toCentre);
+    CapsuleFromPoint c;
+    c.w0 = a - p;
+    c.u = u;
+    c.uu = glm::dot(c.u, c.u);
+    c.inverseLength2 = c.uu > 0.0 ? 1.0 / c.uu : 0.0;
+    c.uw = glm::dot(c.u, c.w0);
+    c.radius = radius;
+    return c;
+}
+
+// On or inside the capsule (within 5 % of its radius): its own character's surface is not
+// occluded by it.
+bool isOnCapsule(const CapsuleFromPoint& c)
+{
+    const glm::dvec3 fromSegment = c.w0 + std::clamp(-c.uw * c.inverseLength2, 0.0, 1.0) * c.u;
+    return glm::dot(fromSegment, fromSegment) <= (1.05 * c.radius) * (1.05 * c.radius);
+}
+
+// The share of the cone (axis dir, from the point the capsule was seen from) that the capsule
+// hides: the sphere of the capsule's radius at the point of its segment nearest the cone's axis,
+// as a spherical cap against the cone's cap (Oat and Sander 2007, "Ambient aperture lighting").
+// Every point below is relative to the point: the segment runs from w0 to w0 + u.
+double occludeCone(const CapsuleFromPoint& c, const glm::dvec3& dir, const ConeAngle& cone)
+{
+    const double r = c.radius;
+    // The point of the segment nearest the cone's axis (closest points of a segment and a ray):
+    // s on the segment, t on the ray, then the segment's point nearest the ray's point at t.
+    const double ud = glm::dot(c.u, dir), dw = glm::dot(dir, c.w0);
+    const double denom = c.uu - ud * ud;
+    const double s = denom > 1e-12 * std::max(c.uu, 1e-300)
+                         ? std::clamp((ud * dw - c.uw) / denom, 0.0, 1.0)
+                         : 0.0;
+    const double t = std::max(0.0, dw + s * ud);
+    const double along = std::clamp((t * ud - c.uw) * c.inverseLength2, 0.0, 1.0);
+    const glm::dvec3 toCentre = c.w0 + along * c.u;
+    const double distance = std::sqrt(glm::dot(toCentre, toCentre));
     if (!(distance > r))
         return 0.0;
     // Disjoint caps (the angle between them at least the sum of their half angles) are tested on
     // cosines first, with no inverse trigonometric function.
     const double sinCap = std::min(1.0, r / distance), cosCap = std::sqrt(1.0 - sinCap * sinCap);
     const double cosOuter = cone.cosHalf * cosCap - cone.sinHalf * sinCap;
-    if (glm::dot(toCentre / distance, dir) < cosOuter - 1e-9) // margin: rounding of the two paths
+    const double cosBetween = std::clamp(glm::dot(toCentre, dir) / distance, -1.0, 1.0);
+    if (cosBetween < cosOuter - 1e-9) // margin: rounding of the two paths
         return 0.0;
     const double coneSolid = 1.0 - cone.cosHalf; // solid angles / 2 pi
     // The smaller cap's solid angle: 1 - cos(min(half, cap)) = 1 - max(cos half, cos cap).
@@ -230,7 +256,6 @@ double occludeCone(const glm::dvec3& p, const glm::dvec3& dir, const ConeAngle& 
     // One cap inside the other (the angle between them at most the difference of their half
     // angles): the whole smaller cap is hidden; tested on cosines too.
     const double cosInner = cone.cosHalf * cosCap + cone.sinHalf * sinCap;
-    const double cosBetween = std::clamp(glm::dot(toCentre / distance, dir), -1.0, 1.0);
     if (cosBetween >= cosInner)
         return std::clamp(smaller / coneSolid, 0.0, 1.0);
     // Between the two: Oat and Sander's smoothstep in the angle between the caps.
@@ -247,16 +272,117 @@ double occludeCone(const glm::dvec3& p, const glm::dvec3& dir, const ConeAngle& 
     return std::clamp(smaller * share / coneSolid, 0.0, 1.0);
 }
 
+// The characters' capsules as the combine tests them: per capsule, once, its segment, the sphere
+// around it and the squared distances within which it is near a point (40 radii from the
+// segment: a capsule farther away hides less than 0.25 % of a cone; from the sphere's centre, a
+// bound of that); per point, the capsules near it, each seen from the point once for all its
+// cones.
+class CapsuleOccluders {
+public:
+    CapsuleOccluders(const std::vector<scene::PosedCapsule>* capsules, const ConeAngle& angle)
+        : mAngle(angle)
+    {
+        if (capsules == nullptr)
+            return;
+        for (const scene::PosedCapsule& c : *capsules) {
+            Bounds b;
+            b.a = glm::dvec3(c.capsule.a);
+            b.u = glm::dvec3(c.capsule.b) - b.a;
+            b.centre = b.a + 0.5 * b.u;
+            const double uu = glm::dot(b.u, b.u);
+            b.inverseLength2 = uu > 0.0 ? 1.0 / uu : 0.0;
+            b.radius = double(c.capsule.radius);
+            b.bound = 0.5 * std::sqrt(uu) + b.radius;
+            b.near2 = (40.0 * b.radius) * (40.0 * b.radius);
+            b.reach2 =
+                (0.5 * std::sqrt(uu) + 40.0 * b.radius) * (0.5 * std::sqrt(uu) + 40.0 * b.radius);
+            mBounds.push_back(b);
+        }
+    }
+
+    bool empty() const { return mBounds.empty(); }
+
+    //! A capsule near a point, with the cosine below which a cone direction's angle to its
+    //! bounding sphere's centre is too wide for the cone to touch it (-2: no such bound).
+    struct Near {
+        CapsuleFromPoint seen;
+        glm::dvec3 towardCentre;
+        double cosLimit;
+    };
+
+    //! The capsules near p that can hide part of its cones; none that p lies on (isOnCapsule).
+    void collect(const glm::dvec3& p, std::vector<Near>& near) const
+    {
+        near.clear();
+        for (const Bounds& c : mBounds) {
+            const glm::dvec3 toCentre = c.centre - p;
+            const double d2 = glm::dot(toCentre, toCentre);
+            if (d2 >= c.reach2)
+                continue; // farther than 40 radii from any point of the segment
+            Near entry{seeCapsule(p, c.a, c.u, c.radius), glm::dvec3(0.0), -2.0};
+            const glm::dvec3 fromSegment =
+                entry.seen.w0 + std::clamp(-entry.seen.uw * c.inverseLength2, 0.0, 1.0) * c.u;
+            if (glm::dot(fromSegment, fromSegment) >= c.near2 || isOnCapsule(entry.seen))
+                continue;
+            // The sphere around the whole capsule: a cone whose axis is more than the cone's half
+            // angle plus the sphere's angular radius away from the sphere's centre misses every
+            // sphere occludeCone places on the segment, so its occlusion is exactly 0.
+            if (d2 > c.bound * c.bound) {
+                const double distance = std::sqrt(d2);
+                const double sinB = c.bound / distance, cosB = std::sqrt(1.0 - sinB * sinB);
+                entry.towardCentre = toCentre / distance;
+                entry.cosLimit =
+                    mAngle.cosHalf * cosB - mAngle.sinHalf * sinB; // cos(half angle + asin(sinB))
+            }
+            near.push_back(entry);
+        }
+    }
+
+    //! The share of the cone along dir that the near capsules leave open (their product).
+    double visibility(const std::vector<Near>& near, const glm::dvec3& dir) const
+    {
+        double visible = 1.0;
+        for (const Near& c : near) {
+            // 1e-9 in cosine keeps rounding from culling a cone that grazes the sphere.
+            if (glm::dot(c.towardCentre, dir) < c.cosLimit - 1e-9)
+                continue;
+            visible *= 1.0 - occludeCone(c.seen, dir, mAngle);
+        }
+        return visible;
+    }
+
+private:
+    struct Bounds {
+        glm::dvec3 a, u, centre;
+        double inverseLength2, radius, bound, near2, reach2;
+    };
+    std::vector<Bounds> mBounds;
+    ConeAngle mAngle;
+};
+
 } // namespace
 
 double computeCapsuleConeOcclusion(const glm::dvec3& p, const glm::dvec3& dir, double coneHalfAngle,
                                    const glm::vec3& a, const glm::vec3& b, float radius)
 {
-    return occludeCone(p, dir, {coneHalfAngle, std::cos(coneHalfAngle), std::sin(coneHalfAngle)}, a, b, radius);
+    const CapsuleFromPoint c =
+        seeCapsule(p, glm::dvec3(a), glm::dvec3(b) - glm::dvec3(a), double(radius));
+    if (isOnCapsule(c))
+        return 0.0;
+    return occludeCone(c, dir, {coneHalfAngle, std::cos(coneHalfAngle), std::sin(coneHalfAngle)});
 }
 
 Image<glm::vec3> combineCones(const ConeCombineInputs& in)
 {
+    if (in.capsuleResolution == CapsuleResolution::Traced && in.capsules != nullptr &&
+        in.coneRadiance != nullptr) {
+        std::vector<glm::vec3> occluded = *in.coneRadiance;
+        occludeTracedCones(in.reduced->gbuffer, occluded, *in.capsules, in.coneHalfAngle);
+        ConeCombineInputs rest = in;
+        rest.coneRadiance = &occluded;
+        rest.capsules = nullptr;
+        return combineCones(rest);
+    }
     const scene::GBuffer& full = *in.full;
     const ReducedGBuffer& reduced = *in.reduced;
     const std::size_t lowPixels = std::size_t(reduced.gbuffer.width) * std::size_t(reduced.gbuffer.height);
@@ -270,39 +396,10 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
     cones.halfAngle = in.coneHalfAngle;
     cones.tanHalfAngle = std::tan(in.coneHalfAngle);
     const ConeAngle angle{in.coneHalfAngle, std::cos(in.coneHalfAngle), std::sin(in.coneHalfAngle)};
-    // Per capsule, once: its segment, the sphere around it, and the squared distances within which
-    // it is near a pixel (40 radii from the segment; from the sphere's centre, a bound of that).
-    struct CapsuleBounds {
-        const scene::PosedCapsule* capsule;
-        glm::dvec3 a, u, centre;
-        double inverseLength2, bound, near2, reach2;
-    };
-    std::vector<CapsuleBounds> bounds;
-    if (in.capsules != nullptr)
-        for (const scene::PosedCapsule& c : *in.capsules) {
-            CapsuleBounds b;
-            b.capsule = &c;
-            b.a = glm::dvec3(c.capsule.a);
-            b.u = glm::dvec3(c.capsule.b) - b.a;
-            b.centre = b.a + 0.5 * b.u;
-            const double uu = glm::dot(b.u, b.u);
-            b.inverseLength2 = uu > 0.0 ? 1.0 / uu : 0.0;
-            const double r = double(c.capsule.radius);
-            b.bound = 0.5 * std::sqrt(uu) + r;
-            b.near2 = (40.0 * r) * (40.0 * r);
-            b.reach2 = (0.5 * std::sqrt(uu) + 40.0 * r) * (0.5 * std::sqrt(uu) + 40.0 * r);
-            bounds.push_back(b);
-        }
+    const CapsuleOccluders occluders(in.capsules, angle);
     Image<glm::vec3> out(full.width, full.height, glm::vec3(0.0f));
     tbb::parallel_for(0, full.height, [&](int y) {
-        // A capsule near the pixel, with the cosine below which a cone direction's angle to its
-        // bounding sphere's centre is too wide for the cone to touch it (-2: no such bound).
-        struct NearCapsule {
-            const scene::PosedCapsule* capsule;
-            glm::dvec3 towardCentre;
-            double cosLimit;
-        };
-        std::vector<NearCapsule> near;
+        std::vector<CapsuleOccluders::Near> near;
         for (int x = 0; x < full.width; ++x) {
             int samples[4];
             float weights[4];
@@ -312,29 +409,7 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
             const glm::dvec3 p(full.position.at(x, y)), n(full.normal.at(x, y));
             if (glm::dot(n, n) < 0.5)
                 continue;
-            // Capsules close enough to hide more than 0.25 % of a cone (40 radii from the segment).
-            near.clear();
-            for (const CapsuleBounds& c : bounds) {
-                const glm::dvec3 toCentre = c.centre - p;
-                const double d2 = glm::dot(toCentre, toCentre);
-                if (d2 >= c.reach2)
-                    continue; // farther than 40 radii from any point of the segment
-                const glm::dvec3 q = c.a + std::clamp(glm::dot(p - c.a, c.u) * c.inverseLength2, 0.0, 1.0) * c.u;
-                const glm::dvec3 fromSegment = p - q;
-                if (glm::dot(fromSegment, fromSegment) >= c.near2)
-                    continue;
-                // The sphere around the whole capsule: a cone whose axis is more than the cone's
-                // half angle plus the sphere's angular radius away from the sphere's centre misses
-                // every sphere occludeCone places on the segment, so its occlusion is exactly 0.
-                NearCapsule entry{c.capsule, glm::dvec3(0.0), -2.0};
-                if (d2 > c.bound * c.bound) {
-                    const double distance = std::sqrt(d2);
-                    const double sinB = c.bound / distance, cosB = std::sqrt(1.0 - sinB * sinB);
-                    entry.towardCentre = toCentre / distance;
-                    entry.cosLimit = angle.cosHalf * cosB - angle.sinHalf * sinB; // cos(half angle + asin(sinB))
-                }
-                near.push_back(entry);
-            }
+            occluders.collect(p, near);
             const auto w = computeIrradianceWeights(cones, n);
             // Each cone's radiance upsampled: the samples' 16 cones are contiguous, so they are
             // read sample by sample (the same sums, in the same order, per cone).
@@ -355,14 +430,8 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
                 double visible = 1.0;
                 if (useVisibility)
                     visible = std::clamp(double((*in.visibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
-                const glm::dvec3& dir = cones.directions[std::size_t(k)];
-                for (const NearCapsule& c : near) {
-                    // 1e-9 in cosine keeps rounding from culling a cone that grazes the sphere.
-                    if (glm::dot(c.towardCentre, dir) < c.cosLimit - 1e-9)
-                        continue;
-                    visible *= 1.0 - occludeCone(p, dir, angle, c.capsule->capsule.a, c.capsule->capsule.b,
-                                                 c.capsule->capsule.radius);
-                }
+                if (!near.empty())
+                    visible *= occluders.visibility(near, cones.directions[std::size_t(k)]);
                 e += w[std::size_t(k)] * visible * radiance;
             }
             out.at(x, y) = glm::max(glm::vec3(e), glm::vec3(0.0f));
@@ -371,11 +440,41 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in)
     return out;
 }
 
+void occludeTracedCones(const scene::GBuffer& traced, std::vector<glm::vec3>& coneRadiance,
+                        const std::vector<scene::PosedCapsule>& capsules, double coneHalfAngle)
+{
+    const std::size_t pixels = std::size_t(traced.width) * std::size_t(traced.height);
+    if (coneRadiance.size() != pixels * kConeCount)
+        throw Error("capsule occlusion: " + std::to_string(coneRadiance.size()) +
+                    " cone radiances for " + std::to_string(pixels) + " pixels x 16 cones");
+    const CapsuleOccluders occluders(
+        &capsules, {coneHalfAngle, std::cos(coneHalfAngle), std::sin(coneHalfAngle)});
+    if (occluders.empty())
+        return;
+    const std::array<glm::dvec3, kConeCount>& directions = scene::getConeDirections();
+    tbb::parallel_for(0, traced.height, [&](int y) {
+        std::vector<CapsuleOccluders::Near> near;
+        for (int x = 0; x < traced.width; ++x) {
+            if (glm::dot(traced.normal.at(x, y), traced.normal.at(x, y)) < 0.5f)
+                continue; // no surface: the combine reads nothing here
+            occluders.collect(glm::dvec3(traced.position.at(x, y)), near);
+            if (near.empty())
+                continue;
+            glm::vec3* row =
+                coneRadiance.data() +
+                (std::size_t(y) * std::size_t(traced.width) + std::size_t(x)) * kConeCount;
+            for (int k = 0; k < kConeCount; ++k)
+                if (row[k] != glm::vec3(0.0f))
+                    row[k] *= float(occluders.visibility(near, directions[std::size_t(k)]));
+        }
+    });
+}
+
 Image<glm::vec3> gatherConesReduced(
     const scene::GBuffer& full, int traceStep, double coneHalfAngle,
     const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
     const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones,
-    double* combineMs)
+    double* combineMs, CapsuleResolution capsuleResolution)
 {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
@@ -384,12 +483,17 @@ Image<glm::vec3> gatherConesReduced(
     std::vector<glm::vec3> cones;
     traceCones(reduced.gbuffer, cones);
     const auto tracedAt = Clock::now();
+    // The capsules at the traced pixels in place (combineCones would copy the cones for them).
+    const bool capsulesTraced =
+        capsuleResolution == CapsuleResolution::Traced && capsules != nullptr;
+    if (capsulesTraced)
+        occludeTracedCones(reduced.gbuffer, cones, *capsules, coneHalfAngle);
     ConeCombineInputs combine;
     combine.coneRadiance = &cones;
     combine.reduced = &reduced;
     combine.full = &full;
     combine.visibility = visibility;
-    combine.capsules = capsules;
+    combine.capsules = capsulesTraced ? nullptr : capsules;
     combine.coneHalfAngle = coneHalfAngle;
     Image<glm::vec3> irradiance = combineCones(combine);
     if (combineMs != nullptr)

@@ -39,12 +39,22 @@ std::vector<Image<float>> reduceConeImages(const std::vector<Image<float>>* full
 Image<glm::vec3> upsampleIrradiance(const Image<glm::vec3>& low, const ReducedGBuffer& reduced,
                                     const scene::GBuffer& full);
 
+//! Where the characters' capsules are tested against the 16 cones: at every pixel of the combine
+//! (`Full`), or at the traced pixels only (`Traced`: one per traceStep^2 block, the capsules'
+//! share of each cone multiplied into the cone's radiance there, then upsampled with it, as the
+//! occlusion is part of what the cones see). The talk tests them per pixel into "a 16 layer deep
+//! screen space texture array" of unstated resolution (shared/seeds/000_3da000e866ebc485.txt,
+//! "Characters"); `Traced` costs 1/traceStep^2 of the tests and blurs the capsules' shadows over
+//! a block, where the cones' light is already blurred.
+enum class CapsuleResolution { Full, Traced };
+
 //! The final combine of the talk ("Screen Space Directional Occlusion", "Characters"): the
 //! radiance each of the 16 cones gathered at the representative pixels (`coneRadiance`,
 //! [low-res pixel * 16 + cone]) is upsampled per cone, multiplied per pixel by the occlusion
 //! family's 16 visibilities (when given) and by the characters' capsules' occlusion of each
 //! cone (when given), and integrated with the pixel's own irradiance weights
-//! (cone_tracing.h computeIrradianceWeights). Full resolution in, full resolution out.
+//! (cone_tracing.h computeIrradianceWeights), the capsules tested where `capsuleResolution`
+//! says. Full resolution in, full resolution out.
 struct ConeCombineInputs {
     const std::vector<glm::vec3>* coneRadiance = nullptr;
     const ReducedGBuffer* reduced = nullptr;
@@ -52,19 +62,27 @@ struct ConeCombineInputs {
     const std::vector<Image<float>>* visibility = nullptr;      //!< 16 full-res images, or null
     const std::vector<scene::PosedCapsule>* capsules = nullptr; //!< or null
     double coneHalfAngle = 0.5;                                 //!< radians
+    CapsuleResolution capsuleResolution = CapsuleResolution::Full;
 };
 Image<glm::vec3> combineCones(const ConeCombineInputs& in);
+
+//! The capsules at the traced pixels (CapsuleResolution::Traced): every non-zero cone radiance of
+//! `traced`'s pixels
+//! ([pixel * 16 + cone]) times the share of the cone the capsules leave open.
+void occludeTracedCones(const scene::GBuffer& traced, std::vector<glm::vec3>& coneRadiance,
+                        const std::vector<scene::PosedCapsule>& capsules, double coneHalfAngle);
 
 //! A cone-traced structure's pixel gather as the family runs it (cascades, svo): the G-buffer
 //! reduced to one pixel per traceStep^2 block, `traceCones(reduced, coneRadiance)` fills
 //! [low-res pixel * 16 + cone] there, and combineCones brings it back to full resolution with the
-//! cone visibilities and capsules (either may be null). `combineMs`, when given, receives the
-//! wall time of the reduction and the combine (the gather's time beyond `traceCones`).
+//! cone visibilities and capsules (either may be null), the capsules tested where
+//! `capsuleResolution` says. `combineMs`, when given, receives the wall time of the reduction,
+//! the capsules and the combine (the gather's time beyond `traceCones`).
 Image<glm::vec3> gatherConesReduced(
     const scene::GBuffer& full, int traceStep, double coneHalfAngle,
     const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
     const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones,
-    double* combineMs = nullptr);
+    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full);
 
 //! The error split's rays (voxel_gi.h traceVoxelRays) at the same representative pixels as
 //! gatherConesReduced, upsampled the same way: `traceRays(reduced, irradiance)`.

@@ -180,4 +180,79 @@ TEST(CapsuleOcclusion, CombineMatchesTestingEveryCapsuleInEveryCone)
     EXPECT_GT(occludedPixels, w * h / 4);
 }
 
+// The capsules at the traced pixels: with every pixel traced (reduction 1) the visibility
+// multiplied into the cone before the combine is the one the combine multiplies after it, so
+// both placements agree to float rounding (the cone radiance is stored as float in between:
+// 1e-6 relative).
+TEST(CapsuleOcclusion, TracedPixelsGiveTheFullCombineWhenEveryPixelIsTraced)
+{
+    const int w = 24, h = 16;
+    scene::GBuffer g;
+    g.width = w;
+    g.height = h;
+    g.depth = Image<float>(w, h, 2.0f);
+    g.position = Image<glm::vec3>(w, h, glm::vec3(0.0f));
+    g.normal = Image<glm::vec3>(w, h, glm::vec3(0.0f, 1.0f, 0.0f));
+    g.materialId = Image<std::uint32_t>(w, h, 0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            g.position.at(x, y) = glm::vec3(-3.0f + 0.25f * x, 0.0f, -2.0f + 0.25f * y);
+    std::vector<scene::PosedCapsule> capsules(1);
+    capsules[0].capsule.a = {0.0f, 0.4f, 0.0f};
+    capsules[0].capsule.b = {0.0f, 1.4f, 0.2f};
+    capsules[0].capsule.radius = 0.3f;
+    const ReducedGBuffer reduced = reduceGBuffer(g, 1);
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    std::vector<glm::vec3> radiance(std::size_t(w * h) * kConeCount);
+    for (glm::vec3& r : radiance)
+        r = glm::vec3(unit(rng), unit(rng), unit(rng));
+    ConeCombineInputs in;
+    in.coneRadiance = &radiance;
+    in.reduced = &reduced;
+    in.full = &g;
+    in.capsules = &capsules;
+    in.coneHalfAngle = 0.52;
+    const Image<glm::vec3> full = combineCones(in);
+    in.capsuleResolution = CapsuleResolution::Traced;
+    const Image<glm::vec3> traced = combineCones(in);
+    in.capsules = nullptr;
+    const Image<glm::vec3> open = combineCones(in);
+    int shadowed = 0;
+    for (std::size_t i = 0; i < full.pixels.size(); ++i) {
+        shadowed += glm::length(open.pixels[i] - full.pixels[i]) > 1e-2f ? 1 : 0;
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(traced.pixels[i][c], full.pixels[i][c],
+                        1e-6 * std::max(1.0f, full.pixels[i][c]))
+                << i;
+    }
+    EXPECT_GT(shadowed, 50); // the capsule's shadow covers part of the plane
+
+    // Reduced by 4: the capsule still darkens part of the plane, and no pixel gets more light than
+    // without it or less than none.
+    const ReducedGBuffer quarter = reduceGBuffer(g, 4);
+    std::vector<glm::vec3> low(std::size_t(quarter.gbuffer.width * quarter.gbuffer.height) *
+                               kConeCount);
+    for (glm::vec3& r : low)
+        r = glm::vec3(unit(rng), unit(rng), unit(rng));
+    ConeCombineInputs q;
+    q.coneRadiance = &low;
+    q.reduced = &quarter;
+    q.full = &g;
+    q.capsules = &capsules;
+    q.coneHalfAngle = 0.52;
+    q.capsuleResolution = CapsuleResolution::Traced;
+    const Image<glm::vec3> quarterTraced = combineCones(q);
+    q.capsules = nullptr;
+    const Image<glm::vec3> quarterOpen = combineCones(q);
+    int darker = 0;
+    for (std::size_t i = 0; i < quarterTraced.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_GE(quarterTraced.pixels[i][c], 0.0f);
+            EXPECT_LE(quarterTraced.pixels[i][c], quarterOpen.pixels[i][c] * (1.0f + 1e-6f));
+            darker += quarterTraced.pixels[i][c] < 0.99f * quarterOpen.pixels[i][c] ? 1 : 0;
+        }
+    EXPECT_GT(darker, 50);
+}
+
 } // namespace

@@ -46,8 +46,10 @@
 // | inject_offset | float | 4       | [0, 8]          | leaves (the leaves' cones)        |
 // | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled         |
 // | trace_step    | int   | 4       | [1, 8]          | pixels                            |
-// | device        | enum  | vulkan  | vulkan, cpu     | where the pixel gather runs       |
-// | inner_layers  | int   | 4       | [1, 8]          | leaves of solid kept inside closed surfaces |
+// | device        | enum  | auto    | auto, vulkan, cpu | where the pixel gather runs (auto: Vulkan
+// on a GPU, C++ on lavapipe) | | capsule_resolution | enum | traced | traced, full  | where the
+// capsules are tested (the traced pixels or every pixel) | | inner_layers  | int   | 4       | [1,
+// 8]          | leaves of solid kept inside closed surfaces |
 //
 // start_offset 4 as svo (the same leaves, the same self-occlusion at a smaller offset);
 // inject_offset 4 as svo: at 1 / 2 / 4 leaves, leak room with 0.5-leaf walls 0.52 / 0.70 / 0.91

@@ -34,12 +34,16 @@
 //    with optional pre-combined direction buffers. At full resolution each cone's radiance is
 //    upsampled by depth and normal and multiplied by the pixel's per-direction visibilities of
 //    bentcone_ssdo (when that occlusion technique runs in the same frame) and by the characters'
-//    capsules tested against the cone ("Characters": not voxelized; families/voxel_gi/upsample.h),
-//    on Vulkan when the gather runs there on a GPU, else in C++, or where `combine_device`
-//    says (Vulkan: cone_combine_gpu.h, the cones of a Vulkan gather read where they are, only
-//    the irradiance read back).
+//    capsules tested against the cone ("Characters": not voxelized; families/voxel_gi/upsample.h;
+//    `capsule_resolution: traced`, the default, tests them at the traced pixels and upsamples
+//    them with the cones, 1/16 of the tests at trace_step 4), on Vulkan when the gather runs
+//    there on a GPU, else in C++, or where `combine_device` says (Vulkan: cone_combine_gpu.h,
+//    the cones of a Vulkan gather read where they are, only the irradiance read back; the
+//    capsules at the traced pixels multiply the device's cone buffer in place).
 //
-// The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`) or in C++; so
+// The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`, the default
+// `auto` where the Vulkan device is a GPU) or in C++ (`device: cpu`, and `auto` where Vulkan runs
+// on the CPU, lavapipe: there the C++ gather is 5-10x faster, README "Voxel GI"); so
 // do the cones of light injection (shaders/cascade_inject.comp, `inject_device: vulkan`: the 16
 // cones and the shadow cones of every surface voxel; the light buffers stay in C++, go up per
 // level when they changed, and the C++ side reflects, propagates inward and pre-combines the
@@ -47,10 +51,11 @@
 // (framework/families/voxel_gi/voxelize_gpu.h, `voxelize_device: vulkan`: the columns' rays and
 // the per-voxel resolve; the binning of triangles to columns and the solid fill's last step in
 // C++).
-// With `far_start` > 0 the pixel cones are split ("Split Cone Trace"): each pixel traces its
-// cones up to far_start voxels of its start level, and the rest comes from far cones traced once
-// per voxel centre of the level (when a pixel first needs them, kept until a level they sample
-// changes) and interpolated trilinearly (cascade_gather.cpp gatherConesSplit). The far cones
+// With `far_start` > 0 (the default) the pixel cones are split ("Split Cone Trace"): each pixel
+// traces its cones up to far_start voxels of its start level (at least start_offset: a smaller
+// far_start is raised to it, and the row records the value used), and the rest comes from far cones
+// traced once per voxel centre of the level (when a pixel first needs them, kept until a level they
+// sample changes) and interpolated trilinearly (cascade_gather.cpp gatherConesSplit). The far cones
 // are traced by the pixel gather's device (Vulkan: the gather shader's far-cone mode, or C++), as
 // are the near parts and the composite.
 // With `extrapolate` the pixels also gather the talk's extrapolated extra bounce ("Extra Magic",
@@ -76,17 +81,21 @@
 // | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
 // | precombine     | bool  | true              |                                       |        |
 // | solid          | bool  | true              |                                       |        |
-// | device         | enum  | vulkan            | vulkan, cpu (pixel gather)            |        |
+// | device         | enum  | auto              | auto, vulkan, cpu (pixel gather)      |        |
 // | combine_device | enum  | auto              | auto, vulkan, cpu (full-res. combine) |        |
+// | capsule_resolution | enum | traced          | traced, full                          |        |
 // | inject_device  | enum  | cpu               | cpu, vulkan (light injection's cones) |        |
 // | voxelize_device| enum  | cpu               | cpu, vulkan (resolution <= 128)       |        |
 // | trace_step     | int   | 4                 | [1, 8]                                | pixels |
-// | far_start      | float | 0 (whole cones)   | 0 or [start_offset, 64]               | voxels of the pixel's start level |
+// | far_start      | float | 1                 | 0 (whole cones) or [start_offset, 64] | voxels of the pixel's start level |
 // | extrapolate    | bool  | false             | needs bounces >= 2                    |        |
 // | level_noise    | float | 0                 | [0, 0.5]                              | of a level's radius |
 // clang-format on
 // voxel_size 0 makes the outermost level hold the whole scene seen from the first camera.
-// The talk's split is "about a meter" at its 0.4 m finest voxels: far_start about 2.5.
+// The talk's split is "about a meter" at its 0.4 m finest voxels: far_start about 2.5. The
+// default 1 (= start_offset: no near part, the pixel's cones interpolated from the far cones of
+// the voxel centres around it) is on both study scenes the fastest and the most accurate of 0, 1,
+// 1.5 and 2.5 (experiments/gpu_voxel_gi.yaml; README "Voxel GI"); 0 traces whole cones per pixel.
 // The talk: 6 levels of 32^3, 16x supersampling per axis, one level per frame, one pass,
 // 2 bounces in the voxels plus the pixel's gather (bounces: 3 here).
 //
@@ -98,6 +107,7 @@
 #include "cascade_inject_gpu.h"
 #include "cascade_volume.h"
 #include "families/voxel_gi/cone_combine_gpu.h"
+#include "families/voxel_gi/sparse_cone_params.h"
 
 #include "core/error.h"
 #include "core/hash.h"
@@ -150,17 +160,18 @@ public:
         schema.addInt("trace_step", 4, 1, 8, "pixels",
                       "trace one pixel per trace_step^2 block and upsample (depth- and "
                       "normal-aware); 4 = the talk's quarter resolution, 1 = every pixel");
-        schema.addFloat("far_start", 0.0, 0.0, 64.0, "voxels",
+        schema.addFloat("far_start", 1.0, 0.0, 64.0, "voxels",
                         "split near/far cones: pixels trace up to this many voxels of their "
-                        "start level, far cones from the voxel centres do the rest (0 = off)");
+                        "start level (at least start_offset), far cones from the voxel centres "
+                        "do the rest (0 = whole cones per pixel)");
         schema.addBool("extrapolate", false,
                        "add the talk's extrapolated extra bounce (bounces + 1 reflections; "
                        "needs bounces >= 2)");
         schema.addFloat("level_noise", 0.0, 0.0, 0.5, "of a level's radius",
                         "3D noise offset on the pixel cones' start-level blend (hides the "
                         "transition between levels)");
-        schema.addEnum("device", "vulkan", {"vulkan", "cpu"},
-                       "where the pixel gather runs (Vulkan needs precombine)");
+        voxelgi::declareGatherPlacement(
+            schema); // device (Vulkan needs precombine), capsule_resolution
         schema.addEnum("combine_device", "auto", {"auto", "vulkan", "cpu"},
                        "where the full-resolution combine runs (upsampling, visibilities, "
                        "capsules); auto: on Vulkan when the pixel gather runs there on a GPU "
@@ -191,16 +202,15 @@ public:
         mSettings.stepScale = p.getFloat("step_scale");
         mSettings.precombine = p.getBool("precombine");
         mSettings.solid = p.getBool("solid");
-        mOnGpu = p.getString("device") == "vulkan";
+        mDevice = p.getString("device");
         mInjectOnGpu = p.getString("inject_device") == "vulkan";
         mCombineDevice = p.getString("combine_device");
+        mCapsuleResolution = voxelgi::readCapsuleResolution(p);
         mVoxelizeOnGpu = p.getString("voxelize_device") == "vulkan";
         mTraceStep = int(p.getInt("trace_step"));
         mSettings.farStart = p.getFloat("far_start");
-        if (mSettings.farStart > 0.0 && mSettings.farStart < mSettings.startOffset)
-            throw Error("cascades: far_start must be 0 (off) or at least start_offset (" +
-                        std::to_string(mSettings.startOffset) + " voxels), found " +
-                        std::to_string(mSettings.farStart));
+        if (mSettings.farStart > 0.0) // no split nearer than where the cones start
+            mSettings.farStart = std::max(mSettings.farStart, mSettings.startOffset);
         mSettings.extrapolate = p.getBool("extrapolate");
         mSettings.levelNoise = p.getFloat("level_noise");
         if (mSettings.extrapolate && mSettings.bounces < 2)
@@ -223,9 +233,10 @@ public:
         p.set("step_scale", mSettings.stepScale);
         p.set("precombine", mSettings.precombine);
         p.set("solid", mSettings.solid);
-        p.set("device", std::string(mOnGpu ? "vulkan" : "cpu"));
+        p.set("device", mDevice);
         p.set("inject_device", std::string(mInjectOnGpu ? "vulkan" : "cpu"));
         p.set("combine_device", mCombineDevice);
+        p.set("capsule_resolution", voxelgi::toString(mCapsuleResolution));
         p.set("voxelize_device", std::string(mVoxelizeOnGpu ? "vulkan" : "cpu"));
         p.set("trace_step", std::int64_t(mTraceStep));
         p.set("far_start", mSettings.farStart);
@@ -300,7 +311,7 @@ public:
         // Reduced resolution ("Trace at a lower resolution"): one pixel per trace_step^2 block,
         // each cone's radiance upsampled by depth and normal, times the pixel's own visibilities
         // (bent-cone SSDO) and the characters' capsules.
-        mGatheredOnGpu = mOnGpu && mSettings.precombine && input.gpu != nullptr;
+        mGatheredOnGpu = voxelgi::shouldGatherOnGpu(input.gpu, mDevice) && mSettings.precombine;
         mCombinedOnGpu = voxelgi::shouldCombineOnGpu(input.gpu, mGatheredOnGpu, mCombineDevice);
         // The Vulkan gather's cones: the far cones first with split cones (on Vulkan too).
         const auto prepareGpuCones = [&](const scene::GBuffer& reduced) {
@@ -326,7 +337,7 @@ public:
                     prepareGpuCones(reduced);
                     return mGpu.gatherConesOnDevice(*input.gpu, *mVolume, reduced);
                 },
-                &mCombineMs);
+                &mCombineMs, mCapsuleResolution);
             return;
         }
         irradiance = voxelgi::gatherConesReduced(
@@ -340,7 +351,7 @@ public:
                     mVolume->gatherCones(reduced, cones);
                 }
             },
-            &mCombineMs);
+            &mCombineMs, mCapsuleResolution);
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
@@ -421,13 +432,14 @@ private:
     voxelgi::VoxelizerGpu mVoxelizer;
     bool mVoxelizeOnGpu = false;
     bool mVoxelizedOnGpu = false;
-    bool mOnGpu = true;
+    std::string mDevice = "auto";
     std::string mCombineDevice = "auto";
     bool mCombinedOnGpu = false;
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;
     bool mGatheredOnGpu = false;
     double mCombineMs = std::nan(""); // the gather beyond its cones: reduction and combine
+    voxelgi::CapsuleResolution mCapsuleResolution = voxelgi::CapsuleResolution::Traced;
     int mTraceStep = 4;
 };
 

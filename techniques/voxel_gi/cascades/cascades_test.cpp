@@ -374,15 +374,20 @@ TEST(Cascades, FarConesAreTracedOnceUntilALevelTheySampleChanges)
     EXPECT_EQ(first, third);
 }
 
-TEST(Cascades, TheSplitNeedsAStartBeyondTheOffset)
+// A split nearer than the cones' start is raised to it (the default far_start 1 with a larger
+// start_offset), and the row records the value used; 0 keeps whole cones.
+TEST(Cascades, TheSplitStartsNoNearerThanTheCones)
 {
-    EXPECT_NO_THROW(createTechnique(rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
-                                    {{"far_start", 2.5}}));
-    EXPECT_THROW(createTechnique(rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
-                                 {{"far_start", 0.5}, {"device", std::string("cpu")}}),
-                 Error);
-    EXPECT_NO_THROW(createTechnique(rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
-                                    {{"far_start", 2.5}, {"device", std::string("cpu")}}));
+    const auto farStart = [](double far, double offset) {
+        auto t = createTechnique(
+            rtlabRegisterTechnique_voxel_gi_cascades, "cascades",
+            {{"far_start", far}, {"start_offset", offset}, {"device", std::string("cpu")}});
+        return t->effectiveParams().getFloat("far_start");
+    };
+    EXPECT_EQ(farStart(2.5, 1.0), 2.5);
+    EXPECT_EQ(farStart(0.5, 1.0), 1.0);
+    EXPECT_EQ(farStart(1.0, 2.0), 2.0);
+    EXPECT_EQ(farStart(0.0, 2.0), 0.0);
 }
 
 TEST(Cascades, TheExtrapolatedBounceCompletesTheFurnacesSeries)

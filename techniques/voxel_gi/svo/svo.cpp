@@ -19,7 +19,8 @@
 //    leaves are isotropic (the paper's); the octree is built top-down over them (node tiles of
 //    2x2x2, one child pointer per node) and their occupancy filtered up the tree anisotropically
 //    (6 faces, front-to-back per column). Rebuilt only when the static geometry changes.
-// 2. inject light: per surface leaf, the family's 16-cone gather through the octree (emission, sky as 16
+// 2. inject light: per surface leaf, the family's 16-cone gather through the octree (emission, sky
+// as 16
 //    lobes, point lights with shadow cones), three passes (direct, bounce 1, bounce 2), each
 //    filtered up the tree before the next reads it. Skipped while the tree and lights are
 //    unchanged.
@@ -45,8 +46,10 @@
 // | inject_offset | float | 4       | [0, 8]          | leaves (the leaves' cones)    |
 // | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled     |
 // | trace_step    | int   | 4       | [1, 8]          | pixels                        |
-// | device        | enum  | vulkan  | vulkan, cpu     | where the pixel gather runs   |
-// | inner_layers  | int   | 1       | [1, 8]          | leaves of solid kept inside closed surfaces |
+// | device        | enum  | auto    | auto, vulkan, cpu | where the pixel gather runs (auto: Vulkan
+// on a GPU, C++ on lavapipe) | | capsule_resolution | enum | traced | traced, full  | where the
+// capsules are tested (the traced pixels or every pixel) | | inner_layers  | int   | 1       | [1,
+// 8]          | leaves of solid kept inside closed surfaces |
 //
 // resolution 64: the pixel's cones start a fixed number of leaves out (there is no start level
 // chosen by the distance to the camera), so finer leaves bring the self-occlusion back and the

@@ -9,13 +9,18 @@
 // Children, GDC 2015 (shared/seeds/000_3da000e866ebc485.txt, "Trace at a lower resolution",
 // "Screen Space Directional Occlusion", "Characters").
 //
+// With flags.w = 1 the same shader runs over the reduced pixels instead and multiplies their cone
+// radiances by the capsules' visibility in place (upsample.h CapsuleResolution::Traced); the
+// combine then runs with no capsules.
+//
 // The G-buffer arrives as the frame holds it (float positions, normals and depth, one word of
 // material per pixel), so that the upload is a copy; positions are made relative to an anchor
 // near the camera here, which is exact for the float inputs wherever the capsule tests matter.
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
-layout(std430, binding = 0) readonly buffer ConeBuffer { vec4 coneRadiance[]; };     // [low pixel * 16 + cone]
+// [low pixel * 16 + cone]; written only by the capsules at the traced pixels (flags.w = 1).
+layout(std430, binding = 0) buffer ConeBuffer { vec4 coneRadiance[]; };
 layout(std430, binding = 1) readonly buffer RepresentativeBuffer { int representative[]; }; // [low pixel]: full pixel, -1: none
 layout(std430, binding = 2) readonly buffer PositionBuffer { float positions[]; };  // 3 per full pixel, world
 layout(std430, binding = 3) readonly buffer NormalBuffer { float normals[]; };      // 3 per full pixel
@@ -32,7 +37,7 @@ const vec3 kCones[16] = vec3[16](CONE_DIRECTIONS);
 
 layout(push_constant) uniform Constants {
     ivec4 size;   // full width, height; low width, height
-    ivec4 flags;  // x: factor, y: capsules, z: 1 = visibility given
+    ivec4 flags;  // x: factor, y: capsules, z: 1 = visibility given, w: 1 = the capsules at the traced pixels
     vec4 angle;   // cone half-angle, its cosine, its sine, 1 - its cosine
     vec4 anchor;  // xyz: what positions are made relative to
 } pc;
@@ -188,8 +193,72 @@ float occludeCone(vec3 p, vec3 dir, int c)
     return clamp(smaller * share / coneSolid, 0.0, 1.0);
 }
 
+// Whether capsule c can hide part of a cone from p (within 40 radii of its segment, p not on
+// it), with the cosine below which a cone direction's angle to the centre of the sphere around
+// the capsule is too wide for the cone to touch it (-2: no such bound). upsample.cpp
+// CapsuleOccluders::collect.
+bool isCapsuleNear(vec3 p, int c, out vec3 towardCentre, out float cosLimit)
+{
+    towardCentre = vec3(0.0);
+    cosLimit = -2.0;
+    const vec4 centre = capsules[4 * c + 2];
+    const vec4 reach = capsules[4 * c + 3];
+    const vec3 toCentre = centre.xyz - p;
+    const float d2 = dot(toCentre, toCentre);
+    if (d2 >= reach.y)
+        return false;
+    const vec3 fromSegment = p - closestOnSegment(p, capsules[4 * c].xyz, capsules[4 * c + 1].xyz,
+                                                 capsules[4 * c + 1].w);
+    if (dot(fromSegment, fromSegment) >= reach.x)
+        return false;
+    if (d2 > centre.w * centre.w) {
+        const float distance = sqrt(d2);
+        const float sinB = centre.w / distance, cosB = sqrt(max(0.0, 1.0 - sinB * sinB));
+        towardCentre = toCentre / distance;
+        cosLimit = pc.angle.y * cosB - pc.angle.z * sinB;
+    }
+    return true;
+}
+
+// The capsules at the traced pixels (upsample.h CapsuleResolution::Traced): per reduced pixel,
+// every non-zero cone radiance times the share of the cone the capsules leave open, in place,
+// before the combine upsamples the cones (upsample.cpp occludeTracedCones).
+void occludeTracedCones()
+{
+    const int x = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y);
+    const int lw = pc.size.z, lh = pc.size.w;
+    if (x >= lw || y >= lh)
+        return;
+    const int s = y * lw + x;
+    const int r = representative[s];
+    if (r < 0 || materials[r] == kNoMaterial)
+        return;
+    const vec3 p = readPosition(r), n = readNormal(r);
+    if (dot(n, n) < 0.5)
+        return;
+    float visible[16];
+    [[unroll]] for (int k = 0; k < 16; ++k)
+        visible[k] = 1.0;
+    for (int c = 0; c < pc.flags.y; ++c) {
+        vec3 towardCentre;
+        float cosLimit;
+        if (!isCapsuleNear(p, c, towardCentre, cosLimit))
+            continue;
+        [[unroll]] for (int k = 0; k < 16; ++k)
+            if (coneRadiance[s * 16 + k].rgb != vec3(0.0) && dot(towardCentre, kCones[k]) >= cosLimit - 1e-5)
+                visible[k] *= 1.0 - occludeCone(p, kCones[k], c);
+    }
+    [[unroll]] for (int k = 0; k < 16; ++k)
+        if (visible[k] != 1.0)
+            coneRadiance[s * 16 + k].rgb *= visible[k];
+}
+
 void main()
 {
+    if (pc.flags.w == 1) {
+        occludeTracedCones();
+        return;
+    }
     const int x = int(gl_GlobalInvocationID.x), y = int(gl_GlobalInvocationID.y);
     const int w = pc.size.x, h = pc.size.y;
     if (x >= w || y >= h)
@@ -221,24 +290,10 @@ void main()
     // The capsules in order (as the C++ combine multiplies them per cone): those within 40 radii
     // of the pixel, and in them the cones that can reach the sphere around the capsule.
     for (int c = 0; c < pc.flags.y; ++c) {
-        const vec4 centre = capsules[4 * c + 2];
-        const vec4 reach = capsules[4 * c + 3];
-        const vec3 toCentre = centre.xyz - p;
-        const float d2 = dot(toCentre, toCentre);
-        if (d2 >= reach.y)
+        vec3 towardCentre;
+        float cosLimit;
+        if (!isCapsuleNear(p, c, towardCentre, cosLimit))
             continue;
-        const vec3 fromSegment = p - closestOnSegment(p, capsules[4 * c].xyz, capsules[4 * c + 1].xyz,
-                                                     capsules[4 * c + 1].w);
-        if (dot(fromSegment, fromSegment) >= reach.x)
-            continue;
-        vec3 towardCentre = vec3(0.0);
-        float cosLimit = -2.0;
-        if (d2 > centre.w * centre.w) {
-            const float distance = sqrt(d2);
-            const float sinB = centre.w / distance, cosB = sqrt(max(0.0, 1.0 - sinB * sinB));
-            towardCentre = toCentre / distance;
-            cosLimit = pc.angle.y * cosB - pc.angle.z * sinB;
-        }
         [[unroll]] for (int k = 0; k < 16; ++k)
             if (coneWeight[k] > 0.0 && dot(towardCentre, kCones[k]) >= cosLimit - 1e-5)
                 visible[k] *= 1.0 - occludeCone(p, kCones[k], c);
