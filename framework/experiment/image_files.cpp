@@ -72,6 +72,24 @@ Image<glm::vec3> readExrRgb(const std::string& path)
     return image;
 }
 
+Image<glm::vec3> readPngRgb(const std::string& path)
+{
+    auto in = OIIO::ImageInput::open(path);
+    if (!in)
+        throw Error(path + ": cannot open: " + OIIO::geterror());
+    const OIIO::ImageSpec& spec = in->spec();
+    if (std::string(in->format_name()) != "png")
+        throw Error(path + ": expected a PNG file, found " + in->format_name());
+    checkImageFileSize(path, spec.width, spec.height, spec.nchannels);
+    if (spec.nchannels < 3)
+        throw Error(path + ": expected 3 channels, found " + std::to_string(spec.nchannels));
+    // Read as float: OpenImageIO maps 8-bit values to [0, 1].
+    Image<glm::vec3> image(spec.width, spec.height);
+    if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, &image.pixels.data()->x))
+        throw Error(path + ": cannot read: " + in->geterror());
+    return image;
+}
+
 Image<float> readExrScalar(const std::string& path)
 {
     checkExrHeader(path); // before the decoder sees a size it would allocate for

@@ -18,6 +18,8 @@ void writeExr(const Image<glm::vec3>& image, const std::string& path);
 void writePng(const Image<glm::vec3>& display, const std::string& path);
 //! Reads the first three channels of an EXR.
 Image<glm::vec3> readExrRgb(const std::string& path);
+//! Reads the first 3 channels of a PNG (writePng's files) as display values in [0, 1].
+Image<glm::vec3> readPngRgb(const std::string& path);
 //! Reads a one-channel EXR (the first channel).
 Image<float> readExrScalar(const std::string& path);
 

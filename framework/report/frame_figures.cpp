@@ -228,11 +228,11 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory,
                               truthHdr = getText(frame, "image.truth_hdr");
             if (png.empty() || !std::filesystem::exists(png) || !std::filesystem::exists(truthHdr))
                 break;
-            images.push_back(plot::makeColorCell(experiment::readExrRgb(png)));
+            images.push_back(plot::makeColorCell(experiment::readPngRgb(png)));
             errors.push_back(plot::makeErrorCell(plot::computeAbsoluteErrorMap(
                 experiment::readExrRgb(hdr), experiment::readExrRgb(truthHdr))));
             if (imageRows.empty())
-                truths.push_back(plot::makeColorCell(experiment::readExrRgb(truthPng)));
+                truths.push_back(plot::makeColorCell(experiment::readPngRgb(truthPng)));
         }
         if (images.empty() || (frameCount && images.size() != frameCount))
             continue;

@@ -54,6 +54,26 @@ TEST(ImageFileSize, PositiveAndAtMostTwoToThe26Values)
     EXPECT_THROW(checkImageFileSize("a.exr", 1ll << 40, 1ll << 40, 1), Error); // no overflow
 }
 
+// writePng's files read back as display values (8 bits: within half a step of 1/255), and an
+// EXR is not taken for a PNG.
+TEST(PngFile, ReadsBackWhatWritePngWrote)
+{
+    Image<glm::vec3> image(4, 2, glm::vec3(0.0f));
+    for (std::size_t i = 0; i < image.pixels.size(); ++i)
+        image.pixels[i] = glm::vec3(float(i) / 7.0f, 1.0f - float(i) / 7.0f, 0.5f);
+    const fs::path png = fs::temp_directory_path() / "rtlab_image_file_test.png";
+    experiment::writePng(image, png.string());
+    const Image<glm::vec3> back = experiment::readPngRgb(png.string());
+    ASSERT_EQ(back.width, 4);
+    ASSERT_EQ(back.height, 2);
+    for (std::size_t i = 0; i < image.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            EXPECT_NEAR(back.pixels[i][c], image.pixels[i][c], 0.5f / 255.0f + 1e-6f) << i;
+    const fs::path exr = fs::temp_directory_path() / "rtlab_image_file_test_not_png.exr";
+    experiment::writeExr(image, exr.string());
+    EXPECT_THROW(experiment::readPngRgb(exr.string()), Error);
+}
+
 TEST(ExrHeader, RtlabsOwnFilesPassAndHugeOrTruncatedHeadersAreRefused)
 {
     Image<glm::vec3> image(5, 3, glm::vec3(0.25f, 0.5f, 0.75f));

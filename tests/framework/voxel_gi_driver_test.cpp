@@ -7,6 +7,7 @@
 #include "experiment/image_files.h"
 #include "experiment/runner.h"
 #include "plugin/technique.h"
+#include "report/report.h"
 
 #include <gtest/gtest.h>
 
@@ -98,6 +99,25 @@ TEST(VoxelGiDriver, CascadesFillTheIndirectSlotOfTheLitFrame)
             std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
             << "lit frame " << i;
     }
+}
+
+// The study report of a game-frame run draws its filmstrip (the lit PNGs and the HDR error
+// maps of every frame): the PNGs are read as PNGs, not through the EXR reader.
+TEST(VoxelGiDriver, TheReportDrawsTheGameFramesFilmstrip)
+{
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_voxel_gi_driver_report";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const auto rows = runGameFrame("true", dir);
+    ASSERT_EQ(rows.size(), 2u) << (rows.empty() ? "" : rows[0].at("error"));
+    const report::ReportSummary summary =
+        report::writeStudyReport((dir / "out_true_auto").string(), plugin::builtinRegistry());
+    const bool filmstrip =
+        std::any_of(summary.plots.begin(), summary.plots.end(), [](const std::string& p) {
+            return std::filesystem::path(p).filename().string().rfind("filmstrip_", 0) == 0;
+        });
+    EXPECT_TRUE(filmstrip) << summary.plots.size() << " plots";
+    EXPECT_TRUE(std::filesystem::exists(summary.html));
 }
 
 // The full-resolution combine (SSDO's 16 visibilities and the cones upsampled) on Vulkan, the
