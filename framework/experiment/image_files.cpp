@@ -56,12 +56,17 @@ void writePng(const Image<glm::vec3>& display, const std::string& path)
         throw Error(path + ": cannot write: " + out->geterror());
 }
 
-Image<glm::vec3> readExrRgb(const std::string& path)
+namespace {
+
+// The first 3 channels of an image file OpenImageIO opens, as float (8-bit values in [0, 1]).
+Image<glm::vec3> readRgb(const std::string& path, const char* format)
 {
-    checkExrHeader(path); // before the decoder sees a size it would allocate for
     auto in = OIIO::ImageInput::open(path);
     if (!in)
         throw Error(path + ": cannot open: " + OIIO::geterror());
+    if (std::string(in->format_name()) != format)
+        throw Error(path + ": expected " + (std::string(format) == "png" ? "a PNG" : "an OpenEXR") +
+                    " file, found " + in->format_name());
     const OIIO::ImageSpec& spec = in->spec();
     checkImageFileSize(path, spec.width, spec.height, spec.nchannels);
     if (spec.nchannels < 3)
@@ -72,22 +77,17 @@ Image<glm::vec3> readExrRgb(const std::string& path)
     return image;
 }
 
+} // namespace
+
+Image<glm::vec3> readExrRgb(const std::string& path)
+{
+    checkExrHeader(path); // before the decoder sees a size it would allocate for
+    return readRgb(path, "openexr");
+}
+
 Image<glm::vec3> readPngRgb(const std::string& path)
 {
-    auto in = OIIO::ImageInput::open(path);
-    if (!in)
-        throw Error(path + ": cannot open: " + OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    if (std::string(in->format_name()) != "png")
-        throw Error(path + ": expected a PNG file, found " + in->format_name());
-    checkImageFileSize(path, spec.width, spec.height, spec.nchannels);
-    if (spec.nchannels < 3)
-        throw Error(path + ": expected 3 channels, found " + std::to_string(spec.nchannels));
-    // Read as float: OpenImageIO maps 8-bit values to [0, 1].
-    Image<glm::vec3> image(spec.width, spec.height);
-    if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, &image.pixels.data()->x))
-        throw Error(path + ": cannot read: " + in->geterror());
-    return image;
+    return readRgb(path, "png");
 }
 
 Image<float> readExrScalar(const std::string& path)

@@ -106,11 +106,9 @@ TEST(CapsuleOcclusion, CoversAConeItFillsAndNothingBehindOrAside)
     EXPECT_LT(previous, 0.01);
 }
 
-// The combine skips the capsule test for cones that miss a capsule's bounding sphere and for
-// capsules farther than 40 radii; the result must equal testing every capsule in every cone.
-TEST(CapsuleOcclusion, CombineMatchesTestingEveryCapsuleInEveryCone)
+// A floor at y = 0 seen from above: w x h pixels 0.25 apart, normals up, depth 2.
+scene::GBuffer makeFloor(int w, int h)
 {
-    const int w = 24, h = 16;
     scene::GBuffer g;
     g.width = w;
     g.height = h;
@@ -119,11 +117,21 @@ TEST(CapsuleOcclusion, CombineMatchesTestingEveryCapsuleInEveryCone)
     g.normal = Image<glm::vec3>(w, h, glm::vec3(0.0f, 1.0f, 0.0f));
     g.materialId = Image<std::uint32_t>(w, h, 0);
     for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
+        for (int x = 0; x < w; ++x)
             g.position.at(x, y) = glm::vec3(-3.0f + 0.25f * x, 0.0f, -2.0f + 0.25f * y);
+    return g;
+}
+
+// The combine skips the capsule test for cones that miss a capsule's bounding sphere and for
+// capsules farther than 40 radii; the result must equal testing every capsule in every cone.
+TEST(CapsuleOcclusion, CombineMatchesTestingEveryCapsuleInEveryCone)
+{
+    const int w = 24, h = 16;
+    scene::GBuffer g = makeFloor(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
             if ((x + y) % 5 == 0) // some tilted normals
                 g.normal.at(x, y) = glm::normalize(glm::vec3(0.6f, 1.0f, -0.3f));
-        }
     std::mt19937 rng(11);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
     std::vector<scene::PosedCapsule> capsules;
@@ -187,16 +195,7 @@ TEST(CapsuleOcclusion, CombineMatchesTestingEveryCapsuleInEveryCone)
 TEST(CapsuleOcclusion, TracedPixelsGiveTheFullCombineWhenEveryPixelIsTraced)
 {
     const int w = 24, h = 16;
-    scene::GBuffer g;
-    g.width = w;
-    g.height = h;
-    g.depth = Image<float>(w, h, 2.0f);
-    g.position = Image<glm::vec3>(w, h, glm::vec3(0.0f));
-    g.normal = Image<glm::vec3>(w, h, glm::vec3(0.0f, 1.0f, 0.0f));
-    g.materialId = Image<std::uint32_t>(w, h, 0);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x)
-            g.position.at(x, y) = glm::vec3(-3.0f + 0.25f * x, 0.0f, -2.0f + 0.25f * y);
+    const scene::GBuffer g = makeFloor(w, h);
     std::vector<scene::PosedCapsule> capsules(1);
     capsules[0].capsule.a = {0.0f, 0.4f, 0.0f};
     capsules[0].capsule.b = {0.0f, 1.4f, 0.2f};
