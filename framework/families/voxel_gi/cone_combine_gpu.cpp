@@ -19,8 +19,8 @@ namespace {
 
 struct CombineConstants {
     glm::ivec4 size{0};  // full width, height; low width, height
-    glm::ivec4 flags{
-        0}; // factor, capsules, visibility given, 1 = the capsules at the traced pixels
+    // factor, capsules, visibility given, 1 = the capsules at the traced pixels
+    glm::ivec4 flags{0};
     glm::vec4 angle{0.0f};
     glm::vec4 anchor{0.0f};
 };

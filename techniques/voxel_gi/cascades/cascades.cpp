@@ -43,7 +43,7 @@
 //
 // The pixel gather runs on Vulkan (shaders/cascade_gather.comp, `device: vulkan`, the default
 // `auto` where the Vulkan device is a GPU) or in C++ (`device: cpu`, and `auto` where Vulkan runs
-// on the CPU, lavapipe: there the C++ gather is 5-10x faster, README "Voxel GI"); so
+// on the CPU, lavapipe: there the C++ gather is 1.6-3x faster, README "Voxel GI"); so
 // do the cones of light injection (shaders/cascade_inject.comp, `inject_device: vulkan`: the 16
 // cones and the shadow cones of every surface voxel; the light buffers stay in C++, go up per
 // level when they changed, and the C++ side reflects, propagates inward and pre-combines the
