@@ -131,16 +131,23 @@ void CascadeVolume::invalidateFarCones()
     }
 }
 
-glm::vec3 CascadeVolume::sampleFar(const Level& level, const glm::dvec3& p, int cone) const
+CascadeVolume::FarNeighbourhood CascadeVolume::findFar(const Level& level,
+                                                       const glm::dvec3& p) const
 {
-    std::array<std::size_t, 8> voxels;
-    std::array<double, 8> weights;
-    getTrilinear(level.region, p, voxels, weights);
+    FarNeighbourhood around;
+    getTrilinear(level.region, p, around.voxels, around.weights);
+    return around;
+}
+
+glm::vec3 CascadeVolume::sampleFar(const Level& level, const FarNeighbourhood& around,
+                                   int cone) const
+{
     glm::dvec3 sum(0.0);
     for (int c = 0; c < 8; ++c)
-        if (weights[std::size_t(c)] != 0.0)
-            sum += weights[std::size_t(c)] *
-                   glm::dvec3(level.far[std::size_t(level.farSlot[voxels[std::size_t(c)]]) * kConeCount +
+        if (around.weights[std::size_t(c)] != 0.0)
+            sum += around.weights[std::size_t(c)] *
+                   glm::dvec3(level.far[std::size_t(level.farSlot[around.voxels[std::size_t(c)]]) *
+                                            kConeCount +
                                         std::size_t(cone)]);
     return glm::vec3(sum);
 }
@@ -273,6 +280,10 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
             const auto [l0, l1, frac] = getStartLevels(s.level);
             const auto w = computeIrradianceWeights(mCones, s.normal);
             const double split0 = mSettings.farStart * mLevels[std::size_t(l0)].region.voxelSize;
+            // The pixel's far neighbourhoods at both start levels, shared by its cones.
+            const FarNeighbourhood far0 = findFar(mLevels[std::size_t(l0)], s.origin);
+            const FarNeighbourhood far1 =
+                l1 >= 0 ? findFar(mLevels[std::size_t(l1)], s.origin) : FarNeighbourhood{};
             for (int k = 0; k < kConeCount; ++k) {
                 if (w[std::size_t(k)] == 0.0)
                     continue;
@@ -286,7 +297,8 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                 ++conesPerRow[std::size_t(y)];
                 // Escaped: the cone left the cascade, nothing lies beyond it.
                 if (!a.escaped)
-                    la += a.transmittance * glm::dvec3(sampleFar(mLevels[std::size_t(l0)], s.origin, k));
+                    la +=
+                        a.transmittance * glm::dvec3(sampleFar(mLevels[std::size_t(l0)], far0, k));
                 glm::dvec3 result = la;
                 if (l1 >= 0) {
                     glm::dvec3 lb(a.light[kDirect]);
@@ -299,7 +311,7 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                         lb += a.transmittance * glm::dvec3(b.light[kDirect]);
                         if (!b.escaped)
                             lb += a.transmittance * b.transmittance *
-                                  glm::dvec3(sampleFar(mLevels[std::size_t(l1)], s.origin, k));
+                                  glm::dvec3(sampleFar(mLevels[std::size_t(l1)], far1, k));
                     }
                     result = la + frac * (lb - la);
                 }

@@ -215,8 +215,14 @@ private:
     void gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
     // Drops the far cones of every level whose sampled levels changed since they were traced.
     void invalidateFarCones();
-    // Trilinear far radiance of cone `cone` at p in level `level` (its traced voxel centres).
-    glm::vec3 sampleFar(const Level& level, const glm::dvec3& p, int cone) const;
+    // The trilinear neighbourhood of a point in a level's far cones, found once for its 16 cones.
+    struct FarNeighbourhood {
+        std::array<std::size_t, 8> voxels;
+        std::array<double, 8> weights;
+    };
+    FarNeighbourhood findFar(const Level& level, const glm::dvec3& p) const;
+    // Trilinear far radiance of cone `cone` in `level` (its traced voxel centres) over `around`.
+    glm::vec3 sampleFar(const Level& level, const FarNeighbourhood& around, int cone) const;
     // The 8 voxels (of the trilinear neighbourhood of p in `region`) and their weights.
     static void getTrilinear(const VoxelRegion& region, const glm::dvec3& p,
                              std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights);
