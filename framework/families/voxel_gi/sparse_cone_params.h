@@ -19,8 +19,8 @@ struct SparseConeParams {
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int traceStep = 4;        //!< pixels: one traced per trace_step^2 block, then upsampled
-    std::string device =
-        "auto"; //!< the pixel gather: vulkan, cpu or auto (cone_combine_gpu.h shouldGatherOnGpu)
+    //! The pixel gather's device: vulkan, cpu or auto (cone_combine_gpu.h shouldGatherOnGpu).
+    std::string device = "auto";
     CapsuleResolution capsules = CapsuleResolution::Traced; //!< capsule_resolution
     int innerLayers = 1;      //!< layers of solid leaves kept inside closed surfaces
 
