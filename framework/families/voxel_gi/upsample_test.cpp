@@ -200,18 +200,27 @@ TEST(CapsuleOcclusion, TracedPixelsGiveTheFullCombineWhenEveryPixelIsTraced)
     capsules[0].capsule.a = {0.0f, 0.4f, 0.0f};
     capsules[0].capsule.b = {0.0f, 1.4f, 0.2f};
     capsules[0].capsule.radius = 0.3f;
-    const ReducedGBuffer reduced = reduceGBuffer(g, 1);
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-    std::vector<glm::vec3> radiance(std::size_t(w * h) * kConeCount);
-    for (glm::vec3& r : radiance)
-        r = glm::vec3(unit(rng), unit(rng), unit(rng));
-    ConeCombineInputs in;
-    in.coneRadiance = &radiance;
-    in.reduced = &reduced;
-    in.full = &g;
-    in.capsules = &capsules;
-    in.coneHalfAngle = 0.52;
+    // Random cone radiances at the reduced G-buffer's pixels, and the combine's inputs over them.
+    const auto randomCones = [&](const ReducedGBuffer& r) {
+        std::vector<glm::vec3> cones(std::size_t(r.gbuffer.width * r.gbuffer.height) * kConeCount);
+        for (glm::vec3& c : cones)
+            c = glm::vec3(unit(rng), unit(rng), unit(rng));
+        return cones;
+    };
+    const auto describe = [&](const ReducedGBuffer& r, const std::vector<glm::vec3>& cones) {
+        ConeCombineInputs in;
+        in.coneRadiance = &cones;
+        in.reduced = &r;
+        in.full = &g;
+        in.capsules = &capsules;
+        in.coneHalfAngle = 0.52;
+        return in;
+    };
+    const ReducedGBuffer reduced = reduceGBuffer(g, 1);
+    const std::vector<glm::vec3> radiance = randomCones(reduced);
+    ConeCombineInputs in = describe(reduced, radiance);
     const Image<glm::vec3> full = combineCones(in);
     in.capsuleResolution = CapsuleResolution::Traced;
     const Image<glm::vec3> traced = combineCones(in);
@@ -230,16 +239,8 @@ TEST(CapsuleOcclusion, TracedPixelsGiveTheFullCombineWhenEveryPixelIsTraced)
     // Reduced by 4: the capsule still darkens part of the plane, and no pixel gets more light than
     // without it or less than none.
     const ReducedGBuffer quarter = reduceGBuffer(g, 4);
-    std::vector<glm::vec3> low(std::size_t(quarter.gbuffer.width * quarter.gbuffer.height) *
-                               kConeCount);
-    for (glm::vec3& r : low)
-        r = glm::vec3(unit(rng), unit(rng), unit(rng));
-    ConeCombineInputs q;
-    q.coneRadiance = &low;
-    q.reduced = &quarter;
-    q.full = &g;
-    q.capsules = &capsules;
-    q.coneHalfAngle = 0.52;
+    const std::vector<glm::vec3> low = randomCones(quarter);
+    ConeCombineInputs q = describe(quarter, low);
     q.capsuleResolution = CapsuleResolution::Traced;
     const Image<glm::vec3> quarterTraced = combineCones(q);
     q.capsules = nullptr;
