@@ -8,7 +8,9 @@
 //                        only: it holds the finest voxels only near the camera)
 //   adaptive_voxel_tree  Quantum Break's 64-ary tree (voxel_tree.h), depth 3 below root cells of
 //                        64^3 leaves, payload for every element (nodes too: the seamless
-//                        interpolation reads them); `_undilated` without the partial dilation
+//                        interpolation reads them), its records' masks shared in a table (the
+//                        default); `_undilated` without the partial dilation; `_inline_masks`
+//                        with the talk's 12-byte records (64-bit mask + offset in each)
 //   svo                  Crassin et al.'s sparse voxel octree (sparse_voxel_octree.h): node tiles
 //                        of 2x2x2 with one 32-bit child pointer per node, down to the next power
 //                        of two above the lattice, payload for every node (cone tracing reads the
@@ -27,7 +29,8 @@
 //   build/tests/families/voxel_structure_benchmark --quick   # cornell_box at 32 and 64 (ctest)
 // Counters: voxels (active), topology_B (bytes per active voxel), payload_B, total_B,
 // mask_floor_B (adaptive_voxel_tree: its child masks at their combinatorial minimum, the part of
-// the topology no per-node mask code goes below), and items_per_second = lookups per second for
+// the topology no code of each node's mask on its own goes below; sharing the masks between
+// nodes does), masks (adaptive_voxel_tree: distinct masks in its table), and items_per_second = lookups per second for
 // the lookup rows (ns per lookup = 1e9 / it).
 
 #include "sparse_voxel_octree.h" // techniques/voxel_gi/svo
@@ -125,6 +128,8 @@ public:
     virtual bool canLookup() const { return true; }
     //! Bytes of the child masks at their combinatorial minimum (NaN: no child masks).
     virtual double getMaskFloorBytes() const { return std::nan(""); }
+    //! Distinct masks in a shared mask table (NaN: none).
+    virtual double getMaskCount() const { return std::nan(""); }
 };
 
 class DenseGrid final : public Structure {
@@ -184,13 +189,13 @@ private:
 
 class Avt final : public Structure {
 public:
-    explicit Avt(bool dilate) : mDilate(dilate) {}
+    explicit Avt(const voxelgi::VoxelTreeBuildOptions& options) : mOptions(options) {}
     void build(const Voxels& v) override
     {
         voxelgi::VoxelTreeLayout layout;
         layout.depth = 3;
         layout.rootCells = glm::max((v.cells + 63) / 64, glm::ivec3(1));
-        mTree = voxelgi::AdaptiveVoxelTree::build(layout, v.active, mDilate);
+        mTree = voxelgi::AdaptiveVoxelTree::build(layout, v.active, mOptions);
         mPayload.assign(mTree.getElementCount(), glm::vec3(0.0f));
         for (const auto& c : v.active)
             mPayload[std::size_t(mTree.find(3, c))] = payloadOf(c);
@@ -212,20 +217,26 @@ public:
     }
     // A node with k of its 64 children present is one of C(64, k) masks: a code that knows k
     // and nothing of the pattern spends log2 C(64, k) bits on it at best. The tree stores each
-    // mask as 64 bits (the talk's node, for a popcount per child lookup).
+    // mask as 64 bits, inline (the talk's node) or once in a table of distinct masks.
     double getMaskFloorBytes() const override
     {
         double bits = 0.0;
-        for (const voxelgi::VoxelTreeNode& node : mTree.getNodes()) {
-            const int k = std::popcount(node.getMask());
+        for (std::size_t r = 0; r < mTree.getNodeCount(); ++r) {
+            const int k = std::popcount(mTree.getRecord(r).getMask());
             bits +=
                 (std::lgamma(65.0) - std::lgamma(k + 1.0) - std::lgamma(65.0 - k)) / std::log(2.0);
         }
         return bits / 8.0;
     }
 
+    double getMaskCount() const override
+    {
+        return mTree.getNodeMasks() == voxelgi::NodeMasks::Shared ? double(mTree.getMaskTable().size())
+                                                                 : NAN;
+    }
+
 private:
-    bool mDilate;
+    voxelgi::VoxelTreeBuildOptions mOptions;
     voxelgi::AdaptiveVoxelTree mTree;
     std::vector<glm::vec3> mPayload;
 };
@@ -356,9 +367,11 @@ std::unique_ptr<Structure> makeStructure(const std::string& name)
     if (name == "cascades")
         return std::make_unique<Cascades>();
     if (name == "adaptive_voxel_tree")
-        return std::make_unique<Avt>(true);
+        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{});
     if (name == "adaptive_voxel_tree_undilated")
-        return std::make_unique<Avt>(false);
+        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{.dilate = false});
+    if (name == "adaptive_voxel_tree_inline_masks")
+        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{.masks = voxelgi::NodeMasks::Inline});
     if (name == "svo")
         return std::make_unique<Svo>();
     if (name == "openvdb")
@@ -376,6 +389,8 @@ void setMemoryCounters(benchmark::State& state, const Structure& s, const Voxels
     state.counters["total_B"] = double(f.topologyBytes + f.payloadBytes) / n;
     if (const double floor = s.getMaskFloorBytes(); !std::isnan(floor))
         state.counters["mask_floor_B"] = floor / n;
+    if (const double masks = s.getMaskCount(); !std::isnan(masks))
+        state.counters["masks"] = masks;
 }
 
 void runBuild(benchmark::State& state, const std::string& sceneName, int resolution, const std::string& name)
@@ -437,7 +452,7 @@ int main(int argc, char** argv)
     for (const auto& [sceneName, r] : sets)
         for (const std::string name :
              {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
-              "svo", "openvdb", "nanovdb"}) {
+              "adaptive_voxel_tree_inline_masks", "svo", "openvdb", "nanovdb"}) {
             // A dense grid over the band's box would take 468^3 x 12 bytes (1.2 GB).
             if (sceneName == "narrow_band_sphere" && name == "dense_grid")
                 continue;

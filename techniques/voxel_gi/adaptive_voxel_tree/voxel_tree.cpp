@@ -60,8 +60,9 @@ void sortUnique(std::vector<std::uint64_t>& keys)
 } // namespace
 
 AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::vector<glm::ivec3> leaves,
-                                           bool dilate)
+                                           const VoxelTreeBuildOptions& options)
 {
+    const bool dilate = options.dilate;
     if (layout.depth < 1 || layout.depth > 8)
         throw Error("adaptive voxel tree: depth " + std::to_string(layout.depth) +
                     " is outside [1, 8]");
@@ -168,13 +169,70 @@ AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::v
         }
     }
     tree.mNodes.shrink_to_fit();
+    tree.mRecordCount = tree.mNodes.size();
+    tree.mEveryUpperHasRecord = tree.mRecordCount == upper;
     std::uint32_t before = 0;
     for (VoxelTreeRank& word : tree.mRanks) {
         word.base = before;
         before += std::uint32_t(std::popcount(word.getBits()));
     }
     tree.mLeafCount = keys[std::size_t(depth)].size();
+    if (options.masks == NodeMasks::Shared)
+        tree.shareMasks(std::min(options.maxSharedMasks, std::size_t(1) << (32 - kOffsetBits)));
     return tree;
+}
+
+void AdaptiveVoxelTree::shareMasks(std::size_t maxMasks)
+{
+    // The table of distinct masks, the most frequent first (they then share cache lines).
+    std::vector<std::uint64_t> masks(mNodes.size());
+    for (std::size_t r = 0; r < mNodes.size(); ++r)
+        masks[r] = mNodes[r].getMask();
+    sortUnique(masks);
+    if (masks.size() > maxMasks)
+        return; // the talk's records stay
+    std::vector<std::uint32_t> uses(masks.size(), 0);
+    const auto indexOf = [&masks](std::uint64_t m) {
+        return std::size_t(std::lower_bound(masks.begin(), masks.end(), m) - masks.begin());
+    };
+    for (const VoxelTreeNode& node : mNodes)
+        ++uses[indexOf(node.getMask())];
+    std::vector<std::uint32_t> order(masks.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&uses](std::uint32_t a, std::uint32_t b) { return uses[a] > uses[b]; });
+    std::vector<std::uint32_t> id(masks.size());
+    mMaskTable.resize(masks.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i) {
+        id[order[i]] = i;
+        mMaskTable[i] = masks[order[i]];
+    }
+    // Records are in element order and children are packed in it, so a record's offset is the
+    // previous record's plus its popcount: within a group of 64 records it exceeds the group's
+    // first offset by at most 63 * 64 < 2^kOffsetBits.
+    // A record's bit field: the offset, then as many index bits as the table needs (>= 1).
+    mRecordWidth = kOffsetBits + unsigned(std::max(1, int(std::bit_width(masks.size() - 1))));
+    mRecordFieldMask = mRecordWidth >= 32 ? ~0u : (1u << mRecordWidth) - 1u;
+    mRecordBits.assign((std::uint64_t(mNodes.size()) * mRecordWidth + 31) / 32 + 2, 0u);
+    mRecordBases.resize((mNodes.size() + 63) / 64);
+    for (std::size_t r = 0; r < mNodes.size(); ++r) {
+        if ((r & 63u) == 0)
+            mRecordBases[r >> 6] = mNodes[r].offset;
+        const std::uint32_t delta = mNodes[r].offset - mRecordBases[r >> 6];
+        if (delta > kOffsetMask)
+            throw Error("adaptive voxel tree: record " + std::to_string(r) +
+                        " lies outside its group's offset range (internal error)");
+        const std::uint64_t field = (std::uint64_t(id[indexOf(mNodes[r].getMask())]) << kOffsetBits) | delta;
+        const std::uint64_t bit = std::uint64_t(r) * mRecordWidth;
+        const std::size_t word = std::size_t(bit >> 5);
+        const std::uint64_t shifted = field << (bit & 31u);
+        mRecordBits[word] |= std::uint32_t(shifted);
+        mRecordBits[word + 1] |= std::uint32_t(shifted >> 32);
+    }
+    mNodes.clear();
+    mNodes.shrink_to_fit();
+    mNodeMasks = NodeMasks::Shared;
 }
 
 std::vector<glm::ivec4> AdaptiveVoxelTree::listElementCells() const
@@ -193,7 +251,7 @@ std::vector<glm::ivec4> AdaptiveVoxelTree::listElementCells() const
         if (((mRanks[i >> 6].getBits() >> (i & 63u)) & 1u) == 0)
             continue;
         const glm::ivec4 parent = cells[i];
-        const VoxelTreeNode& node = mNodes[record++];
+        const VoxelTreeNode node = getRecord(record++);
         std::uint64_t mask = node.getMask();
         std::uint32_t child = node.offset;
         while (mask != 0) {
@@ -214,8 +272,8 @@ AdaptiveVoxelTree::Deepest AdaptiveVoxelTree::findDeepest(const glm::ivec3& leaf
     std::uint32_t index = std::uint32_t(
         root.x + mLayout.rootCells.x * (root.y + mLayout.rootCells.y * root.z));
     for (int l = 1; l <= depth; ++l) {
-        const VoxelTreeNode* node = getNode(index);
-        const std::uint64_t mask = node != nullptr ? node->getMask() : 0;
+        const std::optional<VoxelTreeNode> node = getNode(index);
+        const std::uint64_t mask = node ? node->getMask() : 0;
         const int bit = getChildBit(c >> (2 * (depth - l)));
         if (((mask >> bit) & 1u) == 0)
             return {l - 1, std::int64_t(index), mask != 0};

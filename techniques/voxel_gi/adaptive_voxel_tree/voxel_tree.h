@@ -24,6 +24,20 @@
 //    bytes each: the talk's "partial dilation increases the total memory only by a few percent"
 //    then holds for the topology as well.
 //
+//  * Shared masks (NodeMasks::Shared, the default; not in the talk): the records' 64-bit masks are
+//    kept once each in a mask table, and a record is a bit field of 12 + b bits: its children's
+//    offset relative to a base kept per 64 records (12 bits: 63 records of at most 64 children
+//    each lie before it in its group), and the mask's table index (b bits, as many as the table
+//    needs, at most 20). The records are packed back to back in 32-bit words. This is possible
+//    because a record's offset is implied by the records before it: children are packed in the
+//    records' order, so record r's offset is levelBegin(1) + the popcounts of records 0..r-1.
+//    Voxelized surfaces repeat few patterns: tomorrow_town at 512 has 57,292 records with 6,215
+//    distinct masks, cornell_box 113,286 with 710 (voxel_structure_benchmark's `masks` counter),
+//    so a record costs about 3 bytes + 1/16 of a base + its share of the table, where the talk's
+//    record costs 12. The child index is the same offset + popcount, read in two more loads that
+//    stay in cache (the bases and a table of at most a few thousand masks). When the masks need
+//    more than 20-bit indices the tree keeps the talk's records (getNodeMasks() says which).
+//
 // Element coordinates are integer cells of their level: level l has rootCells * 4^l cells per
 // axis, and level `depth` cells are the leaves.
 
@@ -34,6 +48,8 @@
 #include <bit>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <optional>
 #include <vector>
 
 namespace rtlab::voxelgi {
@@ -63,6 +79,18 @@ inline int getChildBit(const glm::ivec3& c)
     return (c.x & 3) | ((c.y & 3) << 2) | ((c.z & 3) << 4);
 }
 
+//! How a node record stores its child mask: inline (the talk's 12-byte record) or as an index into
+//! a table of the tree's distinct masks (4 bytes).
+enum class NodeMasks { Shared, Inline };
+
+struct VoxelTreeBuildOptions {
+    bool dilate = true;                 //!< partial dilation of the upper levels
+    NodeMasks masks = NodeMasks::Shared;
+    //! Shared masks fall back to inline ones when the tree has more distinct masks than this
+    //! (at most 2^20, the record word's index bits; lower only to test the fallback).
+    std::size_t maxSharedMasks = std::size_t(1) << 20;
+};
+
 struct VoxelTreeLayout {
     glm::ivec3 rootCells{1}; //!< dense first level, cells per axis (each >= 1)
     int depth = 3;           //!< levels below the roots; leaves are level `depth` (1..8)
@@ -79,16 +107,44 @@ public:
     //! layout (depth outside [1, 8], more than 2^24 root cells), a leaf outside the grid, or more
     //! than 2^32 - 1 elements.
     static AdaptiveVoxelTree build(const VoxelTreeLayout& layout, std::vector<glm::ivec3> leaves,
-                                   bool dilate = true);
+                                   const VoxelTreeBuildOptions& options = {});
+    static AdaptiveVoxelTree build(const VoxelTreeLayout& layout, std::vector<glm::ivec3> leaves,
+                                   bool dilate)
+    {
+        return build(layout, std::move(leaves), VoxelTreeBuildOptions{.dilate = dilate});
+    }
+
+    //! Low bits of a shared-mask record that hold the offset from its group's base.
+    static constexpr unsigned kOffsetBits = 12;
+    static constexpr std::uint32_t kOffsetMask = (1u << kOffsetBits) - 1u;
 
     const VoxelTreeLayout& getLayout() const { return mLayout; }
     int getDepth() const { return mLayout.depth; }
-    //! The node records of the root cells and the elements with children, in element order.
-    const std::vector<VoxelTreeNode>& getNodes() const { return mNodes; }
+    //! How the records hold their masks (Inline also where Shared fell back).
+    NodeMasks getNodeMasks() const { return mNodeMasks; }
+    //! Record r (in element order) decoded: its mask and its children's offset.
+    VoxelTreeNode getRecord(std::size_t r) const
+    {
+        if (mNodeMasks == NodeMasks::Inline)
+            return mNodes[r];
+        const std::uint32_t word = readRecordField(r);
+        const std::uint64_t mask = mMaskTable[word >> kOffsetBits];
+        return {std::uint32_t(mask), std::uint32_t(mask >> 32),
+                mRecordBases[r >> 6] + (word & kOffsetMask)};
+    }
+    //! Inline masks: the 12-byte records (empty for shared masks).
+    const std::vector<VoxelTreeNode>& getInlineRecords() const { return mNodes; }
+    //! Shared masks: the records' bit fields (mask table index << kOffsetBits | offset from the
+    //! group's base) of getRecordWidth() bits each, record r at bit r * width, low bits first,
+    //! with two words of padding at the end; the base of each 64 records; the distinct masks.
+    const std::vector<std::uint32_t>& getRecordBits() const { return mRecordBits; }
+    unsigned getRecordWidth() const { return mRecordWidth; }
+    const std::vector<std::uint32_t>& getRecordBases() const { return mRecordBases; }
+    const std::vector<std::uint64_t>& getMaskTable() const { return mMaskTable; }
     //! The rank words over the upper-level elements [0, getLevelBegin(depth)).
     const std::vector<VoxelTreeRank>& getRanks() const { return mRanks; }
     //! Node records: the root cells and the elements with children.
-    std::size_t getNodeCount() const { return mNodes.size(); }
+    std::size_t getNodeCount() const { return mRecordCount; }
     std::size_t getLeafCount() const { return mLeafCount; }
     //! Every element (root cells, upper-level cells with or without children, leaves): the
     //! length of a payload array.
@@ -99,12 +155,14 @@ public:
 
     //! The node record of element e, or nullptr when e has none (a leaf, a childless cell below
     //! the roots; a root cell always has one, its mask 0 when it has no children).
-    const VoxelTreeNode* getNode(std::uint32_t e) const
+    std::optional<VoxelTreeNode> getNode(std::uint32_t e) const
     {
         if (e >= mLevelBegin[std::size_t(mLayout.depth)])
-            return nullptr;
+            return std::nullopt;
         const std::int64_t record = findRecord(e);
-        return record < 0 ? nullptr : &mNodes[std::size_t(record)];
+        if (record < 0)
+            return std::nullopt;
+        return getRecord(std::size_t(record));
     }
 
     //! Index of the element at cell c of `level`, or kAbsent (also for c outside the grid).
@@ -118,26 +176,11 @@ public:
         const glm::ivec3& roots = mLayout.rootCells;
         if (rx >= roots.x || ry >= roots.y || rz >= roots.z)
             return kAbsent;
-        std::uint32_t index = std::uint32_t(rx + roots.x * (ry + roots.y * rz));
-        std::uint32_t record = index; // the dense first level: every root cell has a record
-        for (int s = shift - 2; s >= 0; s -= 2) {
-            const VoxelTreeNode& node = mNodes[record];
-            const std::uint64_t mask = node.getMask();
-            const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
-            if (((mask >> bit) & 1u) == 0)
-                return kAbsent;
-            // The talk's child index: offset + the set bits below this one (one POPCNT).
-            index = node.offset +
-                    std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
-            if (s > 0) {
-                // The child's node record; none: no children at all.
-                const std::int64_t next = findRecord(index);
-                if (next < 0)
-                    return kAbsent;
-                record = std::uint32_t(next);
-            }
-        }
-        return std::int64_t(index);
+        const std::uint32_t root = std::uint32_t(rx + roots.x * (ry + roots.y * rz));
+        // One branch per lookup, not per level: each descent is specialised.
+        if (mNodeMasks == NodeMasks::Shared)
+            return mEveryUpperHasRecord ? descend<true, false>(root, shift, c) : descend<true, true>(root, shift, c);
+        return mEveryUpperHasRecord ? descend<false, false>(root, shift, c) : descend<false, true>(root, shift, c);
     }
     //! Every element's cell (xyz) and level (w), in index order (the inverse of find).
     std::vector<glm::ivec4> listElementCells() const;
@@ -151,14 +194,78 @@ public:
     };
     Deepest findDeepest(const glm::ivec3& leaf) const;
 
-    //! Topology bytes: the node records and the rank words (the root cells' records are the
-    //! dense first level, so there is no other table).
+    //! Topology bytes: the node records (with shared masks: their words, bases and mask table)
+    //! and the rank words (the root cells' records are the dense first level, so there is no
+    //! other table).
     std::size_t getTopologyBytes() const
     {
-        return mNodes.size() * sizeof(VoxelTreeNode) + mRanks.size() * sizeof(VoxelTreeRank);
+        return mNodes.size() * sizeof(VoxelTreeNode) + mRecordBits.size() * sizeof(std::uint32_t) +
+               mRecordBases.size() * sizeof(std::uint32_t) + mMaskTable.size() * sizeof(std::uint64_t) +
+               mRanks.size() * sizeof(VoxelTreeRank);
     }
 
 private:
+    //! Replaces the inline records by shared masks when they need at most maxMasks entries.
+    void shareMasks(std::size_t maxMasks);
+    //! Shared masks: record r's bit field (it may straddle two words; the padding words keep the
+    //! second read inside the array).
+    std::uint32_t readRecordField(std::size_t r) const
+    {
+        const std::uint64_t bit = std::uint64_t(r) * mRecordWidth;
+        const std::size_t word = std::size_t(bit >> 5);
+        const std::uint64_t pair =
+            std::uint64_t(mRecordBits[word]) | (std::uint64_t(mRecordBits[word + 1]) << 32);
+        return std::uint32_t(pair >> (bit & 31u)) & mRecordFieldMask;
+    }
+    //! find() below root cell `root`. Shared: the records' masks are in the table. Ranked: some
+    //! upper-level elements have no record (a dilated tree), so a record is found by rank;
+    //! otherwise record = element (every upper-level element of an undilated tree has children).
+    template <bool Shared, bool Ranked>
+    std::int64_t descend(std::uint32_t root, int shift, const glm::ivec3& c) const
+    {
+        const VoxelTreeNode* nodes = mNodes.data();
+        const unsigned char* fields = reinterpret_cast<const unsigned char*>(mRecordBits.data());
+        const std::uint32_t* bases = mRecordBases.data();
+        const std::uint64_t* table = mMaskTable.data();
+        const std::uint64_t width = mRecordWidth;
+        const std::uint32_t fieldMask = mRecordFieldMask;
+        std::uint32_t index = root;
+        std::uint32_t record = root; // the dense first level: every root cell has a record
+        for (int s = shift - 2; s >= 0; s -= 2) {
+            std::uint64_t mask;
+            std::uint32_t offset;
+            if constexpr (Shared) {
+                // One unaligned 8-byte read holds the field (width <= 32, shift <= 7; the two
+                // padding words keep it inside the array).
+                const std::uint64_t bit = std::uint64_t(record) * width;
+                std::uint64_t bytes;
+                std::memcpy(&bytes, fields + (bit >> 3), sizeof bytes);
+                const std::uint32_t field = std::uint32_t(bytes >> (bit & 7u)) & fieldMask;
+                mask = table[field >> kOffsetBits];
+                offset = bases[record >> 6] + (field & kOffsetMask);
+            } else {
+                mask = nodes[record].getMask();
+                offset = nodes[record].offset;
+            }
+            const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
+            if (((mask >> bit) & 1u) == 0)
+                return kAbsent;
+            // The talk's child index: offset + the set bits below this one (one POPCNT).
+            index = offset + std::uint32_t(std::popcount(mask & ((std::uint64_t(1) << bit) - 1)));
+            if (s > 0) {
+                if constexpr (Ranked) {
+                    // The child's node record; none: no children at all.
+                    const std::int64_t next = findRecord(index);
+                    if (next < 0)
+                        return kAbsent;
+                    record = std::uint32_t(next);
+                } else {
+                    record = index;
+                }
+            }
+        }
+        return std::int64_t(index);
+    }
     //! The node record of upper-level element e by rank, or -1 when it has none.
     std::int64_t findRecord(std::uint32_t e) const
     {
@@ -171,7 +278,14 @@ private:
     }
 
     VoxelTreeLayout mLayout;
-    std::vector<VoxelTreeNode> mNodes;
+    NodeMasks mNodeMasks = NodeMasks::Inline;
+    bool mEveryUpperHasRecord = false; //!< record = element for every upper-level element
+    std::size_t mRecordCount = 0;
+    std::vector<VoxelTreeNode> mNodes; // inline masks
+    std::vector<std::uint32_t> mRecordBits, mRecordBases;
+    unsigned mRecordWidth = 32;
+    std::uint32_t mRecordFieldMask = ~0u;
+    std::vector<std::uint64_t> mMaskTable; // shared masks
     std::vector<VoxelTreeRank> mRanks;
     std::size_t mLeafCount = 0;
     std::vector<std::size_t> mLevelBegin;

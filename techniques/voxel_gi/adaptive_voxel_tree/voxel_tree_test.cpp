@@ -63,10 +63,10 @@ double payloadOf(int level, const glm::ivec3& c)
 }
 
 void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<glm::ivec3>& leaves,
-                             bool dilate, const std::string& what)
+                             const VoxelTreeBuildOptions& options, const std::string& what)
 {
-    const AdaptiveVoxelTree tree = AdaptiveVoxelTree::build(layout, leaves, dilate);
-    const auto expected = expectedLevels(layout, leaves, dilate);
+    const AdaptiveVoxelTree tree = AdaptiveVoxelTree::build(layout, leaves, options);
+    const auto expected = expectedLevels(layout, leaves, options.dilate);
     // Payload array filled from the tree's own element list, as a structure's user does.
     const std::vector<glm::ivec4> cells = tree.listElementCells();
     ASSERT_EQ(cells.size(), tree.getElementCount()) << what;
@@ -100,6 +100,7 @@ void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<gl
     // holding its children's bits; the topology is those records and one rank word per 64
     // upper-level elements.
     std::size_t inner = 0, wrongRecords = 0;
+    std::set<std::uint64_t> distinctMasks;
     for (std::size_t e = 0; e < tree.getElementCount(); ++e) {
         const int l = cells[e].w;
         std::uint64_t want = 0;
@@ -110,17 +111,41 @@ void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<gl
                 if (expected[std::size_t(l) + 1].count(key(child)) != 0)
                     want |= std::uint64_t(1) << bit;
             }
-        const VoxelTreeNode* node = tree.getNode(std::uint32_t(e));
+        const std::optional<VoxelTreeNode> node = tree.getNode(std::uint32_t(e));
         const bool record = want != 0 || l == 0; // every root cell has one
         inner += record ? 1 : 0;
-        if ((node != nullptr) != record || (node != nullptr && node->getMask() != want))
+        if (record)
+            distinctMasks.insert(want);
+        if (node.has_value() != record || (node && node->getMask() != want))
             ++wrongRecords;
     }
     EXPECT_EQ(wrongRecords, 0u) << what;
     EXPECT_EQ(tree.getNodeCount(), inner) << what;
+    // Inline: 12 bytes per record. Shared: a field of 12 bits + the bits of a table index per
+    // record, packed in 32-bit words (two more of padding), a 4-byte base per 64 records, 8 bytes
+    // per distinct mask.
+    const std::size_t ranks = 12 * ((tree.getLevelBegin(layout.depth) + 63) / 64);
+    const bool shared = options.masks == NodeMasks::Shared && distinctMasks.size() <= options.maxSharedMasks;
+    EXPECT_EQ(tree.getNodeMasks(), shared ? NodeMasks::Shared : NodeMasks::Inline) << what;
+    std::size_t indexBits = 1;
+    while ((std::size_t(1) << indexBits) < distinctMasks.size())
+        ++indexBits;
+    const std::size_t fieldWords = (inner * (12 + indexBits) + 31) / 32 + 2;
     EXPECT_EQ(tree.getTopologyBytes(),
-              12 * inner + 12 * ((tree.getLevelBegin(layout.depth) + 63) / 64))
+              shared ? 4 * fieldWords + 4 * ((inner + 63) / 64) + 8 * distinctMasks.size() + ranks
+                     : 12 * inner + ranks)
         << what;
+    if (shared) {
+        EXPECT_EQ(tree.getRecordWidth(), 12 + indexBits) << what;
+    }
+}
+
+void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<glm::ivec3>& leaves,
+                             bool dilate, const std::string& what)
+{
+    for (const NodeMasks masks : {NodeMasks::Shared, NodeMasks::Inline})
+        expectMatchesDenseGrids(layout, leaves, {.dilate = dilate, .masks = masks},
+                                what + (masks == NodeMasks::Shared ? ", shared masks" : ", inline masks"));
 }
 
 TEST(VoxelTree, RandomisedLookupsAgreeWithDenseGridsAtEveryLevel)
@@ -153,7 +178,7 @@ TEST(VoxelTree, OneVoxel)
     EXPECT_EQ(tree.getLeafCount(), 1u);
     EXPECT_EQ(tree.getNodeCount(), 3u); // two root cells and the leaf's parent
     EXPECT_EQ(tree.getElementCount(), 4u);
-    ASSERT_NE(tree.getNode(0), nullptr); // x = 17 lies in root cell 1: cell 0 has no children
+    ASSERT_TRUE(tree.getNode(0).has_value()); // x = 17 lies in root cell 1: cell 0 has no children
     EXPECT_EQ(tree.getNode(0)->getMask(), 0u);
     EXPECT_NE(tree.find(2, {17, 3, 9}), AdaptiveVoxelTree::kAbsent);
     EXPECT_EQ(tree.find(2, {17, 3, 8}), AdaptiveVoxelTree::kAbsent);
@@ -177,9 +202,34 @@ TEST(VoxelTree, FullGridSetsEveryMaskBit)
     const AdaptiveVoxelTree tree = AdaptiveVoxelTree::build(layout, all, true);
     EXPECT_EQ(tree.getLeafCount(), 4096u);
     EXPECT_EQ(tree.getNodeCount(), 65u);
-    for (const VoxelTreeNode& node : tree.getNodes())
-        EXPECT_EQ(node.getMask(), ~std::uint64_t(0));
+    for (std::size_t r = 0; r < tree.getNodeCount(); ++r)
+        EXPECT_EQ(tree.getRecord(r).getMask(), ~std::uint64_t(0));
+    EXPECT_EQ(tree.getMaskTable().size(), 1u); // one mask shared by all 65 records
     expectMatchesDenseGrids(layout, all, true, "full grid");
+}
+
+TEST(VoxelTree, SharedMaskOffsetsHoldAcrossRecordGroups)
+{
+    // 4,161 full records: every group of 64 reaches the largest offset from its base (63 * 64).
+    const VoxelTreeLayout full{.rootCells = glm::ivec3(1), .depth = 3};
+    expectMatchesDenseGrids(full, everyCell(64), true, "full 64^3");
+    // Scattered voxels under 64 root cells: hundreds of records with hundreds of masks.
+    const VoxelTreeLayout scattered{.rootCells = glm::ivec3(4), .depth = 2};
+    std::mt19937 rng(3);
+    std::vector<glm::ivec3> leaves;
+    for (int i = 0; i < 3000; ++i)
+        leaves.emplace_back(int(rng() % 64u), int(rng() % 64u), int(rng() % 64u));
+    expectMatchesDenseGrids(scattered, leaves, false, "scattered");
+}
+
+TEST(VoxelTree, TooManyDistinctMasksKeepTheInlineRecords)
+{
+    const VoxelTreeLayout layout{.rootCells = glm::ivec3(2, 1, 1), .depth = 2};
+    const std::vector<glm::ivec3> leaves = {{1, 2, 3}, {17, 3, 9}, {18, 3, 9}, {30, 15, 15}};
+    for (const std::size_t limit : {std::size_t(1), std::size_t(2), std::size_t(1000)})
+        expectMatchesDenseGrids(layout, leaves,
+                                {.dilate = true, .masks = NodeMasks::Shared, .maxSharedMasks = limit},
+                                "at most " + std::to_string(limit) + " shared masks");
 }
 
 TEST(VoxelTree, VoxelsOnTheBoxFacesAndQueriesOutside)

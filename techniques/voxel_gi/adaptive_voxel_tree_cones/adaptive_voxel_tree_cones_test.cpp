@@ -245,7 +245,7 @@ void compareGpu(glm::vec3 offset, int resolution, int depth)
         int withRecord[2] = {0, 0};
         for (std::uint32_t e = std::uint32_t(t.getLevelBegin(1)); e < t.getLevelBegin(2) && e < 64;
              ++e)
-            withRecord[e / 32u] += t.getNode(e) != nullptr ? 1 : 0;
+            withRecord[e / 32u] += t.getNode(e).has_value() ? 1 : 0;
         EXPECT_GT(std::min(withRecord[0], withRecord[1]), 0);
     }
     std::vector<glm::vec3> cpuCones, gpuCones;

@@ -14,9 +14,11 @@ struct GatherConstants {
     glm::vec4 box{0};    // min corner relative to the centre
     glm::ivec4 roots{
         0}; // xyz: root cells per axis, w: the first node record's uint in the topology buffer
+    glm::ivec4 masks{0}; // x: shared masks' record bits (0: inline), y: first base's uint, z: table's
 };
-static_assert(sizeof(GatherConstants) == 64, "must match tree_cone_gather.comp");
+static_assert(sizeof(GatherConstants) == 80, "must match tree_cone_gather.comp");
 static_assert(sizeof(VoxelTreeNode) == 3 * sizeof(std::uint32_t), "the shader reads 3 uints per node");
+static_assert(AdaptiveVoxelTree::kOffsetBits == 12, "the shader splits a record word at bit 12");
 static_assert(sizeof(VoxelTreeRank) == 3 * sizeof(std::uint32_t),
               "the shader reads 3 uints per rank word");
 
@@ -68,15 +70,27 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
     }
     mLastUploadBytes = 0;
     if (mUploadedStamp != tree.getStamp()) {
-        // One topology buffer: the rank words, then the node records.
+        // One topology buffer: the rank words, then the node records as the tree holds them
+        // (inline masks; or the record words, their bases and the mask table).
         const auto& ranks = t->getRanks();
-        const auto& nodes = t->getNodes();
         std::vector<std::uint32_t> topology;
-        topology.reserve(3 * (ranks.size() + nodes.size()));
+        topology.reserve(3 * ranks.size() + t->getTopologyBytes() / sizeof(std::uint32_t));
         for (const VoxelTreeRank& r : ranks)
             topology.insert(topology.end(), {r.bitsLo, r.bitsHi, r.base});
-        for (const VoxelTreeNode& n : nodes)
-            topology.insert(topology.end(), {n.maskLo, n.maskHi, n.offset});
+        mRecordStart = std::uint32_t(topology.size());
+        if (t->getNodeMasks() == NodeMasks::Inline) {
+            for (const VoxelTreeNode& n : t->getInlineRecords())
+                topology.insert(topology.end(), {n.maskLo, n.maskHi, n.offset});
+            mMasks = glm::ivec4(0);
+        } else {
+            topology.insert(topology.end(), t->getRecordBits().begin(), t->getRecordBits().end());
+            const auto baseStart = std::uint32_t(topology.size());
+            topology.insert(topology.end(), t->getRecordBases().begin(), t->getRecordBases().end());
+            const auto tableStart = std::uint32_t(topology.size());
+            for (const std::uint64_t m : t->getMaskTable())
+                topology.insert(topology.end(), {std::uint32_t(m), std::uint32_t(m >> 32)});
+            mMasks = glm::ivec4(int(t->getRecordWidth()), int(baseStart), int(tableStart), 0);
+        }
         const std::size_t nodeBytes = topology.size() * sizeof(std::uint32_t);
         const auto& gathered = tree.getGathered();
         if (!mNodes.isValid() || mNodes.getSize() < nodeBytes)
@@ -84,7 +98,6 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
         if (!mGathered.isValid() || mGathered.getSize() < gathered.size() * sizeof(glm::vec4))
             mGathered = mDispatch.makeBuffer(gathered.size() * sizeof(glm::vec4), "adaptive_voxel_tree_cones.gathered");
         mNodes.uploadSpan<std::uint32_t>(topology);
-        mNodeStart = std::uint32_t(3 * ranks.size());
         mGathered.uploadSpan<glm::vec4>(gathered);
         mLastUploadBytes += nodeBytes + gathered.size() * sizeof(glm::vec4);
         mUploadedStamp = tree.getStamp();
@@ -97,7 +110,8 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
     constants.march = {float(tree.getLeafSize()), float(tree.getCones().tanHalfAngle), float(s.startOffset),
                        float(s.stepScale)};
     constants.box = glm::vec4(glm::vec3(tree.getOrigin() - anchor), 0.0f);
-    constants.roots = glm::ivec4(t->getLayout().rootCells, int(mNodeStart));
+    constants.roots = glm::ivec4(t->getLayout().rootCells, int(mRecordStart));
+    constants.masks = mMasks;
     mLastGpuMs = mDispatch.run(mNodes, mGathered, gpu::PushConstants(constants), out);
 }
 

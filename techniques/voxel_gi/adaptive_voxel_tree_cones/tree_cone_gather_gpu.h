@@ -9,6 +9,8 @@
 #include "families/voxel_gi/cone_gather_gpu.h"
 #include "gpu/context.h"
 
+#include <glm/vec4.hpp>
+
 #include <filesystem>
 #include <optional>
 #include <vector>
@@ -39,7 +41,8 @@ private:
     PixelConeDispatch mDispatch;
     gpu::Buffer mNodes, mGathered;
     gpu::Buffer mZeros; //!< the radiances of an empty tree, when kept on the device
-    std::uint32_t mNodeStart = 0; //!< uint index of the first node record in mNodes
+    std::uint32_t mRecordStart = 0; //!< uint index of the first node record in mNodes
+    glm::ivec4 mMasks{0};           //!< the shader's masks constant (shared masks: where they lie)
     std::uint64_t mUploadedStamp = 0;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;

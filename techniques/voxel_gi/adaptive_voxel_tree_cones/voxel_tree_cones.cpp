@@ -100,9 +100,9 @@ void VoxelTreeCones::filterUp(const Get& get)
         const std::size_t begin = mTree->getLevelBegin(level), end = mTree->getLevelBegin(level + 1);
         tbb::parallel_for(begin, end, [&](std::size_t n) {
             std::array<std::int64_t, 64> children;
-            const VoxelTreeNode* node = mTree->getNode(std::uint32_t(n));
-            const std::uint64_t mask = node != nullptr ? node->getMask() : 0;
-            std::uint32_t next = node != nullptr ? node->offset : 0;
+            const std::optional<VoxelTreeNode> node = mTree->getNode(std::uint32_t(n));
+            const std::uint64_t mask = node ? node->getMask() : 0;
+            std::uint32_t next = node ? node->offset : 0;
             for (int bit = 0; bit < 64; ++bit)
                 children[std::size_t(bit)] = ((mask >> bit) & 1u) ? std::int64_t(next++) : -1;
             filterParentFaces<4>(children.data(), n, mPayload.gathered, get);

@@ -134,7 +134,8 @@ TEST(VoxelTreeCones, FilteredOccupancyEqualsADenseFilterAtEveryLevel)
     // The full block's parent is opaque from every side (each column holds 4 leaves of 0.7).
     const std::int64_t parent = t.find(depth - 1, {5, 2, 1});
     ASSERT_GE(parent, 0);
-    EXPECT_EQ(t.getNodes()[std::size_t(parent)].getMask(), ~std::uint64_t(0));
+    ASSERT_TRUE(t.getNode(std::uint32_t(parent)).has_value());
+    EXPECT_EQ(t.getNode(std::uint32_t(parent))->getMask(), ~std::uint64_t(0));
     EXPECT_NEAR(tree.getAlpha(std::size_t(parent), 0), 1.0 - std::pow(0.3, 4), 1e-6);
 }
 

@@ -13,8 +13,12 @@
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 // [word * 3 + 0, 1, 2]: which of 64 upper-level elements have children (low, high 32 bits), and
-// how many before the word do; then from pc.roots.w [node * 3 + 0, 1, 2]: child mask low and
-// high 32 bits, offset of the first child.
+// how many before the word do; then from pc.roots.w the node records. Inline masks
+// (pc.masks.x == 0): [record * 3 + 0, 1, 2] = child mask low and high 32 bits, offset of the
+// first child. Shared masks (voxel_tree.h): record r is the bit field of pc.masks.x bits at bit
+// r * pc.masks.x, low bits first, = mask table index << 12 | offset from the base of its 64
+// records; from pc.masks.y [record / 64] = that base; from pc.masks.z [index * 2 + 0, 1] = the
+// mask's low and high 32 bits.
 layout(std430, binding = 0) readonly buffer TopologyBuffer { uint topology[]; };
 // [element * 6 + face]: rgb = gathered light premultiplied by the occupancy, a = occupancy.
 layout(std430, binding = 1) readonly buffer GatheredBuffer { vec4 gathered[]; };
@@ -28,6 +32,7 @@ layout(push_constant) uniform Constants {
     vec4 march;  // leaf size, tan(half-angle), start offset (leaves), step scale
     vec4 box;    // xyz: min corner relative to the centre
     ivec4 roots; // xyz: root cells per axis, w: the first node record's uint in topology[]
+    ivec4 masks; // x: shared masks' record bits (0: inline), y: first base's uint, z: table's first
 } pc;
 
 // The element at cell c of `level`, or -1 (outside the lattice or an empty region).
@@ -40,8 +45,25 @@ int findElement(int level, ivec3 c)
     uint index = uint(r.x + pc.roots.x * (r.y + pc.roots.y * r.z));
     uint record = index; // the dense first level: every root cell has a node record
     for (int s = shift - 2; s >= 0; s -= 2) {
-        const uint at = uint(pc.roots.w) + 3u * record;
-        const uint lo = topology[at], hi = topology[at + 1u], offset = topology[at + 2u];
+        uint lo, hi, offset;
+        if (pc.masks.x == 0) {
+            const uint at = uint(pc.roots.w) + 3u * record;
+            lo = topology[at];
+            hi = topology[at + 1u];
+            offset = topology[at + 2u];
+        } else {
+            // The record's field may straddle two words (the last has a padding word after it).
+            const uint width = uint(pc.masks.x), bit = record * width;
+            const uint first = uint(pc.roots.w) + (bit >> 5u), shift = bit & 31u;
+            uint word = topology[first] >> shift;
+            if (shift + width > 32u)
+                word |= topology[first + 1u] << (32u - shift);
+            word &= width >= 32u ? 0xffffffffu : (1u << width) - 1u;
+            const uint at = uint(pc.masks.z) + 2u * (word >> 12u);
+            lo = topology[at];
+            hi = topology[at + 1u];
+            offset = topology[uint(pc.masks.y) + (record >> 6u)] + (word & 4095u);
+        }
         const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
         uint below;
         if (bit < 32) {
