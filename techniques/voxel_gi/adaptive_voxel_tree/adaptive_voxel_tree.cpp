@@ -37,14 +37,20 @@
 // Parameters
 // | name          | type | default       | range / choices        | unit                        |
 // |---------------|------|---------------|------------------------|-----------------------------|
-// | resolution    | int  | 64            | [4, 4096]              | leaves along the box's longest side |
-// | depth         | int  | 3             | [1, 6]                 | levels below the root cells |
-// | payload       | enum | ambient_cube  | ambient_cube, sh_l1    |                             |
-// | interpolation | enum | seamless      | seamless, plain        |                             |
-// | anti_leak     | bool | true          |                        |                             |
-// | dilate        | bool | true          |                        | partial dilation of the upper levels |
-// | bake_samples  | int  | 32            | [1, 65536]             | paths per probe and axis    |
-// | bounces       | int  | 2             | [1, 8]                 |                             |
+// | resolution    | int  | 64            | [4, 4096]              | leaves along the box's longest
+// side | | depth         | int  | 3             | [1, 6]                 | levels below the root
+// cells | | payload       | enum | ambient_cube  | ambient_cube, sh_l1    | | | interpolation |
+// enum | seamless      | seamless, plain        |                             | | anti_leak     |
+// bool | true          |                        |                             | | dilate        |
+// bool | true          |                        | partial dilation of the upper levels | |
+// node_masks    | enum | shared        | shared, inline         | where the node records' masks are
+// | | normal_offset | float| 0.5           | [0, 4]                 | leaves (the lookup point
+// along the normal) | | bake_samples  | int  | 32            | [1, 65536]             | paths per
+// probe and axis    | | bounces       | int  | 2             | [1, 8]                 | |
+//
+// node_masks: shared keeps the child masks in one table of the tree's distinct masks, each
+// record a bit field of 12 + log2(table size) bits (voxel_tree.h); inline keeps the talk's
+// 12-byte record (64-bit mask + offset). Lookups give the same elements either way.
 //
 // Config example:
 //   techniques:
@@ -99,6 +105,10 @@ public:
                        "across levels (missing corners from the parent) or one level only");
         schema.addBool("anti_leak", true, "normal-based weight multiplied into the trilinear weights");
         schema.addBool("dilate", true, "partial dilation of the upper levels");
+        schema.addEnum("node_masks", "shared", {"shared", "inline"},
+                       "the node records' child masks in one table of the distinct masks (a "
+                       "bit-packed record of 12 + log2(table) bits), or in each record (the "
+                       "talk's 12 bytes: mask + offset); lookups give the same elements");
         schema.addFloat("normal_offset", 0.5, 0.0, 4.0, "leaves",
                         "the pixel's lookup point moved along its normal (away from probes "
                         "inside the surface it lies on)");
@@ -111,7 +121,9 @@ public:
         : mResolution(int(p.getInt("resolution"))), mDepth(int(p.getInt("depth"))),
           mShL1(p.getString("payload") == "sh_l1"), mPlain(p.getString("interpolation") == "plain"),
           mAntiLeak(p.getBool("anti_leak")), mDilate(p.getBool("dilate")),
-          mNormalOffset(p.getFloat("normal_offset")), mBakeSamples(int(p.getInt("bake_samples"))), mBounces(int(p.getInt("bounces")))
+          mInlineMasks(p.getString("node_masks") == "inline"),
+          mNormalOffset(p.getFloat("normal_offset")), mBakeSamples(int(p.getInt("bake_samples"))),
+          mBounces(int(p.getInt("bounces")))
     {
     }
 
@@ -124,6 +136,7 @@ public:
         p.set("interpolation", std::string(mPlain ? "plain" : "seamless"));
         p.set("anti_leak", mAntiLeak);
         p.set("dilate", mDilate);
+        p.set("node_masks", std::string(mInlineMasks ? "inline" : "shared"));
         p.set("normal_offset", mNormalOffset);
         p.set("bake_samples", std::int64_t(mBakeSamples));
         p.set("bounces", std::int64_t(mBounces));
@@ -165,7 +178,10 @@ public:
             layout.rootCells[a] = std::max(1, int(std::ceil((hi[a] - lo[a] + mLeafSize) / rootSize)));
         const std::vector<glm::ivec3> leaves = voxelgi::listCellsMeetingTriangles(
             g, mOrigin, mLeafSize, layout.getCells(mDepth));
-        mTree.emplace(voxelgi::AdaptiveVoxelTree::build(layout, leaves, mDilate));
+        mTree.emplace(voxelgi::AdaptiveVoxelTree::build(
+            layout, leaves,
+            {.dilate = mDilate,
+             .masks = mInlineMasks ? voxelgi::NodeMasks::Inline : voxelgi::NodeMasks::Shared}));
         return plugin::VoxelGiStep::done(
             "built the tree: " + std::to_string(mTree->getLeafCount()) + " leaves, " +
             std::to_string(mTree->getNodeCount()) + " nodes (" + std::to_string(layout.rootCells.x) +
@@ -236,6 +252,7 @@ public:
         return {{"leaf_size", mLeafSize},
                 {"leaves", double(mTree->getLeafCount())},
                 {"nodes", double(mTree->getNodeCount())},
+                {"mask_table", double(mTree->getMaskTable().size())}, // 0: inline masks
                 {"probes", double(mTree->getElementCount())},
                 {"bake_s", mBakeSeconds}};
     }
@@ -336,6 +353,7 @@ private:
     bool mPlain;
     bool mAntiLeak;
     bool mDilate;
+    bool mInlineMasks = false;
     double mNormalOffset;
     int mBakeSamples;
     int mBounces;

@@ -195,3 +195,31 @@ TEST(AdaptiveVoxelTree, SeamlessInterpolationJumpsLessAcrossLevelsThanPlain)
 }
 
 } // namespace
+
+TEST(AdaptiveVoxelTree, SharedAndInlineMasksGiveTheSameIrradianceInLessTopology)
+{
+    // The two node codings hold the same tree: the same probes, the same bake (the same seeds),
+    // the same pixels, bit for bit; the shared masks take fewer topology bytes.
+    const scene::RenderScene s = makeLitRoom();
+    const scene::GBuffer g = reference::castGBuffer(
+        s, makeCamera(glm::vec3(0.6f, 0.2f, 0.9f), glm::vec3(-0.5f, -0.6f, -0.8f)), 24, 16);
+    std::map<std::string, Image<glm::vec3>> images;
+    std::map<std::string, std::size_t> topology;
+    for (const std::string masks : {"shared", "inline"}) {
+        auto t = make({{"resolution", std::int64_t(32)},
+                       {"bake_samples", std::int64_t(2)},
+                       {"node_masks", masks}});
+        auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*t);
+        images[masks] = run(gi, s, g);
+        topology[masks] = gi.memory().topologyBytes;
+    }
+    ASSERT_EQ(images["shared"].pixels.size(), images["inline"].pixels.size());
+    std::size_t differ = 0, lit = 0;
+    for (std::size_t i = 0; i < images["shared"].pixels.size(); ++i) {
+        differ += images["shared"].pixels[i] != images["inline"].pixels[i] ? 1 : 0;
+        lit += images["shared"].pixels[i].x > 0.0f ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_GT(lit, images["shared"].pixels.size() / 4);
+    EXPECT_LT(topology["shared"], topology["inline"]);
+}

@@ -34,22 +34,28 @@
 // Not yet: a local rebuild after a dig.
 //
 // Parameters
-// | name          | type  | default | range / choices | unit                              |
-// |---------------|-------|---------|-----------------|-----------------------------------|
-// | resolution    | int   | 64      | [8, 4096]       | leaves along the box's longest side |
-// | depth         | int   | 3       | [1, 6]          | levels below the root cells       |
-// | voxel_size    | float | 0 (auto)| [0, 1e6]        | world units (leaf size)           |
-// | supersampling | int   | 4       | [1, 16]         | rays per leaf column and axis, per side |
-// | bounces       | int   | 2       | [1, 3]          |                                   |
-// | cone_angle    | float | 29      | [5, 60]         | degrees (half-angle)              |
-// | start_offset  | float | 4       | [0, 8]          | leaves (pixel cones)              |
-// | inject_offset | float | 4       | [0, 8]          | leaves (the leaves' cones)        |
-// | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled         |
-// | trace_step    | int   | 4       | [1, 8]          | pixels                            |
-// | device        | enum  | auto    | auto, vulkan, cpu | where the pixel gather runs (auto: Vulkan
-// on a GPU, C++ on lavapipe) | | capsule_resolution | enum | traced | traced, full  | where the
-// capsules are tested (the traced pixels or every pixel) | | inner_layers  | int   | 4       | [1,
-// 8]          | leaves of solid kept inside closed surfaces |
+// | name               | type  | default  | range / choices   | unit                       |
+// |--------------------|-------|----------|-------------------|----------------------------|
+// | resolution         | int   | 64       | [8, 4096]         | leaves along the longest side |
+// | depth              | int   | 3        | [1, 6]            | levels below the root cells |
+// | node_masks         | enum  | shared   | shared, inline    |                            |
+// | voxel_size         | float | 0 (auto) | [0, 1e6]          | world units (leaf size)    |
+// | supersampling      | int   | 4        | [1, 16]           | rays per leaf column, axis, side |
+// | bounces            | int   | 2        | [1, 3]            |                            |
+// | cone_angle         | float | 29       | [5, 60]           | degrees (half-angle)       |
+// | start_offset       | float | 4        | [0, 8]            | leaves (pixel cones)       |
+// | inject_offset      | float | 4        | [0, 8]            | leaves (the leaves' cones) |
+// | step_scale         | float | 0.5      | [0.1, 2]          | of the voxel size sampled  |
+// | trace_step         | int   | 4        | [1, 8]            | pixels                     |
+// | device             | enum  | auto     | auto, vulkan, cpu |                            |
+// | capsule_resolution | enum  | traced   | traced, full      |                            |
+// | inner_layers       | int   | 4        | [1, 8]            | leaves of solid inside walls |
+//
+// node_masks: shared keeps the node records' child masks in one table of the tree's distinct
+// masks (voxel_tree.h), inline in each record (the talk's 12 bytes); the gather reads the same
+// elements either way. device: where the pixel gather runs (auto: Vulkan on a GPU, C++ where
+// Vulkan runs on the CPU). capsule_resolution: the characters' capsules tested at the traced
+// pixels or at every pixel.
 //
 // start_offset 4 as svo (the same leaves, the same self-occlusion at a smaller offset);
 // inject_offset 4 as svo: at 1 / 2 / 4 leaves, leak room with 0.5-leaf walls 0.52 / 0.70 / 0.91
@@ -92,6 +98,10 @@ public:
         config::ParamSchema schema;
         voxelgi::SparseConeParams::declare(schema, "leaves along the longest side of the static scene's box", 4);
         schema.addInt("depth", 3, 1, 6, "", "tree levels below the dense root cells (4^depth leaves per root cell and axis)");
+        schema.addEnum(
+            "node_masks", "shared", {"shared", "inline"},
+            "the node records' child masks in one table of the distinct masks, or in each record "
+            "(the talk's 12 bytes); the gather reads the same elements");
         return schema;
     }
 
@@ -99,6 +109,8 @@ public:
     {
         voxelgi::TreeConeSettings settings;
         settings.depth = int(p.getInt("depth"));
+        settings.nodeMasks = p.getString("node_masks") == "inline" ? voxelgi::NodeMasks::Inline
+                                                                   : voxelgi::NodeMasks::Shared;
         settings.supersampling = mParams.supersampling;
         settings.bounces = mParams.bounces;
         settings.coneHalfAngleDegrees = mParams.coneAngle;
@@ -139,11 +151,16 @@ private:
     void writeStructureParams(config::ParamSet& p) const override
     {
         p.set("depth", std::int64_t(mStructure->getSettings().depth));
+        p.set("node_masks",
+              std::string(mStructure->getSettings().nodeMasks == voxelgi::NodeMasks::Inline
+                              ? "inline"
+                              : "shared"));
     }
 
     std::vector<std::pair<std::string, double>> structureCounters() const override
     {
         return {{"nodes", double(mStructure->getTree()->getNodeCount())},
+                {"mask_table", double(mStructure->getTree()->getMaskTable().size())},
                 {"elements", double(mStructure->getTree()->getElementCount())}};
     }
 };

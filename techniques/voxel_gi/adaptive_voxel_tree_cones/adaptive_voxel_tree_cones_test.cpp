@@ -214,8 +214,9 @@ namespace {
 
 // The Vulkan gather against the C++ one on the same tree and G-buffer (positions relative to the
 // lattice's centre in the shader), with the tolerance stated in voxel_gi_gpu_parity.h. Two root
-// cells along x, so that the dense first level is indexed too.
-void compareGpu(glm::vec3 offset, int resolution, int depth)
+// cells along x, so that the dense first level is indexed too. Both ways of keeping the masks:
+// shared masks' records are bit fields that straddle 32-bit words.
+void compareGpu(glm::vec3 offset, int resolution, int depth, NodeMasks masks = NodeMasks::Shared)
 {
     const scene::RenderScene s = makeOpenRoom(offset);
     scene::Camera camera;
@@ -223,7 +224,7 @@ void compareGpu(glm::vec3 offset, int resolution, int depth)
     camera.target = offset + glm::vec3(-0.5f, -0.7f, -0.5f);
     camera.nearPlane = 1e-3f;
     const scene::GBuffer g = reference::castGBuffer(s, camera, 48, 32);
-    VoxelTreeCones tree({.depth = depth, .supersampling = 2});
+    VoxelTreeCones tree({.depth = depth, .supersampling = 2, .nodeMasks = masks});
     glm::dvec3 origin;
     double leaf = 0.0;
     glm::ivec3 roots;
@@ -237,6 +238,10 @@ void compareGpu(glm::vec3 offset, int resolution, int depth)
     lattice.supersampling = 2;
     tree.build(origin, leaf, roots, voxelizeSurfaceLeaves(s, lattice, "test"));
     tree.injectLight(s);
+    ASSERT_EQ(tree.getTree()->getNodeMasks(), masks);
+    if (masks == NodeMasks::Shared) {
+        EXPECT_NE(32u % tree.getTree()->getRecordWidth(), 0u);
+    }
     // At depth 3 the pixel cones sample the leaves' parents (never the leaves), found through
     // a level-1 element's node record, by rank: the lookup meets records in both halves of the
     // 64-bit rank word. (Below its root cells an undilated tree has no element without children.)
@@ -265,6 +270,7 @@ TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesTheCppGather)
 {
     compareGpu(glm::vec3(0.0f), 32, 2);
     compareGpu(glm::vec3(0.0f), 128, 3);
+    compareGpu(glm::vec3(0.0f), 128, 3, NodeMasks::Inline);
 }
 
 TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesFarFromTheOrigin)

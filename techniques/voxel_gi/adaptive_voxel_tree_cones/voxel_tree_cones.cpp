@@ -64,7 +64,8 @@ void VoxelTreeCones::build(const glm::dvec3& origin, double leafSize, const glm:
     std::vector<glm::ivec3> coords(leaves.size());
     for (std::size_t i = 0; i < leaves.size(); ++i)
         coords[i] = leaves[i].coord;
-    mTree.emplace(AdaptiveVoxelTree::build(layout, coords, /*dilate=*/false));
+    mTree.emplace(
+        AdaptiveVoxelTree::build(layout, coords, {.dilate = false, .masks = mSettings.nodeMasks}));
     mOrigin = origin;
     mLeafSize = leafSize;
     mBoxSize = glm::dvec3(layout.getCells(mSettings.depth)) * leafSize;

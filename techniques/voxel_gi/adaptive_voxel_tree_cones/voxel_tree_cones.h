@@ -40,6 +40,8 @@ struct TreeConeSettings {
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
     int innerLayers = 1;      //!< layers of solid leaves inside closed surfaces (sparse_leaves.h)
+    NodeMasks nodeMasks =
+        NodeMasks::Shared; //!< where the node records keep their masks (voxel_tree.h)
 };
 
 class VoxelTreeCones {
