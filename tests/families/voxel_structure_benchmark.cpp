@@ -6,11 +6,14 @@
 //   cascades             the Tomorrow Children's clipmap: levels of 32^3 doubling in extent until
 //                        the coarsest holds the box, the finest at the same voxel size (memory
 //                        only: it holds the finest voxels only near the camera)
-//   adaptive_voxel_tree  Quantum Break's 64-ary tree (voxel_tree.h), depth 3 below root cells of
-//                        64^3 leaves, payload for every element (nodes too: the seamless
-//                        interpolation reads them), its records' masks shared in a table (the
-//                        default); `_undilated` without the partial dilation; `_inline_masks`
-//                        with the talk's 12-byte records (64-bit mask + offset in each)
+//   adaptive_voxel_tree  Quantum Break's 64-ary tree (voxel_tree.h), partially dilated, depth 2
+//                        below a dense first level of root cells of 16^3 leaves (the talk: "the
+//                        first level of the tree can have arbitrary dimensions"), payload for
+//                        every element (nodes too: the seamless interpolation reads them), its
+//                        records' masks shared in a table (the default); `_undilated` without
+//                        the partial dilation; `_inline_masks` with the talk's 12-byte records
+//                        (64-bit mask + offset in each); `_depth3` one level deeper below root
+//                        cells of 64^3 leaves (fewer root cells, one more level per lookup)
 //   svo                  Crassin et al.'s sparse voxel octree (sparse_voxel_octree.h): node tiles
 //                        of 2x2x2 with one 32-bit child pointer per node, down to the next power
 //                        of two above the lattice, payload for every node (cone tracing reads the
@@ -30,8 +33,8 @@
 // Counters: voxels (active), topology_B (bytes per active voxel), payload_B, total_B,
 // mask_floor_B (adaptive_voxel_tree: its child masks at their combinatorial minimum, the part of
 // the topology no code of each node's mask on its own goes below; sharing the masks between
-// nodes does), masks (adaptive_voxel_tree: distinct masks in its table), and items_per_second = lookups per second for
-// the lookup rows (ns per lookup = 1e9 / it).
+// nodes does), masks (adaptive_voxel_tree: distinct masks in its table), and items_per_second =
+// lookups per second for the lookup rows (ns per lookup = 1e9 / it).
 
 #include "sparse_voxel_octree.h" // techniques/voxel_gi/svo
 #include "voxel_tree.h"          // techniques/voxel_gi/adaptive_voxel_tree
@@ -189,16 +192,19 @@ private:
 
 class Avt final : public Structure {
 public:
-    explicit Avt(const voxelgi::VoxelTreeBuildOptions& options) : mOptions(options) {}
+    Avt(const voxelgi::VoxelTreeBuildOptions& options, int depth) : mOptions(options), mDepth(depth)
+    {
+    }
     void build(const Voxels& v) override
     {
         voxelgi::VoxelTreeLayout layout;
-        layout.depth = 3;
-        layout.rootCells = glm::max((v.cells + 63) / 64, glm::ivec3(1));
+        layout.depth = mDepth;
+        const int rootLeaves = 1 << (2 * mDepth);
+        layout.rootCells = glm::max((v.cells + rootLeaves - 1) / rootLeaves, glm::ivec3(1));
         mTree = voxelgi::AdaptiveVoxelTree::build(layout, v.active, mOptions);
         mPayload.assign(mTree.getElementCount(), glm::vec3(0.0f));
         for (const auto& c : v.active)
-            mPayload[std::size_t(mTree.find(3, c))] = payloadOf(c);
+            mPayload[std::size_t(mTree.find(mDepth, c))] = payloadOf(c);
     }
     metrics::StructureFootprint footprint() const override
     {
@@ -210,7 +216,7 @@ public:
     {
         double sum = 0.0;
         for (const auto& c : q) {
-            const std::int64_t i = mTree.find(3, c);
+            const std::int64_t i = mTree.find(mDepth, c);
             sum += i >= 0 ? mPayload[std::size_t(i)].x : 0.0f;
         }
         return sum;
@@ -237,6 +243,7 @@ public:
 
 private:
     voxelgi::VoxelTreeBuildOptions mOptions;
+    int mDepth;
     voxelgi::AdaptiveVoxelTree mTree;
     std::vector<glm::vec3> mPayload;
 };
@@ -367,11 +374,14 @@ std::unique_ptr<Structure> makeStructure(const std::string& name)
     if (name == "cascades")
         return std::make_unique<Cascades>();
     if (name == "adaptive_voxel_tree")
-        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{});
+        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{}, 2);
     if (name == "adaptive_voxel_tree_undilated")
-        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{.dilate = false});
+        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{.dilate = false}, 2);
     if (name == "adaptive_voxel_tree_inline_masks")
-        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{.masks = voxelgi::NodeMasks::Inline});
+        return std::make_unique<Avt>(
+            voxelgi::VoxelTreeBuildOptions{.masks = voxelgi::NodeMasks::Inline}, 2);
+    if (name == "adaptive_voxel_tree_depth3")
+        return std::make_unique<Avt>(voxelgi::VoxelTreeBuildOptions{}, 3);
     if (name == "svo")
         return std::make_unique<Svo>();
     if (name == "openvdb")
@@ -452,7 +462,8 @@ int main(int argc, char** argv)
     for (const auto& [sceneName, r] : sets)
         for (const std::string name :
              {"dense_grid", "cascades", "adaptive_voxel_tree", "adaptive_voxel_tree_undilated",
-              "adaptive_voxel_tree_inline_masks", "svo", "openvdb", "nanovdb"}) {
+              "adaptive_voxel_tree_inline_masks", "adaptive_voxel_tree_depth3", "svo", "openvdb",
+              "nanovdb"}) {
             // A dense grid over the band's box would take 468^3 x 12 bytes (1.2 GB).
             if (sceneName == "narrow_band_sphere" && name == "dense_grid")
                 continue;

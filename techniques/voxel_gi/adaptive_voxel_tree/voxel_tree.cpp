@@ -182,12 +182,56 @@ AdaptiveVoxelTree AdaptiveVoxelTree::build(const VoxelTreeLayout& layout, std::v
     return tree;
 }
 
+namespace {
+
+// Writes `field` (at most 32 bits) at bit `bit` of a packed array, low bits first.
+void writeField(std::vector<std::uint32_t>& words, std::uint64_t bit, std::uint64_t field)
+{
+    const std::size_t word = std::size_t(bit >> 5);
+    const std::uint64_t shifted = field << (bit & 31u);
+    words[word] |= std::uint32_t(shifted);
+    words[word + 1] |= std::uint32_t(shifted >> 32);
+}
+
+} // namespace
+
 void AdaptiveVoxelTree::shareMasks(std::size_t maxMasks)
 {
+    const std::size_t records = mNodes.size();
+    // A dilated tree: the upper records (levels < depth - 1, the first ones in element order)
+    // also get the mask of their children that have a record and the record of the first of
+    // those, so that a descent finds the next record without the rank words.
+    std::size_t upper = 0;
+    std::vector<std::uint64_t> realMasks;
+    std::vector<std::uint32_t> realOffsets;
+    if (!mEveryUpperHasRecord && mLayout.depth >= 2) {
+        const auto recordsBefore = [this](std::size_t e) {
+            const VoxelTreeRank& word = mRanks[e >> 6];
+            return std::size_t(word.base) +
+                   std::size_t(
+                       std::popcount(word.getBits() & ((std::uint64_t(1) << (e & 63u)) - 1)));
+        };
+        upper = recordsBefore(mLevelBegin[std::size_t(mLayout.depth) - 1]);
+        realMasks.resize(upper);
+        realOffsets.resize(upper);
+        for (std::size_t r = 0; r < upper; ++r) {
+            std::uint64_t mask = mNodes[r].getMask(), real = 0;
+            std::uint32_t child = mNodes[r].offset;
+            realOffsets[r] = std::uint32_t(recordsBefore(child));
+            while (mask != 0) {
+                const int bit = std::countr_zero(mask);
+                mask &= mask - 1;
+                if (findRecord(child++) >= 0)
+                    real |= std::uint64_t(1) << bit;
+            }
+            realMasks[r] = real;
+        }
+    }
     // The table of distinct masks, the most frequent first (they then share cache lines).
-    std::vector<std::uint64_t> masks(mNodes.size());
-    for (std::size_t r = 0; r < mNodes.size(); ++r)
+    std::vector<std::uint64_t> masks(records + upper);
+    for (std::size_t r = 0; r < records; ++r)
         masks[r] = mNodes[r].getMask();
+    std::copy(realMasks.begin(), realMasks.end(), masks.begin() + std::ptrdiff_t(records));
     sortUnique(masks);
     if (masks.size() > maxMasks)
         return; // the talk's records stay
@@ -197,6 +241,8 @@ void AdaptiveVoxelTree::shareMasks(std::size_t maxMasks)
     };
     for (const VoxelTreeNode& node : mNodes)
         ++uses[indexOf(node.getMask())];
+    for (const std::uint64_t m : realMasks)
+        ++uses[indexOf(m)];
     std::vector<std::uint32_t> order(masks.size());
     for (std::uint32_t i = 0; i < order.size(); ++i)
         order[i] = i;
@@ -208,28 +254,35 @@ void AdaptiveVoxelTree::shareMasks(std::size_t maxMasks)
         id[order[i]] = i;
         mMaskTable[i] = masks[order[i]];
     }
-    // Records are in element order and children are packed in it, so a record's offset is the
-    // previous record's plus its popcount: within a group of 64 records it exceeds the group's
-    // first offset by at most 63 * 64 < 2^kOffsetBits.
-    // A record's bit field: the offset, then as many index bits as the table needs (>= 1).
+    // A field: the offset from the group's base, then as many index bits as the table needs
+    // (>= 1). Within a group of 64 records an offset exceeds the group's first by at most
+    // 63 * 64 < 2^kOffsetBits: records are in element order and children are packed in it, so
+    // a record's offset is the previous record's plus its popcount (and the same holds for the
+    // records of the children that have one).
     mRecordWidth = kOffsetBits + unsigned(std::max(1, int(std::bit_width(masks.size() - 1))));
     mRecordFieldMask = mRecordWidth >= 32 ? ~0u : (1u << mRecordWidth) - 1u;
-    mRecordBits.assign((std::uint64_t(mNodes.size()) * mRecordWidth + 31) / 32 + 2, 0u);
-    mRecordBases.resize((mNodes.size() + 63) / 64);
-    for (std::size_t r = 0; r < mNodes.size(); ++r) {
-        if ((r & 63u) == 0)
-            mRecordBases[r >> 6] = mNodes[r].offset;
-        const std::uint32_t delta = mNodes[r].offset - mRecordBases[r >> 6];
-        if (delta > kOffsetMask)
-            throw Error("adaptive voxel tree: record " + std::to_string(r) +
-                        " lies outside its group's offset range (internal error)");
-        const std::uint64_t field = (std::uint64_t(id[indexOf(mNodes[r].getMask())]) << kOffsetBits) | delta;
-        const std::uint64_t bit = std::uint64_t(r) * mRecordWidth;
-        const std::size_t word = std::size_t(bit >> 5);
-        const std::uint64_t shifted = field << (bit & 31u);
-        mRecordBits[word] |= std::uint32_t(shifted);
-        mRecordBits[word + 1] |= std::uint32_t(shifted >> 32);
-    }
+    const auto pack = [&](std::size_t count, const auto& maskOf, const auto& offsetOf,
+                          std::vector<std::uint32_t>& bits, std::vector<std::uint32_t>& bases) {
+        bits.assign((std::uint64_t(count) * mRecordWidth + 31) / 32 + 2, 0u);
+        bases.resize((count + 63) / 64);
+        for (std::size_t r = 0; r < count; ++r) {
+            if ((r & 63u) == 0)
+                bases[r >> 6] = offsetOf(r);
+            const std::uint32_t delta = offsetOf(r) - bases[r >> 6];
+            if (delta > kOffsetMask)
+                throw Error("adaptive voxel tree: record " + std::to_string(r) +
+                            " lies outside its group's offset range (internal error)");
+            writeField(bits, std::uint64_t(r) * mRecordWidth,
+                       (std::uint64_t(id[indexOf(maskOf(r))]) << kOffsetBits) | delta);
+        }
+    };
+    pack(
+        records, [this](std::size_t r) { return mNodes[r].getMask(); },
+        [this](std::size_t r) { return mNodes[r].offset; }, mRecordBits, mRecordBases);
+    if (upper > 0)
+        pack(
+            upper, [&realMasks](std::size_t r) { return realMasks[r]; },
+            [&realOffsets](std::size_t r) { return realOffsets[r]; }, mUpperBits, mUpperBases);
     mNodes.clear();
     mNodes.shrink_to_fit();
     mNodeMasks = NodeMasks::Shared;

@@ -37,6 +37,11 @@
 //    record costs 12. The child index is the same offset + popcount, read in two more loads that
 //    stay in cache (the bases and a table of at most a few thousand masks). When the masks need
 //    more than 20-bit indices the tree keeps the talk's records (getNodeMasks() says which).
+//    In a dilated tree, each record above level depth - 1 has a second field of the same form:
+//    the mask of its children that have a record (the same table) and the record of the first
+//    of them. A descent needs nothing else above the target level (every ancestor of an element
+//    has children), so it goes from record to record without the rank words, which stay for
+//    getNode(element).
 //
 // Element coordinates are integer cells of their level: level l has rootCells * 4^l cells per
 // axis, and level `depth` cells are the leaves.
@@ -199,9 +204,10 @@ public:
     //! other table).
     std::size_t getTopologyBytes() const
     {
-        return mNodes.size() * sizeof(VoxelTreeNode) + mRecordBits.size() * sizeof(std::uint32_t) +
-               mRecordBases.size() * sizeof(std::uint32_t) + mMaskTable.size() * sizeof(std::uint64_t) +
-               mRanks.size() * sizeof(VoxelTreeRank);
+        return mNodes.size() * sizeof(VoxelTreeNode) +
+               (mRecordBits.size() + mRecordBases.size() + mUpperBits.size() + mUpperBases.size()) *
+                   sizeof(std::uint32_t) +
+               mMaskTable.size() * sizeof(std::uint64_t) + mRanks.size() * sizeof(VoxelTreeRank);
     }
 
 private:
@@ -225,29 +231,47 @@ private:
     {
         const VoxelTreeNode* nodes = mNodes.data();
         const unsigned char* fields = reinterpret_cast<const unsigned char*>(mRecordBits.data());
+        const unsigned char* upperFields =
+            reinterpret_cast<const unsigned char*>(mUpperBits.data());
         const std::uint32_t* bases = mRecordBases.data();
+        const std::uint32_t* upperBases = mUpperBases.data();
         const std::uint64_t* table = mMaskTable.data();
         const std::uint64_t width = mRecordWidth;
         const std::uint32_t fieldMask = mRecordFieldMask;
+        // One unaligned 8-byte read holds a field (width <= 32, shift <= 7; the two padding words
+        // keep it inside the array).
+        const auto readField = [fieldMask](const unsigned char* packed, std::uint64_t bit) {
+            std::uint64_t bytes;
+            std::memcpy(&bytes, packed + (bit >> 3), sizeof bytes);
+            return std::uint32_t(bytes >> (bit & 7u)) & fieldMask;
+        };
         std::uint32_t index = root;
         std::uint32_t record = root; // the dense first level: every root cell has a record
         for (int s = shift - 2; s >= 0; s -= 2) {
+            const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
+            if constexpr (Shared && Ranked) {
+                if (s > 0) {
+                    // Above the target level only the children with a record matter (every
+                    // ancestor of an element has children): the next record without the ranks.
+                    const std::uint32_t field = readField(upperFields, record * width);
+                    const std::uint64_t real = table[field >> kOffsetBits];
+                    if (((real >> bit) & 1u) == 0)
+                        return kAbsent;
+                    record = upperBases[record >> 6] + (field & kOffsetMask) +
+                             std::uint32_t(std::popcount(real & ((std::uint64_t(1) << bit) - 1)));
+                    continue;
+                }
+            }
             std::uint64_t mask;
             std::uint32_t offset;
             if constexpr (Shared) {
-                // One unaligned 8-byte read holds the field (width <= 32, shift <= 7; the two
-                // padding words keep it inside the array).
-                const std::uint64_t bit = std::uint64_t(record) * width;
-                std::uint64_t bytes;
-                std::memcpy(&bytes, fields + (bit >> 3), sizeof bytes);
-                const std::uint32_t field = std::uint32_t(bytes >> (bit & 7u)) & fieldMask;
+                const std::uint32_t field = readField(fields, record * width);
                 mask = table[field >> kOffsetBits];
                 offset = bases[record >> 6] + (field & kOffsetMask);
             } else {
                 mask = nodes[record].getMask();
                 offset = nodes[record].offset;
             }
-            const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
             if (((mask >> bit) & 1u) == 0)
                 return kAbsent;
             // The talk's child index: offset + the set bits below this one (one POPCNT).
@@ -283,6 +307,9 @@ private:
     std::size_t mRecordCount = 0;
     std::vector<VoxelTreeNode> mNodes; // inline masks
     std::vector<std::uint32_t> mRecordBits, mRecordBases;
+    //! Shared masks of a dilated tree: for each record above level depth - 1, the mask of its
+    //! children that have a record and the record of the first one (fields and bases as above).
+    std::vector<std::uint32_t> mUpperBits, mUpperBases;
     unsigned mRecordWidth = 32;
     std::uint32_t mRecordFieldMask = ~0u;
     std::vector<std::uint64_t> mMaskTable; // shared masks

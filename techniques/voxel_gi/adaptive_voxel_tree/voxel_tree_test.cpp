@@ -101,6 +101,12 @@ void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<gl
     // upper-level elements.
     std::size_t inner = 0, wrongRecords = 0;
     std::set<std::uint64_t> distinctMasks;
+    struct Record {
+        int level;
+        std::uint64_t mask;
+        glm::ivec3 cell;
+    };
+    std::vector<Record> childMasks;
     for (std::size_t e = 0; e < tree.getElementCount(); ++e) {
         const int l = cells[e].w;
         std::uint64_t want = 0;
@@ -114,8 +120,10 @@ void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<gl
         const std::optional<VoxelTreeNode> node = tree.getNode(std::uint32_t(e));
         const bool record = want != 0 || l == 0; // every root cell has one
         inner += record ? 1 : 0;
-        if (record)
+        if (record) {
             distinctMasks.insert(want);
+            childMasks.push_back({l, want, glm::ivec3(cells[e])});
+        }
         if (node.has_value() != record || (node && node->getMask() != want))
             ++wrongRecords;
     }
@@ -125,15 +133,35 @@ void expectMatchesDenseGrids(const VoxelTreeLayout& layout, const std::vector<gl
     // record, packed in 32-bit words (two more of padding), a 4-byte base per 64 records, 8 bytes
     // per distinct mask.
     const std::size_t ranks = 12 * ((tree.getLevelBegin(layout.depth) + 63) / 64);
+    // A dilated tree's shared masks also hold, for each record above level depth - 1, the mask
+    // of its children that have a record.
+    std::size_t upper = 0;
+    if (options.masks == NodeMasks::Shared && inner < tree.getLevelBegin(layout.depth))
+        for (const Record& r : childMasks) {
+            if (r.level >= layout.depth - 1)
+                continue;
+            ++upper;
+            std::uint64_t real = 0;
+            for (int bit = 0; bit < 64; ++bit) {
+                const glm::ivec3 child = r.cell * 4 + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4);
+                for (const Record& c : childMasks)
+                    if (c.level == r.level + 1 && c.cell == child)
+                        real |= std::uint64_t(1) << bit;
+            }
+            distinctMasks.insert(real);
+        }
     const bool shared = options.masks == NodeMasks::Shared && distinctMasks.size() <= options.maxSharedMasks;
     EXPECT_EQ(tree.getNodeMasks(), shared ? NodeMasks::Shared : NodeMasks::Inline) << what;
     std::size_t indexBits = 1;
     while ((std::size_t(1) << indexBits) < distinctMasks.size())
         ++indexBits;
     const std::size_t fieldWords = (inner * (12 + indexBits) + 31) / 32 + 2;
-    EXPECT_EQ(tree.getTopologyBytes(),
-              shared ? 4 * fieldWords + 4 * ((inner + 63) / 64) + 8 * distinctMasks.size() + ranks
-                     : 12 * inner + ranks)
+    const std::size_t upperWords =
+        upper == 0 ? 0 : (upper * (12 + indexBits) + 31) / 32 + 2 + (upper + 63) / 64;
+    EXPECT_EQ(tree.getTopologyBytes(), shared
+                                           ? 4 * fieldWords + 4 * ((inner + 63) / 64) +
+                                                 4 * upperWords + 8 * distinctMasks.size() + ranks
+                                           : 12 * inner + ranks)
         << what;
     if (shared) {
         EXPECT_EQ(tree.getRecordWidth(), 12 + indexBits) << what;
