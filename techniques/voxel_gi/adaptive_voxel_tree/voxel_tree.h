@@ -174,14 +174,15 @@ public:
     //! Inline: it is the lookup every use of the tree spends its time in.
     std::int64_t find(int level, const glm::ivec3& c) const
     {
-        if (unsigned(level) > unsigned(mLayout.depth) || c.x < 0 || c.y < 0 || c.z < 0)
+        if (unsigned(level) > unsigned(mLayout.depth))
             return kAbsent;
         const int shift = 2 * level;
-        const int rx = c.x >> shift, ry = c.y >> shift, rz = c.z >> shift;
+        // A negative coordinate stays negative when shifted: as unsigned, it is past any bound.
+        const unsigned rx = unsigned(c.x >> shift), ry = unsigned(c.y >> shift), rz = unsigned(c.z >> shift);
         const glm::ivec3& roots = mLayout.rootCells;
-        if (rx >= roots.x || ry >= roots.y || rz >= roots.z)
+        if (rx >= unsigned(roots.x) || ry >= unsigned(roots.y) || rz >= unsigned(roots.z))
             return kAbsent;
-        const std::uint32_t root = std::uint32_t(rx + roots.x * (ry + roots.y * rz));
+        const std::uint32_t root = rx + unsigned(roots.x) * (ry + unsigned(roots.y) * rz);
         // One branch per lookup, not per level: each descent is specialised.
         if (mNodeMasks == NodeMasks::Shared)
             return mEveryUpperHasRecord ? descend<true, false>(root, shift, c) : descend<true, true>(root, shift, c);
