@@ -35,18 +35,18 @@
 // Not yet: Vulkan lookups.
 //
 // Parameters
-// | name          | type | default       | range / choices        | unit                        |
-// |---------------|------|---------------|------------------------|-----------------------------|
-// | resolution    | int  | 64            | [4, 4096]              | leaves along the box's longest
-// side | | depth         | int  | 3             | [1, 6]                 | levels below the root
-// cells | | payload       | enum | ambient_cube  | ambient_cube, sh_l1    | | | interpolation |
-// enum | seamless      | seamless, plain        |                             | | anti_leak     |
-// bool | true          |                        |                             | | dilate        |
-// bool | true          |                        | partial dilation of the upper levels | |
-// node_masks    | enum | shared        | shared, inline         | where the node records' masks are
-// | | normal_offset | float| 0.5           | [0, 4]                 | leaves (the lookup point
-// along the normal) | | bake_samples  | int  | 32            | [1, 65536]             | paths per
-// probe and axis    | | bounces       | int  | 2             | [1, 8]                 | |
+// | name          | type  | default      | range / choices     | unit                         |
+// |---------------|-------|--------------|---------------------|------------------------------|
+// | resolution    | int   | 64           | [4, 4096]           | leaves along the longest side |
+// | depth         | int   | 3            | [1, 6]              | levels below the root cells  |
+// | payload       | enum  | ambient_cube | ambient_cube, sh_l1 |                              |
+// | interpolation | enum  | seamless     | seamless, plain     |                              |
+// | anti_leak     | bool  | true         |                     |                              |
+// | dilate        | bool  | true         |                     | partial dilation (upper levels) |
+// | node_masks    | enum  | shared       | shared, inline      |                              |
+// | normal_offset | float | 0.5          | [0, 4]              | leaves along the normal      |
+// | bake_samples  | int   | 32           | [1, 65536]          | paths per probe and axis     |
+// | bounces       | int   | 2            | [1, 8]              |                              |
 //
 // node_masks: shared keeps the child masks in one table of the tree's distinct masks, each
 // record a bit field of 12 + log2(table size) bits (voxel_tree.h); inline keeps the talk's

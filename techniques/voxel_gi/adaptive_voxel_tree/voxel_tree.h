@@ -85,14 +85,14 @@ inline int getChildBit(const glm::ivec3& c)
 }
 
 //! How a node record stores its child mask: inline (the talk's 12-byte record) or as an index into
-//! a table of the tree's distinct masks (4 bytes).
+//! a table of the tree's distinct masks (a bit field of 12 + log2(table size) bits).
 enum class NodeMasks { Shared, Inline };
 
 struct VoxelTreeBuildOptions {
     bool dilate = true;                 //!< partial dilation of the upper levels
     NodeMasks masks = NodeMasks::Shared;
     //! Shared masks fall back to inline ones when the tree has more distinct masks than this
-    //! (at most 2^20, the record word's index bits; lower only to test the fallback).
+    //! (at most 2^20, the index bits of a record's field; lower only to test the fallback).
     std::size_t maxSharedMasks = std::size_t(1) << 20;
 };
 
@@ -158,7 +158,7 @@ public:
     std::size_t getLevelBegin(int level) const { return mLevelBegin[std::size_t(level)]; }
     bool isDilated() const { return mDilated; }
 
-    //! The node record of element e, or nullptr when e has none (a leaf, a childless cell below
+    //! The node record of element e, or nothing when e has none (a leaf, a childless cell below
     //! the roots; a root cell always has one, its mask 0 when it has no children).
     std::optional<VoxelTreeNode> getNode(std::uint32_t e) const
     {
@@ -225,8 +225,9 @@ private:
         return std::uint32_t(pair >> (bit & 31u)) & mRecordFieldMask;
     }
     //! find() below root cell `root`. Shared: the records' masks are in the table. Ranked: some
-    //! upper-level elements have no record (a dilated tree), so a record is found by rank;
-    //! otherwise record = element (every upper-level element of an undilated tree has children).
+    //! upper-level elements have no record (a dilated tree), so the next record is found through
+    //! the upper fields (shared masks) or by rank (inline masks); otherwise record = element
+    //! (every upper-level element of an undilated tree has children).
     template <bool Shared, bool Ranked>
     std::int64_t descend(std::uint32_t root, int shift, const glm::ivec3& c) const
     {
