@@ -19,10 +19,9 @@
 //    leaves are isotropic (the paper's); the octree is built top-down over them (node tiles of
 //    2x2x2, one child pointer per node) and their occupancy filtered up the tree anisotropically
 //    (6 faces, front-to-back per column). Rebuilt only when the static geometry changes.
-// 2. inject light: per surface leaf, the family's 16-cone gather through the octree (emission, sky
-// as 16
-//    lobes, point lights with shadow cones), three passes (direct, bounce 1, bounce 2), each
-//    filtered up the tree before the next reads it. Skipped while the tree and lights are
+// 2. inject light: per surface leaf, the family's 16-cone gather through the octree (emission,
+//    sky as 16 lobes, point lights with shadow cones), three passes (direct, bounce 1, bounce
+//    2), each filtered up the tree before the next reads it. Skipped while the tree and lights are
 //    unchanged.
 // 3. gather: per pixel one trace_step^2 block, the 16 cones above the surface through the
 //    octree, each sample quadrilinear at the cone footprint's level; upsampled by depth and
@@ -35,21 +34,23 @@
 // start level chosen by the distance to the camera, a local rebuild after a dig.
 //
 // Parameters
-// | name          | type  | default | range / choices | unit                          |
-// |---------------|-------|---------|-----------------|-------------------------------|
-// | resolution    | int   | 64      | [8, 4096], power of two | leaves along the cube's side |
-// | voxel_size    | float | 0 (auto)| [0, 1e6]        | world units (leaf size)       |
-// | supersampling | int   | 4       | [1, 16]         | rays per leaf column and axis, per side |
-// | bounces       | int   | 2       | [1, 3]          |                               |
-// | cone_angle    | float | 29      | [5, 60]         | degrees (half-angle)          |
-// | start_offset  | float | 4       | [0, 8]          | leaves (pixel cones)          |
-// | inject_offset | float | 4       | [0, 8]          | leaves (the leaves' cones)    |
-// | step_scale    | float | 0.5     | [0.1, 2]        | of the voxel size sampled     |
-// | trace_step    | int   | 4       | [1, 8]          | pixels                        |
-// | device        | enum  | auto    | auto, vulkan, cpu | where the pixel gather runs (auto: Vulkan
-// on a GPU, C++ on lavapipe) | | capsule_resolution | enum | traced | traced, full  | where the
-// capsules are tested (the traced pixels or every pixel) | | inner_layers  | int   | 1       | [1,
-// 8]          | leaves of solid kept inside closed surfaces |
+// | name               | type  | default  | range / choices         | unit                      |
+// |--------------------|-------|----------|-------------------------|---------------------------|
+// | resolution         | int   | 64       | [8, 4096], power of two | leaves along the cube side |
+// | voxel_size         | float | 0 (auto) | [0, 1e6]                | world units (leaf size)   |
+// | supersampling      | int   | 4        | [1, 16]                 | rays per leaf column/side |
+// | bounces            | int   | 2        | [1, 3]                  |                           |
+// | cone_angle         | float | 29       | [5, 60]                 | degrees (half-angle)      |
+// | start_offset       | float | 4        | [0, 8]                  | leaves (pixel cones)      |
+// | inject_offset      | float | 4        | [0, 8]                  | leaves (the leaves' cones) |
+// | step_scale         | float | 0.5      | [0.1, 2]                | of the voxel size sampled |
+// | trace_step         | int   | 4        | [1, 8]                  | pixels                    |
+// | device             | enum  | auto     | auto, vulkan, cpu       |                           |
+// | capsule_resolution | enum  | traced   | traced, full            |                           |
+// | inner_layers       | int   | 1        | [1, 8]                  | solid leaves inside walls |
+//
+// device: where the pixel gather runs (auto: Vulkan on a GPU, C++ where Vulkan runs on the CPU).
+// capsule_resolution: the characters' capsules tested at the traced pixels or at every pixel.
 //
 // resolution 64: the pixel's cones start a fixed number of leaves out (there is no start level
 // chosen by the distance to the camera), so finer leaves bring the self-occlusion back and the
