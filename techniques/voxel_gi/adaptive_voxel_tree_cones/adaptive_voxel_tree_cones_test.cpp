@@ -266,6 +266,48 @@ void compareGpu(glm::vec3 offset, int resolution, int depth, NodeMasks masks = N
 
 } // namespace
 
+TEST(AdaptiveVoxelTreeCones, SharedAndInlineMasksTraceTheSameCones)
+{
+    // The two node codings hold the same elements: the injected light and the pixel cones agree
+    // bit for bit (the C++ gather reads both through the same descent).
+    const scene::RenderScene s = makeOpenRoom(glm::vec3(0.0f));
+    scene::Camera camera;
+    camera.position = glm::vec3(0.8f, 0.4f, 1.6f);
+    camera.target = glm::vec3(-0.5f, -0.7f, -0.5f);
+    camera.nearPlane = 1e-3f;
+    const scene::GBuffer g = reference::castGBuffer(s, camera, 24, 16);
+    std::vector<glm::vec3> cones[2];
+    std::size_t topology[2] = {0, 0};
+    for (int i = 0; i < 2; ++i) {
+        VoxelTreeCones tree({.depth = 3,
+                             .supersampling = 2,
+                             .nodeMasks = i == 0 ? NodeMasks::Shared : NodeMasks::Inline});
+        glm::dvec3 origin;
+        double leaf = 0.0;
+        glm::ivec3 roots;
+        VoxelTreeCones::computeLattice(glm::dvec3(s.boundsMin), glm::dvec3(s.boundsMax), 64, 3, 0.0,
+                                       origin, leaf, roots);
+        LeafLattice lattice;
+        lattice.origin = origin;
+        lattice.leafSize = leaf;
+        lattice.cells = roots * (1 << 6);
+        lattice.supersampling = 2;
+        tree.build(origin, leaf, roots, voxelizeSurfaceLeaves(s, lattice, "test"));
+        tree.injectLight(s);
+        tree.gatherCones(g, cones[i]);
+        topology[i] = tree.getTree()->getTopologyBytes();
+    }
+    ASSERT_EQ(cones[0].size(), cones[1].size());
+    std::size_t differ = 0, lit = 0;
+    for (std::size_t k = 0; k < cones[0].size(); ++k) {
+        differ += cones[0][k] != cones[1][k] ? 1 : 0;
+        lit += cones[0][k].x > 0.0f ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_GT(lit, cones[0].size() / 4);
+    EXPECT_LT(topology[0], topology[1]);
+}
+
 TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesTheCppGather)
 {
     compareGpu(glm::vec3(0.0f), 32, 2);
