@@ -163,7 +163,59 @@ void SparseVoxelOctree::build(const glm::dvec3& origin, double side, std::vector
     filterAlphaUp();
     for (auto& field : mPayload.fields)
         field.clear();
+    mNodeCells.clear();
+    mGatheredBricks.clear();
+    if (mSettings.cornerBricks) {
+        // Every node's cell and level, top down (a tile's children are tile + octant).
+        mNodeCells.assign(mTopology.child.size(), glm::ivec4(0));
+        for (int level = 0; level < mDepth; ++level)
+            for (const std::uint32_t node : mTopology.levelNodes[std::size_t(level)]) {
+                const std::uint32_t tile = mTopology.child[node];
+                for (int octant = 0; octant < 8; ++octant)
+                    mNodeCells[tile + std::uint32_t(octant)] =
+                        glm::ivec4(glm::ivec3(mNodeCells[node]) * 2 +
+                                       glm::ivec3(octant & 1, (octant >> 1) & 1, octant >> 2),
+                                   level + 1);
+            }
+        makeGatheredBricks();
+    }
     ++mStamp;
+}
+
+template <class T, class Get>
+void SparseVoxelOctree::makeBricks(const Get& get, std::vector<T>& bricks) const
+{
+    // Corner (d) of node cell c is the point between the 8 cells c + d - 1 + o, o in {0, 1}^3:
+    // its value is their mean, an absent cell empty (the trilinear sample of the per-node field
+    // at that point).
+    const std::size_t nodes = mNodeCells.size();
+    bricks.assign(nodes * kFaceCount * 8, T(0.0f));
+    tbb::parallel_for(std::size_t(0), nodes, [&](std::size_t n) {
+        const glm::ivec3 cell(mNodeCells[n]);
+        const int level = mNodeCells[n].w;
+        std::array<std::int64_t, 27> around;
+        for (int k = 0; k < 27; ++k)
+            around[std::size_t(k)] =
+                mTopology.find(level, cell + glm::ivec3(k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1));
+        for (int corner = 0; corner < 8; ++corner) {
+            const glm::ivec3 d(corner & 1, (corner >> 1) & 1, corner >> 2);
+            for (int f = 0; f < kFaceCount; ++f) {
+                T sum(0.0f);
+                for (int o = 0; o < 8; ++o) {
+                    const glm::ivec3 q = d + glm::ivec3(o & 1, (o >> 1) & 1, o >> 2); // in [0, 2]
+                    const std::int64_t e = around[std::size_t(q.x + 3 * q.y + 9 * q.z)];
+                    if (e >= 0)
+                        sum += get(std::size_t(e) * kFaceCount + std::size_t(f));
+                }
+                bricks[(n * kFaceCount + std::size_t(f)) * 8 + std::size_t(corner)] = sum * 0.125f;
+            }
+        }
+    });
+}
+
+void SparseVoxelOctree::makeGatheredBricks()
+{
+    makeBricks<glm::vec4>([this](std::size_t g) { return mPayload.gathered[g]; }, mGatheredBricks);
 }
 
 template <class Get>
@@ -203,8 +255,19 @@ void SparseVoxelOctree::injectLight(const scene::RenderScene& geometry)
     s.bounces = mSettings.bounces;
     s.startOffset = mSettings.injectOffset;
     s.stepScale = mSettings.stepScale;
-    injectLeafLight(geometry, mCones, mLeaves, mTopology.leafNode, s, mPayload, SparseFieldSampler<SparseVoxelOctree>{this},
-                    [this](int field) { filterFieldUp(field); });
+    injectLeafLight(geometry, mCones, mLeaves, mTopology.leafNode, s, mPayload,
+                    SparseFieldSampler<SparseVoxelOctree>{this}, [this](int field) {
+                        filterFieldUp(field);
+                        if (mSettings.cornerBricks) {
+                            const auto& light = mPayload.fields[std::size_t(field)];
+                            makeBricks<glm::vec3>([&light](std::size_t g) { return light[g]; },
+                                                  mFieldBricks[std::size_t(field)]);
+                        }
+                    });
+    for (auto& bricks : mFieldBricks)
+        bricks = {};
+    if (mSettings.cornerBricks)
+        makeGatheredBricks();
     ++mStamp;
 }
 
@@ -223,14 +286,58 @@ bool SparseVoxelOctree::sampleAt(const glm::dvec3& p, double diameter, const glm
     const int m0 = int(std::floor(m));
     const float frac = float(m - m0);
     const auto level = [&](int l, float weight) {
-        sampleSparseLevel<Gathered>([&](const glm::ivec3& c) { return mTopology.find(l, c); }, mOrigin,
-                                    mSide / double(std::int64_t(1) << l), mPayload, p, dir, weight, out);
+        if (mSettings.cornerBricks)
+            sampleBrickLevel<Gathered>(l, p, dir, weight, out);
+        else
+            sampleSparseLevel<Gathered>([&](const glm::ivec3& c) { return mTopology.find(l, c); },
+                                        mOrigin, mSide / double(std::int64_t(1) << l), mPayload, p,
+                                        dir, weight, out);
     };
     level(mDepth - m0, 1.0f - frac);
     if (frac > 0.0f && m0 < mDepth)
         level(mDepth - m0 - 1, frac);
     out.voxelSize = leaf * std::exp2(m);
     return true;
+}
+
+template <bool Gathered>
+void SparseVoxelOctree::sampleBrickLevel(int level, const glm::dvec3& p, const glm::dvec3& dir,
+                                         float weight, ConeSample& out) const
+{
+    const double cells = double(std::int64_t(1) << level);
+    const glm::dvec3 q = (p - mOrigin) / mSide * cells;
+    // p lies in the cube (sampleAt checked): its cell, the last one on the far faces.
+    const glm::ivec3 cell =
+        glm::clamp(glm::ivec3(glm::floor(q)), glm::ivec3(0), glm::ivec3(int(cells) - 1));
+    const glm::dvec3 t = glm::clamp(q - glm::dvec3(cell), 0.0, 1.0);
+    const std::int64_t node = mTopology.find(level, cell);
+    if (node < 0)
+        return; // an empty region
+    float cornerWeight[8];
+    for (int corner = 0; corner < 8; ++corner)
+        cornerWeight[corner] =
+            float(((corner & 1) ? t.x : 1.0 - t.x) * (((corner >> 1) & 1) ? t.y : 1.0 - t.y) *
+                  ((corner >> 2) ? t.z : 1.0 - t.z));
+    for (int a = 0; a < 3; ++a) {
+        const float aw = weight * float(dir[a] * dir[a]);
+        if (aw == 0.0f)
+            continue;
+        const std::size_t brick =
+            (std::size_t(node) * kFaceCount + std::size_t(getFaceSeen(a, dir[a]))) * 8;
+        for (int corner = 0; corner < 8; ++corner) {
+            const float w = aw * cornerWeight[corner];
+            const glm::vec4& v = mGatheredBricks[brick + std::size_t(corner)];
+            out.alpha += w * v.a;
+            if constexpr (Gathered) {
+                out.light[kDirect] += w * glm::vec3(v);
+            } else {
+                for (int field = 0; field < kFieldCount; ++field)
+                    if (!mFieldBricks[std::size_t(field)].empty())
+                        out.light[std::size_t(field)] +=
+                            w * mFieldBricks[std::size_t(field)][brick + std::size_t(corner)];
+            }
+        }
+    }
 }
 
 bool SparseVoxelOctree::sampleFields(const glm::dvec3& p, double diameter, const glm::dvec3& dir,
@@ -274,8 +381,9 @@ void SparseVoxelOctree::gatherRays(const scene::GBuffer& gbuffer, int rays, Imag
 
 std::size_t SparseVoxelOctree::getPayloadBytes() const
 {
-    return mPayload.gathered.size() * sizeof(glm::vec4) + mLeaves.size() * sizeof(OctreeLeaf) +
-           mTopology.leafNode.size() * sizeof(std::uint32_t);
+    return (mPayload.gathered.size() + mGatheredBricks.size()) * sizeof(glm::vec4) +
+           mLeaves.size() * sizeof(OctreeLeaf) + mTopology.leafNode.size() * sizeof(std::uint32_t) +
+           mNodeCells.size() * sizeof(glm::ivec4);
 }
 
 } // namespace rtlab::voxelgi

@@ -14,8 +14,9 @@ struct GatherConstants {
     glm::ivec4 size{0}; // width, height, depth, max steps
     glm::vec4 march{0}; // leaf size, tan(half-angle), start offset, step scale
     glm::vec4 cube{0};  // min corner relative to the centre, side
+    glm::ivec4 mode{0}; // x: 1 = corner bricks
 };
-static_assert(sizeof(GatherConstants) == 48, "must match svo_gather.comp");
+static_assert(sizeof(GatherConstants) == 64, "must match svo_gather.comp");
 
 } // namespace
 
@@ -50,7 +51,9 @@ void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree
     mLastUploadBytes = 0;
     if (mUploadedStamp != tree.getStamp()) {
         const auto& children = tree.getChildPointers();
-        const auto& gathered = tree.getGathered();
+        // With corner bricks the shader reads the bricks instead of the per-node values.
+        const auto& gathered =
+            tree.getSettings().cornerBricks ? tree.getGatheredBricks() : tree.getGathered();
         if (!mChildren.isValid() || mChildren.getSize() < children.size() * sizeof(std::uint32_t))
             mChildren = mDispatch.makeBuffer(children.size() * sizeof(std::uint32_t), "svo.children");
         if (!mGathered.isValid() || mGathered.getSize() < gathered.size() * sizeof(glm::vec4))
@@ -70,6 +73,7 @@ void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree
     constants.march = {float(tree.getLeafSize()), float(tree.getCones().tanHalfAngle),
                        float(s.startOffset), float(s.stepScale)};
     constants.cube = glm::vec4(glm::vec3(tree.getOrigin() - anchor), float(tree.getSide()));
+    constants.mode = glm::ivec4(s.cornerBricks ? 1 : 0, 0, 0, 0);
     mLastGpuMs = mDispatch.run(mChildren, mGathered, gpu::PushConstants(constants), out);
 }
 

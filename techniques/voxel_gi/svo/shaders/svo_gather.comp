@@ -2,7 +2,8 @@
 // The pixel gather of the sparse voxel octree on Vulkan: per G-buffer pixel, the 16 fixed cones
 // above the surface marched front to back through the octree's gathered light, each sample
 // quadrilinear (trilinear at the two levels around the cone footprint, every corner found by a
-// descent from the root through the child pointers); the same algorithm as
+// descent from the root through the child pointers, or with corner bricks one descent per level
+// and the node's brick); the same algorithm as
 // SparseVoxelOctree::gatherCones (sparse_voxel_octree.cpp, cone_tracing.h marchCone), in float.
 // Crassin et al., "Interactive Indirect Illumination Using Voxel Cone Tracing", Pacific Graphics
 // 2011, section 4. Positions are relative to the cube's centre (precision far from the origin).
@@ -10,7 +11,9 @@
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 layout(std430, binding = 0) readonly buffer ChildBuffer { uint children[]; }; // [node]: first child, 0 = none
-// [node * 6 + face]: rgb = gathered light premultiplied by the occupancy, a = occupancy.
+// [node * 6 + face]: rgb = gathered light premultiplied by the occupancy, a = occupancy; with
+// corner bricks (pc.mode.x == 1) [(node * 6 + face) * 8 + corner], corner = x | y << 1 | z << 2:
+// the same at the node's corners (sparse_voxel_octree.h).
 layout(std430, binding = 1) readonly buffer GatheredBuffer { vec4 gathered[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
@@ -21,6 +24,7 @@ layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, depth (levels below the root), max steps
     vec4 march;  // leaf size, tan(half-angle), start offset (leaves), step scale
     vec4 cube;   // xyz: min corner relative to the centre, w: side
+    ivec4 mode;  // x: 1 = corner bricks
 } pc;
 
 // The node of voxel c at `level`, or -1 (outside the lattice or an empty region).
@@ -66,6 +70,36 @@ vec4 sampleLevel(int level, vec3 p, vec3 dir)
     return acc;
 }
 
+// Corner bricks: one descent to the node of `level` holding p, its brick blended trilinearly.
+vec4 sampleBrickLevel(int level, vec3 p, vec3 dir)
+{
+    const int cells = 1 << level;
+    const vec3 q = (p - pc.cube.xyz) / pc.cube.w * float(cells);
+    const ivec3 cell = clamp(ivec3(floor(q)), ivec3(0), ivec3(cells - 1));
+    const vec3 t = clamp(q - vec3(cell), vec3(0.0), vec3(1.0));
+    const int node = findNode(level, cell);
+    if (node < 0)
+        return vec4(0.0);
+    const ivec3 faceSeen = ivec3(0, 2, 4) + ivec3(greaterThan(dir, vec3(0.0)));
+    const vec3 axisWeight = dir * dir;
+    vec4 acc = vec4(0.0);
+    for (int corner = 0; corner < 8; ++corner) {
+        const ivec3 d = ivec3(corner & 1, (corner >> 1) & 1, (corner >> 2) & 1);
+        const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
+        const float w = w3.x * w3.y * w3.z;
+        const uint base = uint(node) * 48u + uint(corner);
+        acc += w * (axisWeight.x * gathered[base + 8u * uint(faceSeen.x)] +
+                    axisWeight.y * gathered[base + 8u * uint(faceSeen.y)] +
+                    axisWeight.z * gathered[base + 8u * uint(faceSeen.z)]);
+    }
+    return acc;
+}
+
+vec4 sampleAt(int level, vec3 p, vec3 dir)
+{
+    return pc.mode.x == 1 ? sampleBrickLevel(level, p, dir) : sampleLevel(level, p, dir);
+}
+
 bool insideCube(vec3 p)
 {
     const vec3 rel = (p - pc.cube.xyz) / pc.cube.w;
@@ -104,9 +138,9 @@ void main()
         const float m = min(float(depth), diameter > leaf ? log2(diameter / leaf) : 0.0);
         const int m0 = int(floor(m));
         const float frac = m - float(m0);
-        vec4 s = (1.0 - frac) * sampleLevel(depth - m0, q, dir);
+        vec4 s = (1.0 - frac) * sampleAt(depth - m0, q, dir);
         if (frac > 0.0 && m0 < depth)
-            s += frac * sampleLevel(depth - m0 - 1, q, dir);
+            s += frac * sampleAt(depth - m0 - 1, q, dir);
         const float voxelSize = leaf * exp2(m);
         const float dt = pc.march.w * voxelSize;
         const float a = clamp(s.a, 0.0, 1.0);
