@@ -184,8 +184,16 @@ public:
             return kAbsent;
         const std::uint32_t root = rx + unsigned(roots.x) * (ry + unsigned(roots.y) * rz);
         // One branch per lookup, not per level: each descent is specialised.
-        if (mNodeMasks == NodeMasks::Shared)
-            return mEveryUpperHasRecord ? descend<true, false>(root, shift, c) : descend<true, true>(root, shift, c);
+        if (mNodeMasks == NodeMasks::Shared) {
+            if (!mEveryUpperHasRecord) {
+                if (shift == 4)
+                    return descend<true, true, 4>(root, shift, c);
+                if (shift == 6)
+                    return descend<true, true, 6>(root, shift, c);
+                return descend<true, true>(root, shift, c);
+            }
+            return descend<true, false>(root, shift, c);
+        }
         return mEveryUpperHasRecord ? descend<false, false>(root, shift, c) : descend<false, true>(root, shift, c);
     }
     //! Every element's cell (xyz) and level (w), in index order (the inverse of find).
@@ -228,9 +236,11 @@ private:
     //! upper-level elements have no record (a dilated tree), so the next record is found through
     //! the upper fields (shared masks) or by rank (inline masks); otherwise record = element
     //! (every upper-level element of an undilated tree has children).
-    template <bool Shared, bool Ranked>
+    template <bool Shared, bool Ranked, int FixedShift = -1>
     std::int64_t descend(std::uint32_t root, int shift, const glm::ivec3& c) const
     {
+        if constexpr (FixedShift >= 0)
+            shift = FixedShift; // a known depth: the loop unrolls, its shifts are constants
         const VoxelTreeNode* nodes = mNodes.data();
         const unsigned char* fields = reinterpret_cast<const unsigned char*>(mRecordBits.data());
         const unsigned char* upperFields =
