@@ -35,65 +35,11 @@ layout(push_constant) uniform Constants {
     ivec4 masks; // x: shared masks' record bits (0: inline), y: first base's uint, z: table's first
 } pc;
 
-// The element at cell c of `level`, or -1 (outside the lattice or an empty region).
+#include "tree_find.glsl"
+
 int findElement(int level, ivec3 c)
 {
-    const int shift = 2 * level;
-    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c >> shift, pc.roots.xyz)))
-        return -1;
-    const ivec3 r = c >> shift;
-    uint index = uint(r.x + pc.roots.x * (r.y + pc.roots.y * r.z));
-    uint record = index; // the dense first level: every root cell has a node record
-    for (int s = shift - 2; s >= 0; s -= 2) {
-        uint lo, hi, offset;
-        if (pc.masks.x == 0) {
-            const uint at = uint(pc.roots.w) + 3u * record;
-            lo = topology[at];
-            hi = topology[at + 1u];
-            offset = topology[at + 2u];
-        } else {
-            // The record's field may straddle two words (the last has a padding word after it).
-            const uint width = uint(pc.masks.x), bit = record * width;
-            const uint first = uint(pc.roots.w) + (bit >> 5u), shift = bit & 31u;
-            uint word = topology[first] >> shift;
-            if (shift + width > 32u)
-                word |= topology[first + 1u] << (32u - shift);
-            word &= width >= 32u ? 0xffffffffu : (1u << width) - 1u;
-            const uint at = uint(pc.masks.z) + 2u * (word >> 12u);
-            lo = topology[at];
-            hi = topology[at + 1u];
-            offset = topology[uint(pc.masks.y) + (record >> 6u)] + (word & 4095u);
-        }
-        const int bit = ((c.x >> s) & 3) | (((c.y >> s) & 3) << 2) | (((c.z >> s) & 3) << 4);
-        uint below;
-        if (bit < 32) {
-            if (((lo >> uint(bit)) & 1u) == 0u)
-                return -1;
-            below = uint(bitCount(lo & ((1u << uint(bit)) - 1u)));
-        } else {
-            const uint b = uint(bit - 32);
-            if (((hi >> b) & 1u) == 0u)
-                return -1;
-            below = uint(bitCount(lo)) + uint(bitCount(hi & ((1u << b) - 1u)));
-        }
-        index = offset + below;
-        if (s > 0) {
-            // The child's node record by rank; an element without one has no children.
-            const uint word = 3u * (index >> 6u), b = index & 63u;
-            const uint rankLo = topology[word], rankHi = topology[word + 1u];
-            record = topology[word + 2u];
-            if (b < 32u) {
-                if (((rankLo >> b) & 1u) == 0u)
-                    return -1;
-                record += uint(bitCount(rankLo & ((1u << b) - 1u)));
-            } else {
-                if (((rankHi >> (b - 32u)) & 1u) == 0u)
-                    return -1;
-                record += uint(bitCount(rankLo)) + uint(bitCount(rankHi & ((1u << (b - 32u)) - 1u)));
-            }
-        }
-    }
-    return int(index);
+    return findTreeElement(level, c, pc.roots, pc.masks);
 }
 
 vec4 sampleLevel(int level, vec3 p, vec3 dir)
