@@ -40,6 +40,11 @@
 #include "voxel_tree.h"          // techniques/voxel_gi/adaptive_voxel_tree
 
 #include "families/voxel_gi/voxelize.h"
+#include "gpu/commands.h"
+#include "gpu/context.h"
+#include "gpu/pipeline.h"
+#include "gpu/resources.h"
+#include "gpu/shader_compiler.h"
 #include "metrics/structure_metrics.h"
 #include "scene/scene.h"
 #include "scene/scene_file.h"
@@ -120,6 +125,16 @@ const Voxels& getVoxels(const std::string& sceneName, int resolution)
 }
 
 // One structure: build from the voxels, its footprint, and a lookup returning the payload (or 0).
+// What a structure's lookup on Vulkan needs: its shader (tests/families/shaders), the topology
+// as 32-bit words, one float of payload per element (the value's x), and its push constants.
+struct GpuLookup {
+    std::string shader;
+    std::vector<std::uint32_t> topology;
+    std::vector<float> payload;
+    std::vector<glm::ivec4> constants; //!< the last one's x, y are set to the count and the level
+    int level = 0;
+};
+
 class Structure {
 public:
     virtual ~Structure() = default;
@@ -133,6 +148,8 @@ public:
     virtual double getMaskFloorBytes() const { return std::nan(""); }
     //! Distinct masks in a shared mask table (NaN: none).
     virtual double getMaskCount() const { return std::nan(""); }
+    //! The structure's lookup on Vulkan, where the technique runs one (none: empty shader).
+    virtual GpuLookup getGpuLookup() const { return {}; }
 };
 
 class DenseGrid final : public Structure {
@@ -235,6 +252,19 @@ public:
         return bits / 8.0;
     }
 
+    GpuLookup getGpuLookup() const override
+    {
+        // The dense first level's roots and the records as the cone gather uploads them.
+        voxelgi::GpuTreeTopology packed = voxelgi::packTopologyForGpu(mTree);
+        GpuLookup g{.shader = "tree_lookup.comp", .topology = std::move(packed.words)};
+        g.payload.resize(mPayload.size());
+        for (std::size_t i = 0; i < mPayload.size(); ++i)
+            g.payload[i] = mPayload[i].x;
+        g.constants = {glm::ivec4(mTree.getLayout().rootCells, int(packed.recordStart)),
+                       packed.masks, glm::ivec4(0)};
+        g.level = mDepth;
+        return g;
+    }
     double getMaskCount() const override
     {
         return mTree.getNodeMasks() == voxelgi::NodeMasks::Shared ? double(mTree.getMaskTable().size())
@@ -275,6 +305,17 @@ public:
             sum += i >= 0 ? mPayload[std::size_t(i)].x : 0.0f;
         }
         return sum;
+    }
+
+    GpuLookup getGpuLookup() const override
+    {
+        GpuLookup g{.shader = "octree_lookup.comp", .topology = mTopology.child};
+        g.payload.resize(mPayload.size());
+        for (std::size_t i = 0; i < mPayload.size(); ++i)
+            g.payload[i] = mPayload[i].x;
+        g.constants = {glm::ivec4(0)};
+        g.level = mTopology.depth;
+        return g;
     }
 
 private:
@@ -432,6 +473,80 @@ void runLookups(benchmark::State& state, const std::string& sceneName, int resol
     setMemoryCounters(state, *s, v);
 }
 
+// Random lookups on Vulkan (lavapipe here): the same shuffled queries, one per invocation, one
+// dispatch per iteration, timed by the wall clock around submit and wait (lavapipe's timestamps
+// are not trustworthy: see the README). The results are checked against the CPU lookups once.
+void runGpuLookups(benchmark::State& state, const std::string& sceneName, int resolution,
+                   const std::string& name)
+{
+    static gpu::Context context;
+    const Voxels& v = getVoxels(sceneName, resolution);
+    auto s = makeStructure(name);
+    s->build(v);
+    GpuLookup g = s->getGpuLookup();
+    const std::vector<glm::ivec3>& q = v.randomOrder;
+    gpu::ShaderCompilerOptions options;
+    options.includeDirs = {
+        gpu::findShaderDir("techniques/voxel_gi/adaptive_voxel_tree_cones/shaders",
+                           RTLAB_TREE_SHADER_DIR),
+        gpu::findShaderDir("techniques/voxel_gi/svo/shaders", RTLAB_SVO_SHADER_DIR)};
+    const gpu::ShaderCompiler compiler(options);
+    gpu::ComputePipelineDesc desc;
+    desc.name = name + ".lookup";
+    desc.spirv =
+        compiler
+            .compileFile(gpu::findShaderDir("tests/families/shaders", RTLAB_BENCHMARK_SHADER_DIR) /
+                         g.shader)
+            .spirv;
+    desc.bindings = {{0, gpu::BindingType::StorageBuffer},
+                     {1, gpu::BindingType::StorageBuffer},
+                     {2, gpu::BindingType::StorageBuffer},
+                     {3, gpu::BindingType::StorageBuffer}};
+    desc.pushConstantSize = std::uint32_t(g.constants.size() * sizeof(glm::ivec4));
+    const gpu::ComputePipeline pipeline = context.createPipeline(desc);
+    g.constants.back() = glm::ivec4(int(q.size()), g.level, 0, 0);
+    std::vector<glm::ivec4> queries(q.size());
+    for (std::size_t i = 0; i < q.size(); ++i)
+        queries[i] = glm::ivec4(q[i], 0);
+    const auto upload = [&](const auto& values, const char* label) {
+        using T = typename std::decay_t<decltype(values)>::value_type;
+        gpu::Buffer b =
+            context.createBuffer({std::max<std::size_t>(values.size(), 1) * sizeof(T), label});
+        b.template uploadSpan<T>(values);
+        return b;
+    };
+    const gpu::Buffer topology = upload(g.topology, "lookup.topology");
+    const gpu::Buffer payload = upload(g.payload, "lookup.payload");
+    const gpu::Buffer queryBuffer = upload(queries, "lookup.queries");
+    const gpu::Buffer results = context.createBuffer({q.size() * sizeof(float), "lookup.results"});
+    const auto dispatch = [&] {
+        context.run([&](gpu::CommandList& cmd) {
+            cmd.dispatch(pipeline,
+                         {gpu::Binding::storageBuffer(0, topology),
+                          gpu::Binding::storageBuffer(1, payload),
+                          gpu::Binding::storageBuffer(2, queryBuffer),
+                          gpu::Binding::storageBuffer(3, results)},
+                         gpu::PushConstants(g.constants.data(), desc.pushConstantSize),
+                         gpu::GroupCount{gpu::computeGroupCount(q.size(), 64)}, "lookup");
+        });
+    };
+    dispatch();
+    const std::vector<float> got = results.downloadVector<float>(q.size());
+    double gpuSum = 0.0;
+    for (float x : got)
+        gpuSum += x;
+    const double cpuSum = s->lookupRandom(q);
+    // The same floats summed in another order: 1e-6 relative.
+    if (std::abs(gpuSum - cpuSum) > 1e-6 * std::abs(cpuSum)) {
+        state.SkipWithError("the Vulkan lookups differ from the CPU lookups");
+        return;
+    }
+    for (auto _ : state)
+        dispatch();
+    state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(q.size()));
+    setMemoryCounters(state, *s, v);
+}
+
 } // namespace
 
 int main(int argc, char** argv)
@@ -475,6 +590,12 @@ int main(int argc, char** argv)
                 ->UseRealTime();
             if (name == "cascades")
                 continue;
+            if (name == "adaptive_voxel_tree" || name == "svo")
+                benchmark::RegisterBenchmark(
+                    (prefix + "/lookup_random_gpu").c_str(),
+                    [=](benchmark::State& s) { runGpuLookups(s, sceneName, r, name); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->UseRealTime();
             for (bool coherent : {false, true})
                 benchmark::RegisterBenchmark(
                     (prefix + (coherent ? "/lookup_coherent" : "/lookup_random")).c_str(),

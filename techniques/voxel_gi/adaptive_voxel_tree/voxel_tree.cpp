@@ -288,6 +288,29 @@ void AdaptiveVoxelTree::shareMasks(std::size_t maxMasks)
     mNodeMasks = NodeMasks::Shared;
 }
 
+GpuTreeTopology packTopologyForGpu(const AdaptiveVoxelTree& tree)
+{
+    GpuTreeTopology out;
+    const auto& ranks = tree.getRanks();
+    out.words.reserve(3 * ranks.size() + tree.getTopologyBytes() / sizeof(std::uint32_t));
+    for (const VoxelTreeRank& r : ranks)
+        out.words.insert(out.words.end(), {r.bitsLo, r.bitsHi, r.base});
+    out.recordStart = std::uint32_t(out.words.size());
+    if (tree.getNodeMasks() == NodeMasks::Inline) {
+        for (const VoxelTreeNode& n : tree.getInlineRecords())
+            out.words.insert(out.words.end(), {n.maskLo, n.maskHi, n.offset});
+        return out;
+    }
+    out.words.insert(out.words.end(), tree.getRecordBits().begin(), tree.getRecordBits().end());
+    const auto baseStart = std::uint32_t(out.words.size());
+    out.words.insert(out.words.end(), tree.getRecordBases().begin(), tree.getRecordBases().end());
+    const auto tableStart = std::uint32_t(out.words.size());
+    for (const std::uint64_t m : tree.getMaskTable())
+        out.words.insert(out.words.end(), {std::uint32_t(m), std::uint32_t(m >> 32)});
+    out.masks = glm::ivec4(int(tree.getRecordWidth()), int(baseStart), int(tableStart), 0);
+    return out;
+}
+
 std::vector<glm::ivec4> AdaptiveVoxelTree::listElementCells() const
 {
     std::vector<glm::ivec4> cells(getElementCount());

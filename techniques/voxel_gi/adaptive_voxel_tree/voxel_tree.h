@@ -331,6 +331,18 @@ private:
     bool mDilated = true;
 };
 
+//! The tree's topology as one buffer of 32-bit words for the Vulkan lookup (shaders of
+//! adaptive_voxel_tree_cones: tree_find.glsl): the rank words (3 words each), then the node
+//! records as the tree holds them: inline (3 words each), or the shared masks' record fields,
+//! their bases and the mask table (2 words per mask).
+struct GpuTreeTopology {
+    std::vector<std::uint32_t> words;
+    std::uint32_t recordStart = 0; //!< the first record's word
+    //! x: the shared masks' record bits (0: inline), y: the first base's word, z: the table's.
+    glm::ivec4 masks{0};
+};
+GpuTreeTopology packTopologyForGpu(const AdaptiveVoxelTree& tree);
+
 //! Where an interpolated value comes from: element indices and weights (summing to 1).
 struct TreeStencil {
     //! Distinct elements: 8 corners, then at most 27 cells per level above (the parent-level

@@ -70,27 +70,11 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
     }
     mLastUploadBytes = 0;
     if (mUploadedStamp != tree.getStamp()) {
-        // One topology buffer: the rank words, then the node records as the tree holds them
-        // (inline masks; or the record words, their bases and the mask table).
-        const auto& ranks = t->getRanks();
-        std::vector<std::uint32_t> topology;
-        topology.reserve(3 * ranks.size() + t->getTopologyBytes() / sizeof(std::uint32_t));
-        for (const VoxelTreeRank& r : ranks)
-            topology.insert(topology.end(), {r.bitsLo, r.bitsHi, r.base});
-        mRecordStart = std::uint32_t(topology.size());
-        if (t->getNodeMasks() == NodeMasks::Inline) {
-            for (const VoxelTreeNode& n : t->getInlineRecords())
-                topology.insert(topology.end(), {n.maskLo, n.maskHi, n.offset});
-            mMasks = glm::ivec4(0);
-        } else {
-            topology.insert(topology.end(), t->getRecordBits().begin(), t->getRecordBits().end());
-            const auto baseStart = std::uint32_t(topology.size());
-            topology.insert(topology.end(), t->getRecordBases().begin(), t->getRecordBases().end());
-            const auto tableStart = std::uint32_t(topology.size());
-            for (const std::uint64_t m : t->getMaskTable())
-                topology.insert(topology.end(), {std::uint32_t(m), std::uint32_t(m >> 32)});
-            mMasks = glm::ivec4(int(t->getRecordWidth()), int(baseStart), int(tableStart), 0);
-        }
+        // One topology buffer: the rank words, then the node records as the tree holds them.
+        GpuTreeTopology packed = packTopologyForGpu(*t);
+        const std::vector<std::uint32_t>& topology = packed.words;
+        mRecordStart = packed.recordStart;
+        mMasks = packed.masks;
         const std::size_t nodeBytes = topology.size() * sizeof(std::uint32_t);
         const auto& gathered = tree.getGathered();
         if (!mNodes.isValid() || mNodes.getSize() < nodeBytes)
