@@ -3,7 +3,10 @@
 // technique made from its own registration function (a technique's test links only itself).
 
 #include "core/error.h"
+#include "core/image.h"
+#include "families/voxel_gi/voxel_gi.h"
 #include "plugin/technique.h"
+#include "scene/gbuffer.h"
 #include "scene/render_scene.h"
 
 #include <glm/vec3.hpp>
@@ -121,6 +124,21 @@ inline std::unique_ptr<plugin::Technique> createTechnique(void (*registerTechniq
     for (const auto& [key, value] : overrides)
         params.set(key, value);
     return entry->create(params);
+}
+
+//! One frame of a voxel_gi technique: voxelize and inject `frame` (its geometry the scene), then
+//! gather at the G-buffer's pixels.
+inline Image<glm::vec3> runVoxelGiFrame(plugin::VoxelGiTechnique& gi,
+                                        const plugin::VoxelGiFrame& frame, const scene::GBuffer& g)
+{
+    gi.voxelize(frame);
+    gi.injectLight(frame);
+    plugin::VoxelGiInput input;
+    input.gbuffer = &g;
+    input.scene = frame.geometry;
+    Image<glm::vec3> e;
+    gi.gather(input, e);
+    return e;
 }
 
 } // namespace rtlab::voxelgi::testing

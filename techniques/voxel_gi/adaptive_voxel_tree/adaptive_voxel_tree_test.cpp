@@ -43,14 +43,7 @@ plugin::VoxelGiFrame frameOf(const scene::RenderScene& s, const std::string& geo
 
 Image<glm::vec3> run(plugin::VoxelGiTechnique& gi, const scene::RenderScene& s, const scene::GBuffer& g)
 {
-    gi.voxelize(frameOf(s));
-    gi.injectLight(frameOf(s));
-    plugin::VoxelGiInput input;
-    input.gbuffer = &g;
-    input.scene = &s;
-    Image<glm::vec3> e;
-    gi.gather(input, e);
-    return e;
+    return runVoxelGiFrame(gi, frameOf(s), g);
 }
 
 scene::RenderScene makeLitRoom()

@@ -38,6 +38,20 @@ plugin::VoxelGiFrame frameOf(const scene::RenderScene& s, const std::string& geo
     return f;
 }
 
+//! The mean red irradiance over the pixels with a surface, and their count.
+double meanOverSurfaces(const Image<glm::vec3>& e, const scene::GBuffer& g, int& n)
+{
+    double sum = 0.0;
+    n = 0;
+    for (int y = 0; y < g.height; ++y)
+        for (int x = 0; x < g.width; ++x)
+            if (g.hasSurface(x, y)) {
+                sum += e.at(x, y).x;
+                ++n;
+            }
+    return n > 0 ? sum / n : 0.0;
+}
+
 scene::Camera lookAt(glm::vec3 position, glm::vec3 target)
 {
     scene::Camera c;
@@ -89,20 +103,14 @@ TEST(Svo, FurnaceMatchesItsClosedFormAtThePixelsAndAlongRays)
     ASSERT_TRUE(gi.traceVoxelRays(input, 64, rays));
     const double expected = glm::pi<double>() * (0.5 + 0.25);
     for (const Image<glm::vec3>* e : {&cones, &rays}) {
-        double sum = 0.0;
         int n = 0;
-        for (int y = 0; y < g.height; ++y)
-            for (int x = 0; x < g.width; ++x)
-                if (g.hasSurface(x, y)) {
-                    sum += e->at(x, y).x;
-                    ++n;
-                }
+        const double mean = meanOverSurfaces(*e, g, n);
         ASSERT_GT(n, 100);
         if (e == &rays) {
-            EXPECT_NEAR(sum / n, expected, 0.035 * expected) << "rays";
+            EXPECT_NEAR(mean, expected, 0.035 * expected) << "rays";
         } else {
-            EXPECT_LT(sum / n, 1.035 * expected) << "cones";
-            EXPECT_GT(sum / n, 0.8 * expected) << "cones";
+            EXPECT_LT(mean, 1.035 * expected) << "cones";
+            EXPECT_GT(mean, 0.8 * expected) << "cones";
         }
     }
     EXPECT_TRUE(gi.definition().surfacesOnly);
@@ -127,24 +135,12 @@ TEST(Svo, CornerBricksKeepTheFurnaceWithinTheFamilysBound)
                                {"inject_offset", 1.0},
                                {"bricks", std::string(bricks ? "corner" : "none")}});
         auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*technique);
-        gi.voxelize(frameOf(s));
-        gi.injectLight(frameOf(s));
-        plugin::VoxelGiInput input;
-        input.gbuffer = &g;
-        input.scene = &s;
-        Image<glm::vec3> cones;
-        gi.gather(input, cones);
-        double sum = 0.0;
+        const Image<glm::vec3> cones = runVoxelGiFrame(gi, frameOf(s), g);
         int n = 0;
-        for (int y = 0; y < g.height; ++y)
-            for (int x = 0; x < g.width; ++x)
-                if (g.hasSurface(x, y)) {
-                    sum += cones.at(x, y).x;
-                    ++n;
-                }
+        const double mean = meanOverSurfaces(cones, g, n);
         ASSERT_GT(n, 100);
-        EXPECT_LT(sum / n, 1.035 * expected) << "bricks " << bricks;
-        EXPECT_GT(sum / n, 0.8 * expected) << "bricks " << bricks;
+        EXPECT_LT(mean, 1.035 * expected) << "bricks " << bricks;
+        EXPECT_GT(mean, 0.8 * expected) << "bricks " << bricks;
         payload[bricks] = gi.memory().payloadBytes;
     }
     EXPECT_GT(payload[1], payload[0]);
