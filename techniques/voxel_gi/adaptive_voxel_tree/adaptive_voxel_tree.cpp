@@ -32,7 +32,8 @@
 //    corners dropped), the comparison the talk makes.
 // Characters and the occlusion family's cone visibilities are not used (the probes are static).
 // The tree as the structure of the 16-cone tracing: technique adaptive_voxel_tree_cones.
-// Not yet: Vulkan lookups.
+// Not yet: this gather on Vulkan (the tree's lookup is there: adaptive_voxel_tree_cones's
+// shaders/tree_find.glsl).
 //
 // Parameters
 // | name          | type  | default      | range / choices     | unit                         |
