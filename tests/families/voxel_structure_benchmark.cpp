@@ -34,7 +34,10 @@
 // mask_floor_B (adaptive_voxel_tree: its child masks at their combinatorial minimum, the part of
 // the topology no code of each node's mask on its own goes below; sharing the masks between
 // nodes does), masks (adaptive_voxel_tree: distinct masks in its table), and items_per_second =
-// lookups per second for the lookup rows (ns per lookup = 1e9 / it).
+// lookups per second for the lookup rows (ns per lookup = 1e9 / it). The lookup_random_gpu rows
+// (adaptive_voxel_tree, svo: the structures whose technique runs on Vulkan) run the random
+// lookups through the cone gathers' Vulkan lookups (tests/families/shaders), one dispatch per
+// iteration, checked against the CPU lookups.
 
 #include "sparse_voxel_octree.h" // techniques/voxel_gi/svo
 #include "voxel_tree.h"          // techniques/voxel_gi/adaptive_voxel_tree
