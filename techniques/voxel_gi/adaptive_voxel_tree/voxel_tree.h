@@ -222,15 +222,20 @@ public:
 private:
     //! Replaces the inline records by shared masks when they need at most maxMasks entries.
     void shareMasks(std::size_t maxMasks);
-    //! Shared masks: record r's bit field (it may straddle two words; the padding words keep the
-    //! second read inside the array).
+    //! The bit field of `mask` bits at bit `bit` of a packed array of 32-bit words: one unaligned
+    //! 8-byte read (width <= 32, shift <= 7; the two padding words keep it inside the array).
+    static std::uint32_t readField(const std::uint32_t* words, std::uint64_t bit,
+                                   std::uint32_t mask)
+    {
+        std::uint64_t bytes;
+        std::memcpy(&bytes, reinterpret_cast<const unsigned char*>(words) + (bit >> 3),
+                    sizeof bytes);
+        return std::uint32_t(bytes >> (bit & 7u)) & mask;
+    }
+    //! Shared masks: record r's bit field.
     std::uint32_t readRecordField(std::size_t r) const
     {
-        const std::uint64_t bit = std::uint64_t(r) * mRecordWidth;
-        const std::size_t word = std::size_t(bit >> 5);
-        const std::uint64_t pair =
-            std::uint64_t(mRecordBits[word]) | (std::uint64_t(mRecordBits[word + 1]) << 32);
-        return std::uint32_t(pair >> (bit & 31u)) & mRecordFieldMask;
+        return readField(mRecordBits.data(), std::uint64_t(r) * mRecordWidth, mRecordFieldMask);
     }
     //! find() below root cell `root`. Shared: the records' masks are in the table. Ranked: some
     //! upper-level elements have no record (a dilated tree), so the next record is found through
@@ -242,21 +247,13 @@ private:
         if constexpr (FixedShift >= 0)
             shift = FixedShift; // a known depth: the loop unrolls, its shifts are constants
         const VoxelTreeNode* nodes = mNodes.data();
-        const unsigned char* fields = reinterpret_cast<const unsigned char*>(mRecordBits.data());
-        const unsigned char* upperFields =
-            reinterpret_cast<const unsigned char*>(mUpperBits.data());
+        const std::uint32_t* fields = mRecordBits.data();
+        const std::uint32_t* upperFields = mUpperBits.data();
         const std::uint32_t* bases = mRecordBases.data();
         const std::uint32_t* upperBases = mUpperBases.data();
         const std::uint64_t* table = mMaskTable.data();
         const std::uint64_t width = mRecordWidth;
         const std::uint32_t fieldMask = mRecordFieldMask;
-        // One unaligned 8-byte read holds a field (width <= 32, shift <= 7; the two padding words
-        // keep it inside the array).
-        const auto readField = [fieldMask](const unsigned char* packed, std::uint64_t bit) {
-            std::uint64_t bytes;
-            std::memcpy(&bytes, packed + (bit >> 3), sizeof bytes);
-            return std::uint32_t(bytes >> (bit & 7u)) & fieldMask;
-        };
         std::uint32_t index = root;
         std::uint32_t record = root; // the dense first level: every root cell has a record
         for (int s = shift - 2; s >= 0; s -= 2) {
@@ -265,7 +262,7 @@ private:
                 if (s > 0) {
                     // Above the target level only the children with a record matter (every
                     // ancestor of an element has children): the next record without the ranks.
-                    const std::uint32_t field = readField(upperFields, record * width);
+                    const std::uint32_t field = readField(upperFields, record * width, fieldMask);
                     const std::uint64_t real = table[field >> kOffsetBits];
                     if (((real >> bit) & 1u) == 0)
                         return kAbsent;
@@ -277,7 +274,7 @@ private:
             std::uint64_t mask;
             std::uint32_t offset;
             if constexpr (Shared) {
-                const std::uint32_t field = readField(fields, record * width);
+                const std::uint32_t field = readField(fields, record * width, fieldMask);
                 mask = table[field >> kOffsetBits];
                 offset = bases[record >> 6] + (field & kOffsetMask);
             } else {
