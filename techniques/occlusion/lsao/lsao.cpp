@@ -101,6 +101,7 @@
 // | radius          | float | 1       | [0, inf)               | world units |
 // | falloff         | enum  | linear  | {linear, smoothstep}   |             |
 // | walls           | bool  | true    |                        |             |
+// | gather          | enum  | nearest | {bilinear, nearest}    |             |
 //
 // Config:
 //   techniques:
@@ -119,6 +120,7 @@ namespace rtlab::occlusion::lsao {
 namespace {
 
 const std::vector<std::string> kFalloffChoices = {"linear", "smoothstep"};
+const std::vector<std::string> kGatherChoices = {"bilinear", "nearest"};
 
 void checkRange(const char* name, double value, double lo, double hi)
 {
@@ -171,6 +173,11 @@ config::ParamSchema Lsao::declareParams()
                    "a wall below each occluder whose foot on the receiver's tangent plane is the "
                    "visible surface: the rays below the occluder meet it at their own distance "
                    "(creases); false: at the occluder's distance, as in the paper");
+    schema.addEnum("gather", "nearest", kGatherChoices,
+                   "per direction, the occluders of the sample nearest to the pixel on the "
+                   "nearest line (nearest, as Quantum Break), or a bilinear blend over the two "
+                   "bracketing lines and the two bracketing samples on each (bilinear, as the "
+                   "paper's gather): four occluder sets instead of one");
     return schema;
 }
 
@@ -191,6 +198,14 @@ Lsao::Lsao(const config::ParamSet& params)
     mParams.interleave = int(params.getInt("interleave"));
     mParams.radius = params.getFloat("radius");
     mParams.walls = params.getBool("walls");
+    const std::string& gather = params.getString("gather");
+    if (gather == kGatherChoices[0])
+        mParams.gather = Gather::Bilinear;
+    else if (gather == kGatherChoices[1])
+        mParams.gather = Gather::Nearest;
+    else
+        throw std::invalid_argument("lsao: gather '" + gather +
+                                    "' is not one of bilinear, nearest");
     const std::string& falloff = params.getString("falloff");
     if (falloff == kFalloffChoices[0])
         mParams.falloff = Falloff::Linear;
@@ -216,6 +231,7 @@ config::ParamSet Lsao::effectiveParams() const
     p.set("radius", mParams.radius);
     p.set("falloff", kFalloffChoices[mParams.falloff == Falloff::Linear ? 0 : 1]);
     p.set("walls", mParams.walls);
+    p.set("gather", kGatherChoices[mParams.gather == Gather::Bilinear ? 0 : 1]);
     return p;
 }
 

@@ -34,6 +34,16 @@ constexpr std::size_t kMaxBatchEntries = std::size_t(16) << 20;
 
 enum class Falloff { Linear, Smoothstep };
 
+//! Which sweep samples a receiver evaluates per direction (Params::gather).
+enum class Gather {
+    //! The two lines that bracket the receiver and the two samples that bracket it on each
+    //! [Timonen 2013: gathering]: up to four occluder sets, weighted bilinearly.
+    Bilinear,
+    //! The nearest line and, on it, the nearest sample [Quantum Break seed: "average distance to
+    //! the nearest step is less than 3 px"]: one occluder set.
+    Nearest,
+};
+
 //! The technique's parameters (lsao.cpp declares them with units and ranges).
 struct Params {
     int directions = 36;      //!< sweep directions over the full circle, [1, 128]
@@ -46,6 +56,7 @@ struct Params {
     double radius = 1.0;      //!< world units: falloff radius
     Falloff falloff = Falloff::Linear;
     bool walls = true; //!< walls below occluders whose foot is the visible surface
+    Gather gather = Gather::Nearest;
 };
 
 //! One direction of the layout, as the shaders read it (std430, 64 bytes).

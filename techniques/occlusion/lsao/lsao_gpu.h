@@ -23,7 +23,7 @@ std::filesystem::path getShaderDir();
 class GpuRunner {
 public:
     //! Compiles the shaders and creates the pipelines on `context`, which must outlive this,
-    //! for the walls and falloff of `params` (every run must have the same: the shaders are
+    //! for the walls, falloff and gather of `params` (every run must have the same: the shaders are
     //! compiled with or without their code).
     explicit GpuRunner(gpu::Context& context, const Params& params = Params{});
 
@@ -51,6 +51,7 @@ private:
     gpu::Context* mContext = nullptr;
     bool mWalls = true;
     Falloff mFalloff = Falloff::Linear;
+    Gather mGatherMode = Gather::Nearest;
     gpu::ComputePipeline mSweep;
     gpu::ComputePipeline mGather;
     gpu::ComputePipeline mResolve;

@@ -110,6 +110,12 @@ TEST_F(LsaoGpu, MatchesTheCpuPathAndTheSweepBuffersAreIdentical)
         {{"interleave", std::int64_t(4)}, {"directions", std::int64_t(20)}},
         {{"walls", false}},
         {{"walls", false}, {"falloff", std::string("smoothstep")}, {"radius", 0.3}},
+        {{"gather", std::string("bilinear")}},
+        {{"gather", std::string("bilinear")}, {"interleave", std::int64_t(1)}},
+        {{"gather", std::string("bilinear")},
+         {"walls", false},
+         {"near_field", false},
+         {"directions", std::int64_t(7)}},
     };
     for (int frame : {0, 3}) {
         for (const Overrides& o : configs) {

@@ -3,7 +3,8 @@
 // discrete choices (sample positions, hull pops, bracketing) are computed into `precise`
 // variables so that no operation is fused or reordered, as in the C++ build (no contraction).
 // Defines: LSAO_HULL_CAPACITY (power of two, = kHullCapacity); LSAO_WALLS (0 or 1,
-// Params::walls) and LSAO_SMOOTHSTEP (0 or 1, Params::falloff): the code of the options not
+// Params::walls), LSAO_SMOOTHSTEP (0 or 1, Params::falloff) and LSAO_GATHER_NEAREST (0 or 1,
+// Params::gather, read by lsao_gather.comp): the code of the options not
 // taken is left out, since lavapipe runs every branch of a shader for every lane.
 #ifndef LSAO_COMMON_GLSL
 #define LSAO_COMMON_GLSL
@@ -75,27 +76,41 @@ uint lsaoClassDirections(uint pixelClass, uint directionCount, int n)
     return directionCount / classes + (pixelClass < directionCount % classes ? 1u : 0u);
 }
 
-// lsao::isSameSurface, operation for operation.
-bool lsaoIsSameSurface(vec2 pixelI, float zi, vec3 ni, vec2 pixelJ, float zj, vec3 nj)
+// lsao::isSameSurface, operation for operation, with the receiver's terms computed once.
+struct SurfaceReceiver {
+    float z;
+    vec3 n;
+    float len; // |n|^2
+    float ux;
+    float uy;
+};
+
+SurfaceReceiver lsaoMakeSurfaceReceiver(vec2 pixelI, float zi, vec3 ni)
 {
-    precise float dn = ni.x * nj.x + ni.y * nj.y + ni.z * nj.z;
     precise float lenI = ni.x * ni.x + ni.y * ni.y + ni.z * ni.z;
+    precise float uxi = zi * ((pixelI.x * pc.invSize.x * 2.0 - 1.0) + pc.projOffset.x);
+    precise float uyi = zi * ((pixelI.y * pc.invSize.y * 2.0 - 1.0) + pc.projOffset.y);
+    return SurfaceReceiver(zi, ni, lenI, uxi, uyi);
+}
+
+bool lsaoIsSameSurface(SurfaceReceiver r, vec2 pixelJ, float zj, vec3 nj)
+{
+    vec3 ni = r.n;
+    precise float dn = ni.x * nj.x + ni.y * nj.y + ni.z * nj.z;
     precise float lenJ = nj.x * nj.x + nj.y * nj.y + nj.z * nj.z;
-    precise float cosBound = 0.81 * (lenI * lenJ);
+    precise float cosBound = 0.81 * (r.len * lenJ);
     precise float dn2 = dn * dn;
     if (!(dn > 0.0) || !(dn2 >= cosBound))
         return false;
-    precise float uxi = zi * ((pixelI.x * pc.invSize.x * 2.0 - 1.0) + pc.projOffset.x);
-    precise float uyi = zi * ((pixelI.y * pc.invSize.y * 2.0 - 1.0) + pc.projOffset.y);
     precise float uxj = zj * ((pixelJ.x * pc.invSize.x * 2.0 - 1.0) + pc.projOffset.x);
     precise float uyj = zj * ((pixelJ.y * pc.invSize.y * 2.0 - 1.0) + pc.projOffset.y);
-    precise float dx = (uxj - uxi) * pc.projScale.y;
-    precise float dy = (uyj - uyi) * pc.projScale.x;
-    precise float dz = (zi - zj) * (pc.projScale.x * pc.projScale.y);
+    precise float dx = (uxj - r.ux) * pc.projScale.y;
+    precise float dy = (uyj - r.uy) * pc.projScale.x;
+    precise float dz = (r.z - zj) * (pc.projScale.x * pc.projScale.y);
     precise float plane = ni.x * dx + ni.y * dy + ni.z * dz;
     precise float separation2 = dx * dx + dy * dy + dz * dz;
     precise float plane2 = plane * plane;
-    precise float bound = 0.015625 * (separation2 * lenI);
+    precise float bound = 0.015625 * (separation2 * r.len);
     return plane2 <= bound;
 }
 

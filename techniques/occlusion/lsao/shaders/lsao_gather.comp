@@ -85,6 +85,55 @@ void lsaoAddScaled(inout Contribution total, float weight, Contribution c)
     total.moment += weight * c.moment;
 }
 
+#if LSAO_GATHER_NEAREST
+// lsao::runGatherCpu's gatherNearest: one occluder set per direction, that of the sample nearest
+// to the receiver on the nearest line [Quantum Break seed: "average distance to the nearest step
+// is less than 3 px"].
+Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
+{
+    Direction d = directions[k];
+    Slice sl = lsaoMakeSlice(x, n, d.axis.xyz);
+    if (!sl.hasHemisphere)
+        return Contribution(0.0, 0.0, vec3(0.0));
+    float minDistance = 1e-4 * length(x);
+
+    precise float cX = p.x * d.perp.x + p.y * d.perp.y;
+    precise float tX = p.x * d.dir.x + p.y * d.dir.y;
+    precise float fl = (cX - d.cMin) * pc.invSpacing;
+    int i0 = clamp(int(floor(fl)), 0, int(d.lineCount) - 2);
+    float f = clamp(fl - float(i0), 0.0, 1.0);
+    precise float fs = (tX - d.tMin) * pc.invStep;
+    int mX = int(floor(fs));
+    uint line = uint(f < 0.5 ? i0 : i0 + 1);
+    float c = lsaoLineOffset(d, line);
+    LineSample atX = lsaoLocateSample(d, k, line, c, mX);
+    bool atXIsLower = atX.t <= tX;
+    LineSample other = lsaoLocateSample(d, k, line, c, atXIsLower ? mX + 1 : mX - 1);
+    LineSample lower = atXIsLower ? atX : other;
+    LineSample upper = atXIsLower ? other : atX;
+    precise float lowerGap = tX - lower.t;
+    precise float upperGap = upper.t - tX;
+    bool useLower = lower.exists && (!upper.exists || lowerGap <= upperGap);
+    LineSample s = useLower ? lower : upper;
+
+    Occluder nearSample = lsaoNoOccluder();
+    if ((pc.flags & LSAO_FLAG_NEAR_FIELD) != 0u) {
+        // [Quantum Break seed] one sample roughly half-way to the nearest upstream sample.
+        precise float gap = lower.exists ? lowerGap : pc.step;
+        precise float delta = max(0.5 * gap, 1.0);
+        precise float qx = p.x - delta * d.dir.x;
+        precise float qy = p.y - delta * d.dir.y;
+        nearSample =
+            lsaoLoadOccluder(ivec2(int(floor(qx)), int(floor(qy))), sl, x, n, minDistance);
+    }
+    uint row = d.base + line * d.stepCount;
+    Occluder dominant = s.exists ? lsaoLoadDominant(d, k, line, c, row, s, sl, x, n, minDistance)
+                                 : lsaoNoOccluder();
+    Occluder self = useLower ? lsaoLoadLineSample(d, c, lower, sl, x, n, minDistance)
+                             : lsaoNoOccluder();
+    return lsaoEvaluateOccluders(sl, dominant, self, nearSample);
+}
+#else
 Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
 {
     Direction d = directions[k];
@@ -185,6 +234,7 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
     }
     return total;
 }
+#endif
 
 void main()
 {

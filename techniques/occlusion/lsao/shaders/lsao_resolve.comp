@@ -16,73 +16,50 @@ layout(set = 0, binding = 5, r32f) uniform readonly image2D accumB;    // visibi
 layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D outA;  // bent normal, aperture
 layout(set = 0, binding = 7, r32f) uniform writeonly image2D outB;     // ambient
 
-// The group's 8x8 pixels and the window's reach around them (at most 1 before and 2 after for
-// interleave <= 4) are loaded once into shared memory: 121 texels instead of 64 x 9 loads.
-#define LSAO_TILE 11
-shared float tileDepth[LSAO_TILE * LSAO_TILE];
-shared vec3 tileNormal[LSAO_TILE * LSAO_TILE];
-shared vec4 tileSumA[LSAO_TILE * LSAO_TILE]; // share * (moment.xyz, obscurance); w < 0: none
-shared float tileSumB[LSAO_TILE * LSAO_TILE]; // share * visibility
-
 void main()
 {
-    ivec2 origin = ivec2(gl_WorkGroupID.xy) * 8 - 1;
-    int n = int(pc.interleave);
-    for (uint i = gl_LocalInvocationIndex; i < LSAO_TILE * LSAO_TILE; i += 64u) {
-        ivec2 q = origin + ivec2(int(i % LSAO_TILE), int(i / LSAO_TILE));
-        float zq = 0.0;
-        vec3 nq = vec3(0.0);
-        vec4 a = vec4(0.0, 0.0, 0.0, -1.0);
-        float b = 0.0;
-        if (q.x >= 0 && q.y >= 0 && q.x < pc.width && q.y < pc.height) {
-            zq = imageLoad(depthImage, q).r;
-            nq = imageLoad(normalImage, q).xyz;
-            if (lsaoHasSurface(zq, nq)) {
-                float share = float(pc.dirCount) /
-                              float(lsaoClassDirections(lsaoPixelClass(q, n), pc.dirCount, n));
-                vec4 sums = imageLoad(accumA, q);
-                a = vec4(share * sums.xyz, share * sums.w);
-                b = share * imageLoad(accumB, q).r;
-            }
-        }
-        tileDepth[i] = zq;
-        tileNormal[i] = nq;
-        tileSumA[i] = a;
-        tileSumB[i] = b;
-    }
-    barrier();
-
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (pixel.x >= pc.width || pixel.y >= pc.height)
         return;
-    ivec2 local = pixel - origin;
-    int centre = local.x + LSAO_TILE * local.y;
-    if (tileSumA[centre].w < 0.0) {
+    int n = int(pc.interleave);
+    float z = imageLoad(depthImage, pixel).r;
+    vec3 nRaw = imageLoad(normalImage, pixel).xyz;
+    if (!lsaoHasSurface(z, nRaw)) {
         imageStore(outA, pixel, vec4(0.0));
         imageStore(outB, pixel, vec4(1.0));
         return;
     }
-    float z = tileDepth[centre];
-    vec3 nRaw = tileNormal[centre];
-    vec2 pi = vec2(pixel) + 0.5;
+    SurfaceReceiver receiver = lsaoMakeSurfaceReceiver(vec2(pixel) + 0.5, z, nRaw);
     int begin = -((n - 1) / 2);
+    // The classes of the window's pixels, from this pixel's, without a division per tap.
+    uint classes = uint(n * n);
+    uint fewer = pc.dirCount / classes;
+    uint extra = pc.dirCount % classes;
+    int cx0 = (pixel.x + begin + n) % n; // pixel.x + begin >= -1
+    int cy0 = (pixel.y + begin + n) % n;
     float obscurance = 0.0;
     float visibility = 0.0;
     float count = 0.0;
     vec3 moment = vec3(0.0);
-    for (int dy = begin; dy < begin + n; ++dy) {
-        for (int dx = begin; dx < begin + n; ++dx) {
-            int j = centre + dx + LSAO_TILE * dy;
-            vec4 a = tileSumA[j];
-            if (a.w < 0.0)
-                continue; // outside the image or no surface
-            if ((dx != 0 || dy != 0) &&
-                !lsaoIsSameSurface(pi, z, nRaw, vec2(pixel + ivec2(dx, dy)) + 0.5, tileDepth[j],
-                                   tileNormal[j]))
+    int cy = cy0;
+    for (int dy = begin; dy < begin + n; ++dy, cy = cy + 1 == n ? 0 : cy + 1) {
+        int cx = cx0;
+        for (int dx = begin; dx < begin + n; ++dx, cx = cx + 1 == n ? 0 : cx + 1) {
+            ivec2 q = pixel + ivec2(dx, dy);
+            if (!(q.x >= 0 && q.y >= 0 && q.x < pc.width && q.y < pc.height))
                 continue;
-            obscurance += a.w;
-            visibility += tileSumB[j];
-            moment += a.xyz;
+            float zq = imageLoad(depthImage, q).r;
+            vec3 nq = imageLoad(normalImage, q).xyz;
+            if (!lsaoHasSurface(zq, nq))
+                continue;
+            if ((dx != 0 || dy != 0) && !lsaoIsSameSurface(receiver, vec2(q) + 0.5, zq, nq))
+                continue;
+            uint pixelClass = uint(cx + n * cy);
+            float share = float(pc.dirCount) / float(fewer + (pixelClass < extra ? 1u : 0u));
+            vec4 sums = imageLoad(accumA, q);
+            obscurance += share * sums.w;
+            visibility += share * imageLoad(accumB, q).r;
+            moment += share * sums.xyz;
             count += 1.0;
         }
     }
