@@ -40,16 +40,20 @@
 //   The stack holds 32 entries as a ring; a push onto a full ring forgets the farthest vertex
 //   (answers are then exact among the retained vertices). Per sample, the stratum index of its
 //   dominant occluder is stored (uint32; no occluder: 0xffffffff).
-// - Pass 2 "lsao.gather", per pixel and direction [Timonen 2013: gathering]: the two lines that
-//   bracket the pixel (weights by distance) and, on each, the two samples that bracket it along
-//   the line (weights by position). Unlike the paper, which interpolates obscurance computed at
-//   the samples, every occluder is re-evaluated from the receiver (its G-buffer point and normal,
-//   as Quantum Break clamps occluders with the pixel's normal): the upstream sample contributes
-//   itself and its dominant occluder, the downstream sample its dominant occluder (which lies at
-//   or before the upstream sample), and both the near-field sample half-way between the receiver
-//   and the upstream sample (at least 1 px) [Quantum Break seed]. Points of neighbouring lines
-//   are moved into the receiver's slice plane along its tangent plane (exact for samples of the
-//   receiver's plane at any incidence); their side (upstream or not) is taken relative to the eye.
+// - Pass 2 "lsao.gather", per pixel and direction. `gather: nearest` (the default) [Quantum
+//   Break seed: "average distance to the nearest step is less than 3 px"]: the line nearest to
+//   the pixel and, on it, the sample nearest to the pixel; `gather: bilinear` [Timonen 2013:
+//   gathering]: the two lines that bracket the pixel (weights by distance) and, on each, the two
+//   samples that bracket it along the line (weights by position), four occluder sets for about
+//   three times the gather's time (experiments/lsao_gather.yaml). Unlike the paper, which
+//   interpolates obscurance computed at the samples, every occluder is re-evaluated from the
+//   receiver (its G-buffer point and normal, as Quantum Break clamps occluders with the pixel's
+//   normal): an upstream sample contributes itself and its dominant occluder, a downstream sample
+//   its dominant occluder (which lies at or before the upstream sample), and both the near-field
+//   sample half-way between the receiver and the upstream sample of the line (at least 1 px)
+//   [Quantum Break seed]. Points of neighbouring lines are moved into the receiver's slice plane
+//   along its tangent plane (exact for samples of the receiver's plane at any incidence); their
+//   side (upstream or not) is taken relative to the eye.
 // - Per half-slice (w(theta) = cos(theta) v + sin(theta) t, theta from the view vector v toward
 //   the upstream side t): up to three occluders at angles theta_i with distances d_i; each blocks
 //   the rays from theta_i down to the tangent plane, and a ray is weighted 1 - rho(d/r) with d the

@@ -127,13 +127,18 @@ uint lsaoMixHash(uint h, uint value)
     return h;
 }
 
-float lsaoStepJitter(uint direction, uint line, uint stepIndex)
+// The first two rounds of lsao::computeStepJitter's hash, which depend on the line only: computed
+// once per line, the same integers.
+uint lsaoLineHash(uint direction, uint line)
+{
+    return lsaoMixHash(lsaoMixHash(0x4c53414fu, direction), line);
+}
+
+float lsaoStepJitter(uint lineHash, uint stepIndex)
 {
     if ((pc.flags & LSAO_FLAG_JITTER) == 0u)
         return 0.5;
-    uint h = lsaoMixHash(0x4c53414fu, direction);
-    h = lsaoMixHash(h, line);
-    h = lsaoMixHash(h, stepIndex);
+    uint h = lsaoMixHash(lineHash, stepIndex);
     h = lsaoMixHash(h, pc.setIndex);
     return float(h >> 8) * (1.0 / 16777216.0);
 }
@@ -151,7 +156,7 @@ struct LineSample {
     ivec2 pixel;
 };
 
-LineSample lsaoLocateSample(Direction d, uint k, uint line, float c, int stratum)
+LineSample lsaoLocateSample(Direction d, uint lineHash, float c, int stratum)
 {
     LineSample s;
     s.exists = false;
@@ -160,7 +165,7 @@ LineSample lsaoLocateSample(Direction d, uint k, uint line, float c, int stratum
     s.pixel = ivec2(-1);
     if (stratum < 0 || stratum >= int(d.stepCount))
         return s;
-    float xi = lsaoStepJitter(k, line, uint(stratum));
+    float xi = lsaoStepJitter(lineHash, uint(stratum));
     precise float t = d.tMin + (float(stratum) + xi) * pc.step;
     precise float px = t * d.dir.x + c * d.perp.x;
     precise float py = t * d.dir.y + c * d.perp.y;

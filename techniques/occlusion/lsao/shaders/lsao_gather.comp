@@ -68,13 +68,13 @@ Occluder lsaoLoadLineSample(Direction d, float c, LineSample ls, Slice sl, vec3 
     return o;
 }
 
-Occluder lsaoLoadDominant(Direction d, uint k, uint line, float c, uint row, LineSample ls,
+Occluder lsaoLoadDominant(Direction d, uint lineHash, float c, uint row, LineSample ls,
                           Slice sl, vec3 x, vec3 n, float minDistance)
 {
     uint id = sweep[row + uint(ls.stratum)];
     if (id == LSAO_NO_OCCLUDER)
         return lsaoNoOccluder();
-    LineSample s = lsaoLocateSample(d, k, line, c, int(id));
+    LineSample s = lsaoLocateSample(d, lineHash, c, int(id));
     return lsaoLoadLineSample(d, c, s, sl, x, n, minDistance);
 }
 
@@ -105,10 +105,11 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
     precise float fs = (tX - d.tMin) * pc.invStep;
     int mX = int(floor(fs));
     uint line = uint(f < 0.5 ? i0 : i0 + 1);
+    uint lineHash = lsaoLineHash(k, line);
     float c = lsaoLineOffset(d, line);
-    LineSample atX = lsaoLocateSample(d, k, line, c, mX);
+    LineSample atX = lsaoLocateSample(d, lineHash, c, mX);
     bool atXIsLower = atX.t <= tX;
-    LineSample other = lsaoLocateSample(d, k, line, c, atXIsLower ? mX + 1 : mX - 1);
+    LineSample other = lsaoLocateSample(d, lineHash, c, atXIsLower ? mX + 1 : mX - 1);
     LineSample lower = atXIsLower ? atX : other;
     LineSample upper = atXIsLower ? other : atX;
     precise float lowerGap = tX - lower.t;
@@ -127,7 +128,7 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
             lsaoLoadOccluder(ivec2(int(floor(qx)), int(floor(qy))), sl, x, n, minDistance);
     }
     uint row = d.base + line * d.stepCount;
-    Occluder dominant = s.exists ? lsaoLoadDominant(d, k, line, c, row, s, sl, x, n, minDistance)
+    Occluder dominant = s.exists ? lsaoLoadDominant(d, lineHash, c, row, s, sl, x, n, minDistance)
                                  : lsaoNoOccluder();
     Occluder self = useLower ? lsaoLoadLineSample(d, c, lower, sl, x, n, minDistance)
                              : lsaoNoOccluder();
@@ -156,13 +157,14 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
     precise float gap = 0.0;
     for (int j = 0; j < 2; ++j) {
         uint line = uint(i0 + j);
+        uint lineHash = lsaoLineHash(k, line);
         float c = lsaoLineOffset(d, line);
-        LineSample atX = lsaoLocateSample(d, k, line, c, mX);
+        LineSample atX = lsaoLocateSample(d, lineHash, c, mX);
         if (atX.t <= tX) {
             lower[j] = atX;
-            upper[j] = lsaoLocateSample(d, k, line, c, mX + 1);
+            upper[j] = lsaoLocateSample(d, lineHash, c, mX + 1);
         } else {
-            lower[j] = lsaoLocateSample(d, k, line, c, mX - 1);
+            lower[j] = lsaoLocateSample(d, lineHash, c, mX - 1);
             upper[j] = atX;
         }
         precise float lineGap = lower[j].exists ? tX - lower[j].t : pc.step;
@@ -181,6 +183,7 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
 
     for (int j = 0; j < 2; ++j) {
         uint line = uint(i0 + j);
+        uint lineHash = lsaoLineHash(k, line);
         float c = lsaoLineOffset(d, line);
         float lineWeight = j == 0 ? 1.0 - f : f;
         uint row = d.base + line * d.stepCount;
@@ -204,7 +207,7 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         Occluder self = none;
         Occluder dominant = none;
         if (wLower > 0.0) {
-            lowerDominant = lsaoLoadDominant(d, k, line, c, row, lower[j], sl, x, n, minDistance);
+            lowerDominant = lsaoLoadDominant(d, lineHash, c, row, lower[j], sl, x, n, minDistance);
             self = lsaoLoadLineSample(d, c, lower[j], sl, x, n, minDistance);
         }
         if (wUpper > 0.0) {
@@ -214,7 +217,7 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
             else if (wLower > 0.0 && id == lowerId)
                 dominant = lowerDominant;
             else
-                dominant = lsaoLoadDominant(d, k, line, c, row, upper[j], sl, x, n, minDistance);
+                dominant = lsaoLoadDominant(d, lineHash, c, row, upper[j], sl, x, n, minDistance);
         }
         // The upstream sample's occluders (or, where the line has no sample around the pixel,
         // the near-field sample alone: wNear > 0 only where wLower = wUpper = 0), then the

@@ -26,6 +26,7 @@ void main()
         return;
     float c = lsaoLineOffset(d, line);
     uint row = d.base + line * d.stepCount;
+    uint lineHash = lsaoLineHash(k, line);
 
     float hullT[LSAO_HULL_CAPACITY];
     vec2 hullHeight[LSAO_HULL_CAPACITY];
@@ -33,7 +34,7 @@ void main()
     int top = -1;
     int size = 0;
     for (uint m = 0u; m < d.stepCount; ++m) {
-        LineSample s = lsaoLocateSample(d, k, line, c, int(m));
+        LineSample s = lsaoLocateSample(d, lineHash, c, int(m));
         float z = s.exists ? lsaoLoadDepth(s.pixel) : 0.0;
         uint result = LSAO_NO_OCCLUDER;
         if (z != 0.0) {
