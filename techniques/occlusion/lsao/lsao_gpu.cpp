@@ -29,7 +29,9 @@ gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderComp
         {"LSAO_HULL_CAPACITY", std::to_string(kHullCapacity)},
         {"LSAO_WALLS", params.walls ? "1" : "0"},
         {"LSAO_SMOOTHSTEP", params.falloff == Falloff::Smoothstep ? "1" : "0"},
-        {"LSAO_GATHER_NEAREST", params.gather == Gather::Nearest ? "1" : "0"}};
+        {"LSAO_GATHER_NEAREST", params.gather == Gather::Nearest ? "1" : "0"},
+        {"LSAO_INTERLEAVE",
+         std::to_string(computeEffectiveInterleave(params.interleave, params.directions))}};
     gpu::ComputePipelineDesc desc;
     desc.name = name;
     desc.spirv = compiler.compileFile(getShaderDir() / file, defines).spirv;
@@ -41,7 +43,9 @@ gpu::ComputePipeline createPipeline(gpu::Context& context, const gpu::ShaderComp
 } // namespace
 
 GpuRunner::GpuRunner(gpu::Context& context, const Params& params)
-    : mContext(&context), mWalls(params.walls), mFalloff(params.falloff), mGatherMode(params.gather)
+    : mContext(&context), mWalls(params.walls), mFalloff(params.falloff),
+      mGatherMode(params.gather),
+      mInterleave(computeEffectiveInterleave(params.interleave, params.directions))
 {
     gpu::ShaderCompilerOptions options;
     options.includeDirs = {getShaderDir(), render::getRenderShaderDir()};
@@ -110,9 +114,10 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
-    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode)
+    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode ||
+        layout.interleave != mInterleave)
         throw std::invalid_argument(
-            "lsao: the shaders were compiled for other walls, falloff or gather");
+            "lsao: the shaders were compiled for other walls, falloff, gather or interleave");
     prepare(layout);
     const int w = layout.width, h = layout.height;
     const std::size_t count = std::size_t(w) * std::size_t(h);
@@ -132,9 +137,10 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const gpu::Image& depth, const gpu::Image& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
-    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode)
+    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode ||
+        layout.interleave != mInterleave)
         throw std::invalid_argument(
-            "lsao: the shaders were compiled for other walls, falloff or gather");
+            "lsao: the shaders were compiled for other walls, falloff, gather or interleave");
     prepare(layout);
     const int w = layout.width, h = layout.height;
     mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));

@@ -23,8 +23,8 @@ std::filesystem::path getShaderDir();
 class GpuRunner {
 public:
     //! Compiles the shaders and creates the pipelines on `context`, which must outlive this,
-    //! for the walls, falloff and gather of `params` (every run must have the same: the shaders are
-    //! compiled with or without their code).
+    //! for the walls, falloff, gather and interleave of `params` (every run must have the same: the
+    //! shaders are compiled with or without their code).
     explicit GpuRunner(gpu::Context& context, const Params& params = Params{});
 
     gpu::Context& getContext() const { return *mContext; }
@@ -52,6 +52,7 @@ private:
     bool mWalls = true;
     Falloff mFalloff = Falloff::Linear;
     Gather mGatherMode = Gather::Nearest;
+    int mInterleave = 1; //!< Layout::interleave the resolve was compiled for
     gpu::ComputePipeline mSweep;
     gpu::ComputePipeline mGather;
     gpu::ComputePipeline mResolve;

@@ -4,8 +4,9 @@
 // variables so that no operation is fused or reordered, as in the C++ build (no contraction).
 // Defines: LSAO_HULL_CAPACITY (power of two, = kHullCapacity); LSAO_WALLS (0 or 1,
 // Params::walls), LSAO_SMOOTHSTEP (0 or 1, Params::falloff) and LSAO_GATHER_NEAREST (0 or 1,
-// Params::gather, read by lsao_gather.comp): the code of the options not
-// taken is left out, since lavapipe runs every branch of a shader for every lane.
+// Params::gather, read by lsao_gather.comp): the code of the options not taken is left out,
+// since lavapipe runs every branch of a shader for every lane; LSAO_INTERLEAVE
+// (Layout::interleave, read by lsao_resolve.comp), so that the resolve's window loops unroll.
 #ifndef LSAO_COMMON_GLSL
 #define LSAO_COMMON_GLSL
 

@@ -21,7 +21,8 @@ void main()
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (pixel.x >= pc.width || pixel.y >= pc.height)
         return;
-    int n = int(pc.interleave);
+    // LSAO_INTERLEAVE: Layout::interleave, a constant so that the window's loops unroll.
+    const int n = LSAO_INTERLEAVE;
     float z = imageLoad(depthImage, pixel).r;
     vec3 nRaw = imageLoad(normalImage, pixel).xyz;
     if (!lsaoHasSurface(z, nRaw)) {
@@ -33,8 +34,10 @@ void main()
     int begin = -((n - 1) / 2);
     // The classes of the window's pixels, from this pixel's, without a division per tap.
     uint classes = uint(n * n);
-    uint fewer = pc.dirCount / classes;
     uint extra = pc.dirCount % classes;
+    // A class holds dirCount / classes directions, one more below `extra`.
+    float shareFewer = float(pc.dirCount) / float(pc.dirCount / classes);
+    float shareMore = float(pc.dirCount) / float(pc.dirCount / classes + 1u);
     int cx0 = (pixel.x + begin + n) % n; // pixel.x + begin >= -1
     int cy0 = (pixel.y + begin + n) % n;
     float obscurance = 0.0;
@@ -55,7 +58,7 @@ void main()
             if ((dx != 0 || dy != 0) && !lsaoIsSameSurface(receiver, vec2(q) + 0.5, zq, nq))
                 continue;
             uint pixelClass = uint(cx + n * cy);
-            float share = float(pc.dirCount) / float(fewer + (pixelClass < extra ? 1u : 0u));
+            float share = pixelClass < extra ? shareMore : shareFewer;
             vec4 sums = imageLoad(accumA, q);
             obscurance += share * sums.w;
             visibility += share * imageLoad(accumB, q).r;
