@@ -85,8 +85,13 @@ std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfaceP
                                      const PixelSequence& sequence, std::uint32_t first,
                                      std::uint32_t count, SampleValue* values);
 //! direct, indirect, full: E/pi per colour (before albedo). Returns the number of rays traced.
+//! `streams` (optional): sequence.getStream(p) for the pairs p < streamCount, which a batch of
+//! the pixel's samples computes once; the samples are the same bits either way.
 std::uint32_t evaluateLightSample(const TraceContext& context, const SurfacePoint& point,
                                   const PixelSequence& sequence, std::uint32_t index,
-                                  SampleValue& value);
+                                  SampleValue& value, const SobolStream* streams = nullptr,
+                                  std::uint32_t streamCount = 0);
+//! The pairs of the first vertices of a path, whose streams a batch computes once.
+constexpr std::uint32_t kLightStreamsPerBatch = 24;
 
 } // namespace rtlab::reference

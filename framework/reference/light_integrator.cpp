@@ -45,9 +45,10 @@ struct Vertex {
 
 class LightPathTracer {
 public:
-    LightPathTracer(const TraceContext& context, const PixelSequence& sequence, std::uint32_t index)
+    LightPathTracer(const TraceContext& context, const PixelSequence& sequence, std::uint32_t index,
+                    const SobolStream* streams, std::uint32_t streamCount)
         : mContext(context), mLights(*context.lights), mEmbree(*context.embree),
-          mSequence(sequence), mIndex(index)
+          mSequence(sequence), mStreams(streams), mStreamCount(streamCount), mIndex(index)
     {
     }
 
@@ -57,7 +58,9 @@ public:
 private:
     glm::dvec2 get2D(int vertex, std::uint32_t pair) const
     {
-        return mSequence.get2D(mIndex, std::uint32_t(vertex) * kPairsPerVertex + pair);
+        const std::uint32_t dimensionPair = std::uint32_t(vertex) * kPairsPerVertex + pair;
+        return dimensionPair < mStreamCount ? PixelSequence::get2D(mStreams[dimensionPair], mIndex)
+                                            : mSequence.get2D(mIndex, dimensionPair);
     }
     bool isVisible(const glm::vec3& origin, const glm::dvec3& direction, double distance)
     {
@@ -76,6 +79,8 @@ private:
     const SceneLights& mLights;
     const EmbreeScene& mEmbree;
     const PixelSequence& mSequence;
+    const SobolStream* mStreams; //!< mSequence.getStream(p) for p < mStreamCount
+    std::uint32_t mStreamCount;
     std::uint32_t mIndex;
     std::uint32_t mRays = 0;
 };
@@ -237,9 +242,10 @@ glm::dvec3 LightPathTracer::trace(const SurfacePoint& point)
 
 std::uint32_t evaluateLightSample(const TraceContext& context, const SurfacePoint& point,
                                   const PixelSequence& sequence, std::uint32_t index,
-                                  SampleValue& value)
+                                  SampleValue& value, const SobolStream* streams,
+                                  std::uint32_t streamCount)
 {
-    LightPathTracer tracer(context, sequence, index);
+    LightPathTracer tracer(context, sequence, index, streams, streamCount);
     const glm::dvec3 e = tracer.trace(point);
     value[0] = e.x;
     value[1] = e.y;

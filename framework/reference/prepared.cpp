@@ -4,6 +4,7 @@
 
 #include <glm/geometric.hpp>
 
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -123,9 +124,14 @@ std::uint32_t PreparedReference::evaluateBatch(std::size_t pixel, std::uint32_t 
     case Quantity::Direct:
     case Quantity::Indirect:
     case Quantity::Full: {
+        // The first vertices' stream hashes once for the batch, not once per sample.
+        std::array<SobolStream, kLightStreamsPerBatch> streams;
+        for (std::uint32_t p = 0; p < kLightStreamsPerBatch; ++p)
+            streams[p] = sequence.getStream(p);
         std::uint32_t rays = 0;
         for (std::uint32_t i = 0; i < count; ++i)
-            rays += evaluateLightSample(mContext, mPoints[pixel], sequence, first + i, values[i]);
+            rays += evaluateLightSample(mContext, mPoints[pixel], sequence, first + i, values[i],
+                                        streams.data(), kLightStreamsPerBatch);
         return rays;
     }
     default:

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 namespace rtlab::reference {
@@ -170,14 +171,31 @@ DiscreteDistribution::DiscreteDistribution(const std::vector<double>& weights)
     // Exact end, and zero-width intervals at the end must not catch rounding: pin them to 1.
     for (std::size_t i = weights.size(); i > 0 && (i == weights.size() || mPmf[i] == 0.0); --i)
         mCdf[i] = 1.0;
+    if (weights.size() > std::numeric_limits<std::uint32_t>::max())
+        throw Error("discrete distribution: more than 2^32 - 1 weights");
+    mGuide.resize(weights.size());
+    std::size_t i = 0;
+    for (std::size_t b = 0; b < mGuide.size(); ++b) {
+        const double u = double(b) / double(mGuide.size());
+        while (i < mPmf.size() && mCdf[i + 1] <= u)
+            ++i;
+        mGuide[b] = std::uint32_t(i);
+    }
 }
 
 std::size_t DiscreteDistribution::sample(double u, double* uRemapped) const
 {
-    // First interval [cdf[i], cdf[i+1]) containing u; zero-width intervals are never chosen.
-    const auto it = std::upper_bound(mCdf.begin() + 1, mCdf.end(), u);
-    std::size_t i = std::size_t(it - (mCdf.begin() + 1));
-    i = std::min(i, mPmf.size() - 1);
+    // The number of cdf[1..n] at or below u: the first interval [cdf[i], cdf[i+1]) containing u,
+    // zero-width intervals never chosen. The guide table's entry is that count for the bucket's
+    // lower end; the walk down covers a product u * n rounded up into the next bucket.
+    const std::size_t n = mPmf.size();
+    const double scaled = u * double(n);
+    std::size_t i = scaled >= 0.0 ? mGuide[std::min(std::size_t(scaled), n - 1)] : 0;
+    while (i > 0 && mCdf[i] > u)
+        --i;
+    while (i < n && mCdf[i + 1] <= u)
+        ++i;
+    i = std::min(i, n - 1);
     if (uRemapped)
         *uRemapped = std::clamp((u - mCdf[i]) / mPmf[i], 0.0, 0x1.fffffffffffffp-1);
     return i;

@@ -10,6 +10,7 @@
 #include <glm/vec3.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace rtlab::reference {
@@ -78,6 +79,9 @@ public:
 private:
     std::vector<double> mPmf;
     std::vector<double> mCdf; //!< mCdf[i] = sum of pmf below i; size() + 1 entries
+    //! mGuide[b]: the interval of u = b / mGuide.size() (a guide table [Chen & Asau 1974]): the
+    //! search starts there and walks a step or two, the same index as a binary search.
+    std::vector<std::uint32_t> mGuide;
     double mTotal = 0.0;
 };
 

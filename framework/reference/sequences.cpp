@@ -130,19 +130,31 @@ PixelSequence::PixelSequence(std::uint64_t seed, std::uint64_t pixelIndex)
 {
 }
 
+SobolStream PixelSequence::getStream(std::uint32_t dimensionPair) const
+{
+    // sampleScrambledSobol2D's two hashes of the pair's stream seed.
+    SobolStream stream;
+    stream.h0 = mixBits64(mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
+    stream.h1 = mixBits64(stream.h0 ^ 0x9e3779b97f4a7c15ull);
+    return stream;
+}
+
+glm::dvec2 PixelSequence::get2D(const SobolStream& stream, std::uint32_t sampleIndex)
+{
+    return sampleScrambledSobol2DHashed(sampleIndex, stream.h0, stream.h1);
+}
+
 glm::dvec2 PixelSequence::get2D(std::uint32_t sampleIndex, std::uint32_t dimensionPair) const
 {
-    return sampleScrambledSobol2D(sampleIndex,
-                                  mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
+    return get2D(getStream(dimensionPair), sampleIndex);
 }
 
 void PixelSequence::get2D(std::uint32_t first, std::uint32_t count, std::uint32_t dimensionPair,
                           glm::dvec2* out) const
 {
-    const std::uint64_t h0 = mixBits64(mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
-    const std::uint64_t h1 = mixBits64(h0 ^ 0x9e3779b97f4a7c15ull);
+    const SobolStream stream = getStream(dimensionPair);
     for (std::uint32_t i = 0; i < count; ++i)
-        out[i] = sampleScrambledSobol2DHashed(first + i, h0, h1);
+        out[i] = sampleScrambledSobol2DHashed(first + i, stream.h0, stream.h1);
 }
 
 } // namespace rtlab::reference

@@ -26,11 +26,21 @@ double toUnitInterval(std::uint32_t x);
 //! The shuffled, scrambled 2D Sobol point `index` for one stream seed.
 glm::dvec2 sampleScrambledSobol2D(std::uint32_t index, std::uint64_t streamSeed);
 
+//! The two hashes that seed one dimension pair of one pixel's sequence.
+struct SobolStream {
+    std::uint64_t h0 = 0;
+    std::uint64_t h1 = 0;
+};
+
 //! The samples of one pixel: pair `dimensionPair` of sample `sampleIndex`.
 class PixelSequence {
 public:
     PixelSequence(std::uint64_t seed, std::uint64_t pixelIndex);
     glm::dvec2 get2D(std::uint32_t sampleIndex, std::uint32_t dimensionPair) const;
+    //! The hashes of pair `dimensionPair`, for a caller that draws many samples of it.
+    SobolStream getStream(std::uint32_t dimensionPair) const;
+    //! Sample `sampleIndex` of a stream: get2D(sampleIndex, pair) with stream = getStream(pair).
+    static glm::dvec2 get2D(const SobolStream& stream, std::uint32_t sampleIndex);
     //! Samples first .. first + count - 1 of one dimension pair into out[0 .. count - 1].
     void get2D(std::uint32_t first, std::uint32_t count, std::uint32_t dimensionPair, glm::dvec2* out) const;
 

@@ -378,5 +378,79 @@ TEST(ReferenceSamplers, DiscreteDistributionRejectsNegativeWeights)
     EXPECT_TRUE(DiscreteDistribution({0.0, 0.0}).empty());
 }
 
+//! The index a binary search over the cumulative sums picks, the sums formed as the distribution
+//! forms them (its pinned ends included): the definition the guide table must reproduce.
+std::size_t pickByBinarySearch(const std::vector<double>& weights, double u)
+{
+    double total = 0.0;
+    for (double w : weights)
+        total += w;
+    std::vector<double> cdf(weights.size() + 1, 0.0);
+    double sum = 0.0;
+    for (std::size_t i = 0; i < weights.size(); ++i) {
+        sum += weights[i];
+        cdf[i + 1] = sum / total;
+    }
+    for (std::size_t i = weights.size();
+         i > 0 && (i == weights.size() || weights[i] / total == 0.0); --i)
+        cdf[i] = 1.0;
+    const auto it = std::upper_bound(cdf.begin() + 1, cdf.end(), u);
+    return std::min(std::size_t(it - (cdf.begin() + 1)), weights.size() - 1);
+}
+
+TEST(ReferenceSamplers, DiscreteDistributionGuideTablePicksWhatABinarySearchPicks)
+{
+    std::mt19937_64 rng(17);
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    std::vector<std::vector<double>> cases = {{1.0},
+                                              {1.0, 1.0, 1.0, 1.0, 1.0, 1.0, 1.0},
+                                              {0.0, 0.0, 5.0, 0.0},
+                                              {3.0, 0.0, 0.0},
+                                              {1e-300, 1.0, 1e-300},
+                                              {1e6, 1e-9, 1e-9, 1e-9, 1e6}};
+    std::vector<double> random(1000);
+    for (double& w : random)
+        w = uniform(rng) < 0.3 ? 0.0 : std::pow(uniform(rng), 4.0);
+    cases.push_back(random);
+    std::vector<double> skewed(257, 1e-6);
+    skewed[100] = 1.0;
+    cases.push_back(skewed);
+    int checked = 0;
+    for (const std::vector<double>& weights : cases) {
+        const DiscreteDistribution d(weights);
+        std::vector<double> us;
+        for (int i = 0; i < 2000; ++i)
+            us.push_back(uniform(rng));
+        // Bucket ends and the cumulative sums, with their neighbours: where a rounded u * n or a
+        // walk of the wrong length would show.
+        const double n = double(weights.size());
+        double sum = 0.0, total = 0.0;
+        for (double w : weights)
+            total += w;
+        for (std::size_t b = 0; b <= weights.size(); ++b) {
+            const double edge = double(b) / n;
+            const double cdf = sum / total;
+            for (double v : {edge, cdf})
+                for (double x : {std::nextafter(v, -1.0), v, std::nextafter(v, 2.0)})
+                    if (x >= 0.0 && x < 1.0)
+                        us.push_back(x);
+            if (b < weights.size())
+                sum += weights[b];
+        }
+        us.push_back(0.0);
+        us.push_back(0x1.fffffffffffffp-1);
+        for (double u : us) {
+            const std::size_t expected = pickByBinarySearch(weights, u);
+            double remapped = -1.0;
+            ASSERT_EQ(d.sample(u, &remapped), expected)
+                << "u " << u << ", " << weights.size() << " weights";
+            EXPECT_GT(d.pmf(expected), 0.0) << "u " << u;
+            EXPECT_TRUE(remapped >= 0.0 && remapped < 1.0) << "u " << u;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 16000);
+}
+
 } // namespace
 } // namespace rtlab::reference
