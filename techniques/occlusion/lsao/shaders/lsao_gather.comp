@@ -1,10 +1,12 @@
 // Pass 2 "lsao.gather" of Line-Sweep Ambient Obscurance [Timonen 2013: gathering]: one invocation
-// per pixel. For each direction of the batch it interpolates bilinearly between the samples of the
-// two lines that bracket the pixel and the two samples that bracket it along each line, each
-// sample's dominant occluder seen from the pixel itself with its normal, plus one near-field
-// sample [Quantum Break seed], and adds the half-slice contributions to the accumulators.
-// Each pixel takes the directions of its class (k mod interleave^2, [Quantum Break seed]);
-// lsao_resolve.comp turns the sums into the outputs. The twin of lsao::runGatherCpu.
+// per pixel. For each direction of the batch it takes the occluders of the sweep sample nearest to
+// the pixel on the nearest line (LSAO_GATHER_NEAREST, [Quantum Break seed]) or interpolates
+// bilinearly between the samples of the two lines that bracket the pixel and the two samples that
+// bracket it along each line; each sample's dominant occluder is seen from the pixel itself with
+// its normal, with one near-field sample [Quantum Break seed], and the half-slice contributions
+// are added to the accumulators. Each pixel takes the directions of its class (k mod
+// interleave^2, [Quantum Break seed]); lsao_resolve.comp turns the sums into the outputs. The twin
+// of lsao::runGatherCpu.
 #version 450
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
