@@ -134,6 +134,20 @@ void checkRange(const char* name, double value, double lo, double hi)
                                     std::to_string(hi) + "]");
 }
 
+//! The index of `value` among an enum parameter's choices; throws naming them otherwise.
+std::size_t findChoice(const char* name, const std::string& value,
+                       const std::vector<std::string>& choices)
+{
+    for (std::size_t i = 0; i < choices.size(); ++i)
+        if (value == choices[i])
+            return i;
+    std::string list;
+    for (const std::string& c : choices)
+        list += (list.empty() ? "" : ", ") + c;
+    throw std::invalid_argument(std::string("lsao: ") + name + " '" + value + "' is not one of " +
+                                list);
+}
+
 } // namespace
 
 plugin::TechniqueInfo Lsao::describe()
@@ -202,22 +216,12 @@ Lsao::Lsao(const config::ParamSet& params)
     mParams.interleave = int(params.getInt("interleave"));
     mParams.radius = params.getFloat("radius");
     mParams.walls = params.getBool("walls");
-    const std::string& gather = params.getString("gather");
-    if (gather == kGatherChoices[0])
-        mParams.gather = Gather::Bilinear;
-    else if (gather == kGatherChoices[1])
-        mParams.gather = Gather::Nearest;
-    else
-        throw std::invalid_argument("lsao: gather '" + gather +
-                                    "' is not one of bilinear, nearest");
-    const std::string& falloff = params.getString("falloff");
-    if (falloff == kFalloffChoices[0])
-        mParams.falloff = Falloff::Linear;
-    else if (falloff == kFalloffChoices[1])
-        mParams.falloff = Falloff::Smoothstep;
-    else
-        throw std::invalid_argument("lsao: falloff '" + falloff +
-                                    "' is not one of linear, smoothstep");
+    mParams.gather = findChoice("gather", params.getString("gather"), kGatherChoices) == 0
+                         ? Gather::Bilinear
+                         : Gather::Nearest;
+    mParams.falloff = findChoice("falloff", params.getString("falloff"), kFalloffChoices) == 0
+                          ? Falloff::Linear
+                          : Falloff::Smoothstep;
 }
 
 Lsao::~Lsao() = default;

@@ -115,29 +115,42 @@ Occluder loadDominant(const GatherContext& g, const Direction& d, std::uint32_t 
     return loadLineSample(g, d, c, s, r);
 }
 
-//! The contribution of direction k at receiver x (pixel centre p, unit normal n).
+//! Where receiver p lies among the lines of direction d: its position along them, the line
+//! below it (the pair i0, i0 + 1 brackets it), the weight of line i0 + 1, and its step stratum.
+struct ReceiverOnLines {
+    float t;
+    int lowerLine;
+    float lineWeight;
+    int stratum;
+};
+
+ReceiverOnLines locateReceiver(const Layout& layout, const Direction& d, glm::vec2 p)
+{
+    const float cX = p.x * d.perp.x + p.y * d.perp.y;
+    const float tX = p.x * d.dir.x + p.y * d.dir.y;
+    const float fl = (cX - d.cMin) * layout.invSpacing;
+    const int i0 = std::clamp(int(std::floor(fl)), 0, int(d.lineCount) - 2);
+    return {tX, i0, std::clamp(fl - float(i0), 0.0f, 1.0f),
+            int(std::floor((tX - d.tMin) * layout.invStep))};
+}
+
+//! Gather::Bilinear: the contribution of direction k at receiver r (pixel centre p).
 //! [Timonen 2013: gathering] bilinear over the two lines that bracket p and the two samples that
 //! bracket it along each line; each sample's dominant occluder (from the sweep) is seen from the
 //! receiver itself, with the receiver's normal [Quantum Break seed: occluders clamped to the
 //! visible hemisphere]. The gap between the upstream sample and the receiver gets one near-field
 //! sample half-way [Quantum Break seed].
-Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 p,
-                             const glm::vec3& x, const glm::vec3& n)
+Contribution gatherBilinear(const GatherContext& g, std::uint32_t k, glm::vec2 p, const Receiver& r,
+                            const ReceiverOnLines& at)
 {
     const Layout& layout = g.layout;
     const Direction& d = layout.directions[k];
+    const Slice& slice = r.slice;
     Contribution total;
-    const Slice slice = makeSlice(x, n, glm::vec3(d.axis));
-    if (!slice.hasHemisphere)
-        return total;
-    const Receiver r{slice, x, n, 1e-4f * glm::length(x)};
-
-    const float cX = p.x * d.perp.x + p.y * d.perp.y;
-    const float tX = p.x * d.dir.x + p.y * d.dir.y;
-    const float fl = (cX - d.cMin) * layout.invSpacing;
-    const int i0 = std::clamp(int(std::floor(fl)), 0, int(d.lineCount) - 2);
-    const float f = std::clamp(fl - float(i0), 0.0f, 1.0f);
-    const int mX = int(std::floor((tX - d.tMin) * layout.invStep));
+    const float tX = at.t;
+    const int i0 = at.lowerLine;
+    const float f = at.lineWeight;
+    const int mX = at.stratum;
 
     LineSample lower[2], upper[2];
     float gap = 0.0f;
@@ -216,28 +229,20 @@ Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 
     return total;
 }
 
-//! gatherDirection with Gather::Nearest: one occluder set per direction, that of the sample
+//! Gather::Nearest: one occluder set per direction, that of the sample
 //! nearest to the receiver on the nearest line [Quantum Break seed: "average distance to the
 //! nearest step is less than 3 px"], instead of the bilinear blend of four. The sample's
 //! dominant occluder, the sample itself when it is upstream, and the near-field sample half-way
 //! to the upstream sample of that line.
-Contribution gatherNearest(const GatherContext& g, std::uint32_t k, glm::vec2 p, const glm::vec3& x,
-                           const glm::vec3& n)
+Contribution gatherNearest(const GatherContext& g, std::uint32_t k, glm::vec2 p, const Receiver& r,
+                           const ReceiverOnLines& at)
 {
     const Layout& layout = g.layout;
     const Direction& d = layout.directions[k];
-    const Slice slice = makeSlice(x, n, glm::vec3(d.axis));
-    if (!slice.hasHemisphere)
-        return Contribution{};
-    const Receiver r{slice, x, n, 1e-4f * glm::length(x)};
-
-    const float cX = p.x * d.perp.x + p.y * d.perp.y;
-    const float tX = p.x * d.dir.x + p.y * d.dir.y;
-    const float fl = (cX - d.cMin) * layout.invSpacing;
-    const int i0 = std::clamp(int(std::floor(fl)), 0, int(d.lineCount) - 2);
-    const float f = std::clamp(fl - float(i0), 0.0f, 1.0f);
-    const int mX = int(std::floor((tX - d.tMin) * layout.invStep));
-    const std::uint32_t line = std::uint32_t(f < 0.5f ? i0 : i0 + 1);
+    const float tX = at.t;
+    const int mX = at.stratum;
+    const std::uint32_t line =
+        std::uint32_t(at.lineWeight < 0.5f ? at.lowerLine : at.lowerLine + 1);
     const float c = computeLineOffset(d, line, layout.spacing);
     const LineSample atX = locateSample(layout, d, k, line, c, mX);
     const bool atXIsLower = atX.t <= tX;
@@ -259,7 +264,21 @@ Contribution gatherNearest(const GatherContext& g, std::uint32_t k, glm::vec2 p,
     const Occluder dominant =
         sample.exists ? loadDominant(g, d, k, line, c, row, sample, r) : Occluder{};
     const Occluder self = useLower ? loadLineSample(g, d, c, lower, r) : Occluder{};
-    return evaluateOccluders(slice, dominant, self, near, g.radius, g.invRadius, g.smoothstep);
+    return evaluateOccluders(r.slice, dominant, self, near, g.radius, g.invRadius, g.smoothstep);
+}
+
+//! The contribution of direction k at receiver x (pixel centre p, unit normal n), by the gather
+//! of Params::gather.
+Contribution gatherDirection(const GatherContext& g, std::uint32_t k, glm::vec2 p,
+                             const glm::vec3& x, const glm::vec3& n)
+{
+    const Direction& d = g.layout.directions[k];
+    const Slice slice = makeSlice(x, n, glm::vec3(d.axis));
+    if (!slice.hasHemisphere)
+        return Contribution{};
+    const Receiver r{slice, x, n, 1e-4f * glm::length(x)};
+    const ReceiverOnLines at = locateReceiver(g.layout, d, p);
+    return g.nearest ? gatherNearest(g, k, p, r, at) : gatherBilinear(g, k, p, r, at);
 }
 
 } // namespace
@@ -339,8 +358,7 @@ void runGatherCpu(const Layout& layout, std::size_t batchIndex,
                     const std::uint32_t first =
                         batch.begin + (pixelClass + classes - batch.begin % classes) % classes;
                     for (std::uint32_t k = first; k < batch.end; k += classes) {
-                        const Contribution c = g.nearest ? gatherNearest(g, k, p, x, n)
-                                                         : gatherDirection(g, k, p, x, n);
+                        const Contribution c = gatherDirection(g, k, p, x, n);
                         sums.obscurance[i] += c.obscurance;
                         sums.visibility[i] += c.visibility;
                         sums.moment[i] += c.moment;

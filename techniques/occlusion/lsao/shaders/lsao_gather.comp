@@ -87,6 +87,24 @@ void lsaoAddScaled(inout Contribution total, float weight, Contribution c)
     total.moment += weight * c.moment;
 }
 
+// lsao::runGatherCpu's locateReceiver: where the receiver lies among the lines of direction d.
+struct ReceiverOnLines {
+    float t;
+    int lowerLine;
+    float lineWeight;
+    int stratum;
+};
+
+ReceiverOnLines lsaoLocateReceiver(Direction d, vec2 p)
+{
+    precise float cX = p.x * d.perp.x + p.y * d.perp.y;
+    precise float tX = p.x * d.dir.x + p.y * d.dir.y;
+    precise float fl = (cX - d.cMin) * pc.invSpacing;
+    int i0 = clamp(int(floor(fl)), 0, int(d.lineCount) - 2);
+    precise float fs = (tX - d.tMin) * pc.invStep;
+    return ReceiverOnLines(tX, i0, clamp(fl - float(i0), 0.0, 1.0), int(floor(fs)));
+}
+
 #if LSAO_GATHER_NEAREST
 // lsao::runGatherCpu's gatherNearest: one occluder set per direction, that of the sample nearest
 // to the receiver on the nearest line [Quantum Break seed: "average distance to the nearest step
@@ -99,13 +117,11 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         return Contribution(0.0, 0.0, vec3(0.0));
     float minDistance = 1e-4 * length(x);
 
-    precise float cX = p.x * d.perp.x + p.y * d.perp.y;
-    precise float tX = p.x * d.dir.x + p.y * d.dir.y;
-    precise float fl = (cX - d.cMin) * pc.invSpacing;
-    int i0 = clamp(int(floor(fl)), 0, int(d.lineCount) - 2);
-    float f = clamp(fl - float(i0), 0.0, 1.0);
-    precise float fs = (tX - d.tMin) * pc.invStep;
-    int mX = int(floor(fs));
+    ReceiverOnLines at = lsaoLocateReceiver(d, p);
+    precise float tX = at.t;
+    int i0 = at.lowerLine;
+    float f = at.lineWeight;
+    int mX = at.stratum;
     uint line = uint(f < 0.5 ? i0 : i0 + 1);
     uint lineHash = lsaoLineHash(k, line);
     float c = lsaoLineOffset(d, line);
@@ -146,13 +162,11 @@ Contribution lsaoGatherDirection(uint k, vec2 p, vec3 x, vec3 n)
         return total;
     float minDistance = 1e-4 * length(x);
 
-    precise float cX = p.x * d.perp.x + p.y * d.perp.y;
-    precise float tX = p.x * d.dir.x + p.y * d.dir.y;
-    precise float fl = (cX - d.cMin) * pc.invSpacing;
-    int i0 = clamp(int(floor(fl)), 0, int(d.lineCount) - 2);
-    float f = clamp(fl - float(i0), 0.0, 1.0);
-    precise float fs = (tX - d.tMin) * pc.invStep;
-    int mX = int(floor(fs));
+    ReceiverOnLines at = lsaoLocateReceiver(d, p);
+    precise float tX = at.t;
+    int i0 = at.lowerLine;
+    float f = at.lineWeight;
+    int mX = at.stratum;
 
     LineSample lower[2];
     LineSample upper[2];
