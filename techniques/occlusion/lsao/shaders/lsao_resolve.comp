@@ -16,6 +16,8 @@ layout(set = 0, binding = 5, r32f) uniform readonly image2D accumB;    // visibi
 layout(set = 0, binding = 6, rgba32f) uniform writeonly image2D outA;  // bent normal, aperture
 layout(set = 0, binding = 7, r32f) uniform writeonly image2D outB;     // ambient
 
+// The window is read straight from the images: a shared-memory tile of the group's pixels and
+// their reach took the same time on lavapipe (73 against 69 ms at 1280x720); not compared on a GPU.
 void main()
 {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
