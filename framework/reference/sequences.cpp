@@ -117,12 +117,21 @@ glm::dvec2 sampleScrambledSobol2DHashed(std::uint32_t index, std::uint64_t h0, s
     return {toUnitInterval(x), toUnitInterval(y)};
 }
 
+//! The two hashes of a stream seed that sampleScrambledSobol2DHashed takes.
+SobolStream hashStreamSeed(std::uint64_t streamSeed)
+{
+    SobolStream stream;
+    stream.h0 = mixBits64(streamSeed);
+    stream.h1 = mixBits64(stream.h0 ^ 0x9e3779b97f4a7c15ull);
+    return stream;
+}
+
 } // namespace
 
 glm::dvec2 sampleScrambledSobol2D(std::uint32_t index, std::uint64_t streamSeed)
 {
-    const std::uint64_t h0 = mixBits64(streamSeed);
-    return sampleScrambledSobol2DHashed(index, h0, mixBits64(h0 ^ 0x9e3779b97f4a7c15ull));
+    const SobolStream stream = hashStreamSeed(streamSeed);
+    return sampleScrambledSobol2DHashed(index, stream.h0, stream.h1);
 }
 
 PixelSequence::PixelSequence(std::uint64_t seed, std::uint64_t pixelIndex)
@@ -132,11 +141,7 @@ PixelSequence::PixelSequence(std::uint64_t seed, std::uint64_t pixelIndex)
 
 SobolStream PixelSequence::getStream(std::uint32_t dimensionPair) const
 {
-    // sampleScrambledSobol2D's two hashes of the pair's stream seed.
-    SobolStream stream;
-    stream.h0 = mixBits64(mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
-    stream.h1 = mixBits64(stream.h0 ^ 0x9e3779b97f4a7c15ull);
-    return stream;
+    return hashStreamSeed(mPixelSeed ^ mixBits64(std::uint64_t(dimensionPair) + 1));
 }
 
 glm::dvec2 PixelSequence::get2D(const SobolStream& stream, std::uint32_t sampleIndex)

@@ -75,6 +75,14 @@ GpuRunner::GpuRunner(gpu::Context& context, const Params& params)
                               params);
 }
 
+void GpuRunner::checkCompiledFor(const Params& params, const Layout& layout) const
+{
+    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode ||
+        layout.interleave != mInterleave)
+        throw std::invalid_argument(
+            "lsao: the shaders were compiled for other walls, falloff, gather or interleave");
+}
+
 void GpuRunner::prepare(const Layout& layout)
 {
     if (layout.width != mWidth || layout.height != mHeight) {
@@ -114,10 +122,7 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const Image<float>& depth, const Image<glm::vec3>& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
-    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode ||
-        layout.interleave != mInterleave)
-        throw std::invalid_argument(
-            "lsao: the shaders were compiled for other walls, falloff, gather or interleave");
+    checkCompiledFor(params, layout);
     prepare(layout);
     const int w = layout.width, h = layout.height;
     const std::size_t count = std::size_t(w) * std::size_t(h);
@@ -137,10 +142,7 @@ void GpuRunner::run(const Layout& layout, const plugin::ScreenProjection& projec
                     const Params& params, const gpu::Image& depth, const gpu::Image& normal,
                     plugin::OcclusionOutput& out, bool readBack)
 {
-    if (params.walls != mWalls || params.falloff != mFalloff || params.gather != mGatherMode ||
-        layout.interleave != mInterleave)
-        throw std::invalid_argument(
-            "lsao: the shaders were compiled for other walls, falloff, gather or interleave");
+    checkCompiledFor(params, layout);
     prepare(layout);
     const int w = layout.width, h = layout.height;
     mDirections.upload(layout.directions.data(), layout.directions.size() * sizeof(Direction));

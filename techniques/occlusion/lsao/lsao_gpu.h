@@ -46,6 +46,8 @@ public:
     std::vector<std::uint32_t> downloadSweep(std::size_t entryCount) const;
 
 private:
+    //! Throws std::invalid_argument unless the shaders were compiled for these options.
+    void checkCompiledFor(const Params& params, const Layout& layout) const;
     void prepare(const Layout& layout);
 
     gpu::Context* mContext = nullptr;
