@@ -226,6 +226,8 @@ SkyLobeSampler::SkyLobeSampler(const scene::Sky& sky)
         mFrames.push_back(Frame::fromNormal(glm::normalize(axis)));
         mAxes.push_back(axis);
     }
+    for (std::size_t i = 0; i < mAxes.size(); ++i)
+        mPmf[i] = mLobes.pmf(i); // 0 for a black lobe: its term drops out of the pdf
     if (mLobes.empty()) {
         mFrames.clear();
         mAxes.clear();
@@ -242,28 +244,26 @@ glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
 double SkyLobeSampler::evaluate(const glm::dvec3& direction, const scene::Sky& sky,
                                 glm::dvec3& radiance) const
 {
-    // The exponentials as scene::Sky::radiance takes them (its axes, its sharpness), so that the
-    // radiance keeps its bits; the pdf's axes agree with the normalised frames' to an ulp.
-    double p = 0.0;
-    glm::dvec3 sum(0.0);
-    const double k = double(sky.sharpness);
-    for (std::size_t i = 0; i < mAxes.size(); ++i) {
-        const double e = std::exp(k * (glm::dot(direction, mAxes[i]) - 1.0));
-        sum += glm::dvec3(sky.lobes[i]) * e;
-        if (mLobes.pmf(i) > 0.0)
-            p += mLobes.pmf(i) * (mNormalise * e);
-    }
-    radiance = glm::dvec3(glm::vec3(sum));
-    return p;
+    // The lobes as scene::Sky::radiance takes them (its axes, its sharpness), so that the radiance
+    // keeps its bits; the pdf's axes agree with the normalised frames' to an ulp.
+    double values[scene::kConeDirectionCount];
+    scene::evaluateSkyLobes(direction, double(sky.sharpness), values);
+    radiance = glm::dvec3(sky.sumLobes(values));
+    return sumPdf(values);
 }
 
 double SkyLobeSampler::pdf(const glm::dvec3& direction) const
 {
+    double values[scene::kConeDirectionCount];
+    scene::evaluateSkyLobes(direction, mSharpness, values);
+    return sumPdf(values);
+}
+
+double SkyLobeSampler::sumPdf(const double values[scene::kConeDirectionCount]) const
+{
     double p = 0.0;
-    for (std::size_t i = 0; i < mFrames.size(); ++i)
-        if (mLobes.pmf(i) > 0.0)
-            p += mLobes.pmf(i) *
-                 (mNormalise * std::exp(mSharpness * (glm::dot(direction, mFrames[i].normal) - 1.0)));
+    for (std::size_t i = 0; i < mAxes.size(); ++i)
+        p += mPmf[i] * (mNormalise * values[i]);
     return p;
 }
 

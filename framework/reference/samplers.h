@@ -9,6 +9,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -104,9 +105,13 @@ public:
     double evaluate(const glm::dvec3& direction, const scene::Sky& sky, glm::dvec3& radiance) const;
 
 private:
+    //! The mixture's pdf from the lobes' values (scene::evaluateSkyLobes).
+    double sumPdf(const double values[scene::kConeDirectionCount]) const;
+
     DiscreteDistribution mLobes;
     std::vector<Frame> mFrames;
     std::vector<glm::dvec3> mAxes; //!< the lobes' axes as scene::Sky's radiance takes them
+    std::array<double, scene::kConeDirectionCount> mPmf{}; //!< each lobe's pick probability
     double mSharpness = 0.0;
     double mExpm1 = 0.0;     //!< expm1(-2 k), shared by every lobe's sample
     double mNormalise = 0.0; //!< k / (-2 pi expm1(-2 k)), every lobe's pdf factor

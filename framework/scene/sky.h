@@ -23,6 +23,16 @@ int getConeDesignStrength();
 //! Its integral over the sphere is 2*pi/sharpness * (1 - exp(-2*sharpness)).
 double integrateSphericalGaussian(double sharpness);
 
+//! The 16 lobes at `toSky`: values[i] = exp(sharpness * (dot(toSky, axis_i) - 1)) with the
+//! axes of getConeDirections(), two lobes at a time (SSE2) with an exponential of its own: the
+//! same bits as computeExpNonPositive lobe by lobe. The reference's sky pdf and Sky::radiance
+//! both take their lobes from here, so that they agree to the bit.
+void evaluateSkyLobes(const glm::dvec3& toSky, double sharpness,
+                      double values[kConeDirectionCount]);
+//! exp(x) for x <= 1 to within 2 ulp of libm's (subnormals and 0 as libm rounds them); for x > 1
+//! it returns e. Without calls, so that evaluateSkyLobes can take it two lanes at a time.
+double computeExpNonPositive(double x);
+
 struct Sky {
     enum class Kind { None, Constant, Gradient, Srbf };
     Kind kind = Kind::None;
@@ -35,6 +45,8 @@ struct Sky {
 
     //! Radiance arriving from direction `toSky` (unit, world space, pointing away from the scene).
     glm::vec3 radiance(const glm::dvec3& toSky) const;
+    //! Kind::Srbf's radiance from its lobes' values (evaluateSkyLobes), summed in lobe order.
+    glm::vec3 sumLobes(const double values[kConeDirectionCount]) const;
     bool emits() const;  //!< false for Kind::None or all-zero radiance
 };
 

@@ -6,7 +6,10 @@
 #include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 using namespace rtlab::scene;
 
@@ -108,4 +111,56 @@ TEST(Sky, RadianceOfEachKind)
     sky.lobes[3] = glm::vec3(2.0f);
     EXPECT_NEAR(sky.radiance(getConeDirections()[3]).x, 2.0, 1e-6);  // peak on the axis
     EXPECT_TRUE(sky.emits());
+}
+
+// The lobes' exponential is libm's to 2 ulp: the first omitted Taylor term is below a twentieth
+// of an ulp, and Horner's 13 roundings, the two-part ln 2 and the final scaling add at most 1.5
+// ulp between them. In the subnormals the result is rounded twice (to a normal, then by the
+// exact 2^-64 into the subnormals), so it may be one least subnormal off libm's.
+TEST(Sky, ExpNonPositiveIsLibmsToTwoUlp)
+{
+    int checked = 0;
+    for (double x = -750.0; x <= 1.0; x += 0.000731) {
+        const double expected = std::exp(x), got = computeExpNonPositive(x);
+        ASSERT_TRUE(std::isfinite(got)) << x;
+        ASSERT_GE(got, 0.0) << x;
+        const double ulp = std::nextafter(expected, 2.0 * expected + 1.0) - expected;
+        if (expected >= 0x1p-1022)
+            ASSERT_LE(std::abs(got - expected), 2.0 * ulp) << "x = " << x;
+        else
+            ASSERT_LE(std::abs(got - expected),
+                      4e-16 * expected + std::numeric_limits<double>::denorm_min())
+                << "x = " << x;
+        ++checked;
+    }
+    EXPECT_GT(checked, 1000000);
+    EXPECT_EQ(computeExpNonPositive(0.0), 1.0);
+    EXPECT_EQ(computeExpNonPositive(-746.0), 0.0);
+    EXPECT_EQ(computeExpNonPositive(-1e300), 0.0);
+    EXPECT_EQ(computeExpNonPositive(-std::numeric_limits<double>::infinity()), 0.0);
+}
+
+// Whichever vector width the CPU gives evaluateSkyLobes, every lobe is computeExpNonPositive's
+// bits, also for sharpness so large or small that the exponent leaves the exponential's range.
+TEST(Sky, LobesAreTheScalarExponentialToTheBit)
+{
+    const double sharpnesses[] = {1e-30, 0.01, 3.0, 4.0, 50.0, 1e4, 3.4e38};
+    for (int j = 0; j < 2000; ++j) {
+        const double z = 1.0 - 2.0 * (j + 0.5) / 2000.0, phi = 2.399963229728653 * j;
+        const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
+        const glm::dvec3 d(r * std::cos(phi), z, r * std::sin(phi));
+        for (const double k : sharpnesses) {
+            double values[kConeDirectionCount];
+            evaluateSkyLobes(d, k, values);
+            for (int i = 0; i < kConeDirectionCount; ++i) {
+                const glm::dvec3& a = getConeDirections()[i];
+                const double expected =
+                    computeExpNonPositive(k * ((d.x * a.x + d.y * a.y + d.z * a.z) - 1.0));
+                ASSERT_EQ(std::bit_cast<std::uint64_t>(values[i]),
+                          std::bit_cast<std::uint64_t>(expected))
+                    << "direction " << j << ", sharpness " << k << ", lobe " << i;
+                ASSERT_LE(values[i], std::exp(1e-12 * k) * (1.0 + 1e-15));
+            }
+        }
+    }
 }
