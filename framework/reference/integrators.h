@@ -28,12 +28,23 @@ public:
     //! Throws rtlab::Error when triangleMaterial or normals do not match the triangles.
     explicit SceneLights(const scene::RenderScene& scene);
 
-    const glm::dvec3& getAlbedo(std::uint32_t triangle) const { return mAlbedo[triangle]; }
-    const glm::dvec3& getEmission(std::uint32_t triangle) const { return mEmission[triangle]; }
+    // By material: a path's hit reads one small per-triangle index and a table that stays in
+    // cache, not two triangle-sized arrays.
+    const glm::dvec3& getAlbedo(std::uint32_t triangle) const
+    {
+        return mMaterialAlbedo[mScene.triangleMaterial[triangle]];
+    }
+    const glm::dvec3& getEmission(std::uint32_t triangle) const
+    {
+        return mMaterialEmission[mScene.triangleMaterial[triangle]];
+    }
     //! Interpolated shading normal (the geometric one where the scene has no normals).
     glm::dvec3 getShadingNormal(std::uint32_t triangle, double u, double v,
                                 const glm::dvec3& geometricNormal) const;
     glm::dvec3 getPoint(std::uint32_t triangle, double u, double v) const;
+    //! getPoint and getShadingNormal from one read of the triangle's indices.
+    void getSurface(std::uint32_t triangle, double u, double v, const glm::dvec3& geometricNormal,
+                    glm::dvec3& point, glm::dvec3& shadingNormal) const;
     //! Unit geometric normal (zero for a degenerate triangle).
     const glm::dvec3& getGeometricNormal(std::uint32_t triangle) const { return mNormal[triangle]; }
     const std::vector<scene::PointLight>& getPointLights() const { return mScene.pointLights; }
@@ -52,8 +63,8 @@ public:
 
 private:
     const scene::RenderScene& mScene;
-    std::vector<glm::dvec3> mAlbedo;
-    std::vector<glm::dvec3> mEmission;
+    std::vector<glm::dvec3> mMaterialAlbedo;
+    std::vector<glm::dvec3> mMaterialEmission;
     std::vector<glm::dvec3> mNormal;
     std::vector<std::int32_t> mEmitterSlot; //!< per triangle, -1 when not emissive
 };

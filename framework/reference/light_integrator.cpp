@@ -228,9 +228,8 @@ glm::dvec3 LightPathTracer::trace(const SurfacePoint& point)
             throughput /= survive;
         }
 
-        v.position = mLights.getPoint(hit.triangle, hit.u, hit.v);
         v.geometricNormal = ng;
-        v.shadingNormal = mLights.getShadingNormal(hit.triangle, hit.u, hit.v, ng);
+        mLights.getSurface(hit.triangle, hit.u, hit.v, ng, v.position, v.shadingNormal);
         if (glm::dot(v.shadingNormal, ng) < 0.0)
             v.shadingNormal = -v.shadingNormal;
         v.origin = glm::vec3(v.position + mContext.rayEpsilon * ng);

@@ -43,6 +43,31 @@ void computeCosSinQuarter(double t, double& c, double& s)
         t2 * (-1.0 / 39916800 + t2 * (1.0 / 6227020800.0 + t2 * (-1.0 / 1307674368000.0))))))));
 }
 
+// cos and sin of 2 pi t for t in [0, 1] without libm's sincos: the nearest quarter turn q,
+// the series above on the rest (|2 pi (t - q/4)| <= pi/4; t - q/4 is exact by Sterbenz's lemma),
+// turned by q quarter turns.
+void computeCosSinTurns(double t, double& c, double& s)
+{
+    constexpr double kShifter = 0x1.8p52; // adding it rounds to the nearest integer
+    const double q = (4.0 * t + kShifter) - kShifter;
+    double c0, s0;
+    computeCosSinQuarter(2.0 * kPi * (t - 0.25 * q), c0, s0);
+    switch (int(q) & 3) {
+    case 0:
+        c = c0, s = s0;
+        break;
+    case 1:
+        c = -s0, s = c0;
+        break;
+    case 2:
+        c = -c0, s = -s0;
+        break;
+    default:
+        c = s0, s = -c0;
+        break;
+    }
+}
+
 } // namespace
 
 glm::dvec3 sampleCosineHemisphere(const glm::dvec2& u)
@@ -81,8 +106,9 @@ glm::dvec3 sampleUniformHemisphere(const glm::dvec2& u)
 {
     const double z = u.x;
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = 2.0 * kPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    double c, s;
+    computeCosSinTurns(u.y, c, s); // azimuth 2 pi u.y
+    return {r * c, r * s, z};
 }
 
 void sampleUniformHemispheres(const glm::dvec2* u, glm::dvec3* out, std::size_t n)
@@ -100,8 +126,9 @@ glm::dvec3 sampleUniformSphere(const glm::dvec2& u)
 {
     const double z = 1.0 - 2.0 * u.x;
     const double r = std::sqrt(std::max(0.0, 1.0 - z * z));
-    const double phi = 2.0 * kPi * u.y;
-    return {r * std::cos(phi), r * std::sin(phi), z};
+    double c, s;
+    computeCosSinTurns(u.y, c, s); // azimuth 2 pi u.y
+    return {r * c, r * s, z};
 }
 
 double pdfUniformSphere()
@@ -121,8 +148,9 @@ glm::dvec3 sampleSphericalGaussian(const glm::dvec2& u, double sharpness, double
     const double oneMinusW = -std::log1p((1.0 - u.x) * expm1MinusTwoK) / k;
     const double w = std::clamp(1.0 - oneMinusW, -1.0, 1.0);
     const double sinTheta = std::sqrt(std::max(0.0, oneMinusW * (2.0 - oneMinusW)));
-    const double phi = 2.0 * kPi * u.y;
-    return {sinTheta * std::cos(phi), sinTheta * std::sin(phi), w};
+    double c, s;
+    computeCosSinTurns(u.y, c, s); // azimuth 2 pi u.y
+    return {sinTheta * c, sinTheta * s, w};
 }
 
 } // namespace

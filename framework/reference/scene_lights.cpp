@@ -41,8 +41,10 @@ SceneLights::SceneLights(const scene::RenderScene& scene) : mScene(scene)
             throw Error("reference: point light " + std::to_string(l) +
                         " has a negative or non-finite intensity");
 
-    mAlbedo.resize(triangles);
-    mEmission.resize(triangles);
+    for (const scene::Material& m : scene.materials) {
+        mMaterialAlbedo.push_back(glm::dvec3(m.albedo));
+        mMaterialEmission.push_back(glm::dvec3(m.emission));
+    }
     mNormal.resize(triangles);
     mEmitterSlot.assign(triangles, -1);
     std::vector<double> emitterWeights;
@@ -52,15 +54,13 @@ SceneLights::SceneLights(const scene::RenderScene& scene) : mScene(scene)
             throw Error("reference: triangle " + std::to_string(t) + " uses material " +
                         std::to_string(m) + " but the scene has " +
                         std::to_string(scene.materials.size()) + " materials");
-        mAlbedo[t] = glm::dvec3(scene.materials[m].albedo);
-        mEmission[t] = glm::dvec3(scene.materials[m].emission);
         const glm::dvec3 p0(scene.positions[scene.indices[3 * t + 0]]);
         const glm::dvec3 p1(scene.positions[scene.indices[3 * t + 1]]);
         const glm::dvec3 p2(scene.positions[scene.indices[3 * t + 2]]);
         const glm::dvec3 cross = glm::cross(p1 - p0, p2 - p0);
         const double area = 0.5 * glm::length(cross);
         mNormal[t] = area > 0.0 ? cross / (2.0 * area) : glm::dvec3(0.0);
-        const double power = computeLuminance(mEmission[t]) * area;
+        const double power = computeLuminance(mMaterialEmission[m]) * area;
         if (power > 0.0) {
             mEmitterSlot[t] = std::int32_t(emitterTriangles.size());
             emitterTriangles.push_back(std::uint32_t(t));
@@ -74,24 +74,49 @@ SceneLights::SceneLights(const scene::RenderScene& scene) : mScene(scene)
     skyLobes = SkyLobeSampler(scene.sky);
 }
 
-glm::dvec3 SceneLights::getShadingNormal(std::uint32_t triangle, double u, double v,
-                                         const glm::dvec3& geometricNormal) const
+namespace {
+
+glm::dvec3 interpolateNormal(const std::vector<glm::vec3>& normals, const std::uint32_t* corners,
+                             double u, double v, const glm::dvec3& geometricNormal)
 {
-    if (mScene.normals.empty())
+    if (normals.empty())
         return geometricNormal;
-    const glm::dvec3 n = (1.0 - u - v) * glm::dvec3(mScene.normals[mScene.indices[3 * triangle]]) +
-                         u * glm::dvec3(mScene.normals[mScene.indices[3 * triangle + 1]]) +
-                         v * glm::dvec3(mScene.normals[mScene.indices[3 * triangle + 2]]);
+    const glm::dvec3 n = (1.0 - u - v) * glm::dvec3(normals[corners[0]]) +
+                         u * glm::dvec3(normals[corners[1]]) + v * glm::dvec3(normals[corners[2]]);
     const double length = glm::length(n);
     return length > 0.0 && std::isfinite(length) ? n / length : geometricNormal;
 }
 
+glm::dvec3 interpolatePoint(const std::vector<glm::vec3>& positions, const std::uint32_t* corners,
+                            double u, double v)
+{
+    const glm::dvec3 p0(positions[corners[0]]);
+    const glm::dvec3 p1(positions[corners[1]]);
+    const glm::dvec3 p2(positions[corners[2]]);
+    return p0 + u * (p1 - p0) + v * (p2 - p0);
+}
+
+} // namespace
+
+glm::dvec3 SceneLights::getShadingNormal(std::uint32_t triangle, double u, double v,
+                                         const glm::dvec3& geometricNormal) const
+{
+    return interpolateNormal(mScene.normals, &mScene.indices[3 * std::size_t(triangle)], u, v,
+                             geometricNormal);
+}
+
 glm::dvec3 SceneLights::getPoint(std::uint32_t triangle, double u, double v) const
 {
-    const glm::dvec3 p0(mScene.positions[mScene.indices[3 * triangle + 0]]);
-    const glm::dvec3 p1(mScene.positions[mScene.indices[3 * triangle + 1]]);
-    const glm::dvec3 p2(mScene.positions[mScene.indices[3 * triangle + 2]]);
-    return p0 + u * (p1 - p0) + v * (p2 - p0);
+    return interpolatePoint(mScene.positions, &mScene.indices[3 * std::size_t(triangle)], u, v);
+}
+
+void SceneLights::getSurface(std::uint32_t triangle, double u, double v,
+                             const glm::dvec3& geometricNormal, glm::dvec3& point,
+                             glm::dvec3& shadingNormal) const
+{
+    const std::uint32_t* corners = &mScene.indices[3 * std::size_t(triangle)];
+    point = interpolatePoint(mScene.positions, corners, u, v);
+    shadingNormal = interpolateNormal(mScene.normals, corners, u, v, geometricNormal);
 }
 
 double SceneLights::pdfEmitter(std::uint32_t triangle, double distance, double cosLight) const

@@ -7,12 +7,8 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-
-#if defined(__x86_64__)
-#include <immintrin.h>
-#elif defined(__SSE2__)
-#include <emmintrin.h>
-#endif
+#include <cstring>
+#include <type_traits>
 
 namespace rtlab::scene {
 
@@ -63,12 +59,16 @@ double integrateSphericalGaussian(double sharpness)
     return -2.0 * glm::pi<double>() * std::expm1(-2.0 * sharpness) / sharpness;
 }
 
+// The lane types below never cross a call (their functions are always inlined): GCC's note that
+// an AVX vector's calling convention differs without AVX does not apply.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 namespace {
 
-// computeExpNonPositive's constants. exp(x) = 2^n exp(r), n = round(x / ln 2), r = x - n ln 2 in
-// [-ln2/2, ln2/2], with ln 2 in two parts so that n * ln2Hi is exact for |n| < 2^11 [Cody & Waite
-// 1980, "Software Manual for the Elementary Functions"]. exp(r) by its Taylor series to r^13: the
-// first omitted term is below 4e-18 on that interval, under a twentieth of an ulp of the result.
+// exp(x) = 2^n exp(r), n = round(x / ln 2), r = x - n ln 2 in [-ln2/2, ln2/2], with ln 2 in two
+// parts so that n * ln2Hi is exact for |n| < 2^11 [Cody & Waite 1980, "Software Manual for the
+// Elementary Functions"]. exp(r) by its Taylor series to r^13: the first omitted term is below
+// 4e-18 on that interval, under a twentieth of an ulp of the result.
 constexpr double kLog2E = 1.4426950408889634;
 constexpr double kLn2Hi = 6.93147180369123816490e-01; // 0x3fe62e42fee00000: 32 low bits zero
 constexpr double kLn2Lo = 1.90821492927058770002e-10;
@@ -76,49 +76,85 @@ constexpr double kShifter = 0x1.8p52; // adding it rounds to an integer held in 
 // Below -746, exp is under half the least subnormal and rounds to 0, as libm's does.
 constexpr double kExpLowest = -746.0;
 constexpr double kExpHighest = 1.0;
-constexpr double kTaylor[14] = {1.0,
-                                1.0,
-                                1.0 / 2,
-                                1.0 / 6,
-                                1.0 / 24,
-                                1.0 / 120,
-                                1.0 / 720,
-                                1.0 / 5040,
-                                1.0 / 40320,
-                                1.0 / 362880,
-                                1.0 / 3628800,
-                                1.0 / 39916800,
-                                1.0 / 479001600,
-                                1.0 / 6227020800.0};
 // 2^(n + 64) from its exponent bits (n sits in the low bits of `shifted`; n + 64 >= -1012, a
 // normal), then the exact factor 2^-64, which rounds into the subnormals where exp does.
 constexpr std::int64_t kExponentBias = 1023 + 64 - std::bit_cast<std::int64_t>(kShifter);
 constexpr double kUnscale = 0x1p-64;
 
+// Lanes of doubles and of the int64s of their bits (GCC and Clang vector extensions); a width of
+// 1 is the plain scalar. Every lane takes the same IEEE operations in the same order whatever
+// the width, so all widths give the same bits.
+// (GCC drops a vector_size that depends on a template parameter: each width is spelled out.)
+using Double2 = double __attribute__((vector_size(16)));
+using Double4 = double __attribute__((vector_size(32)));
+using Int2 = std::int64_t __attribute__((vector_size(16)));
+using Int4 = std::int64_t __attribute__((vector_size(32)));
+template <int N> struct Lanes;
+template <> struct Lanes<1> {
+    using D = double;
+    using I = std::int64_t;
+};
+template <> struct Lanes<2> {
+    using D = Double2;
+    using I = Int2;
+};
+template <> struct Lanes<4> {
+    using D = Double4;
+    using I = Int4;
+};
+
+template <class V, class S> [[gnu::always_inline]] inline V splat(S value)
+{
+    if constexpr (std::is_same_v<V, S>) {
+        return value;
+    } else {
+        V v{};
+        for (std::size_t i = 0; i < sizeof(V) / sizeof(S); ++i)
+            v[i] = value;
+        return v;
+    }
+}
+
+//! exp of each lane of x; always inlined, so that it takes its caller's instruction set.
+template <int N>
+[[gnu::always_inline]] inline typename Lanes<N>::D computeExpLanes(typename Lanes<N>::D x)
+{
+    using D = typename Lanes<N>::D;
+    using I = typename Lanes<N>::I;
+    const D lowest = splat<D>(kExpLowest), highest = splat<D>(kExpHighest);
+    const D low = x > lowest ? x : lowest; // NaN takes the lowest
+    const D clamped = low < highest ? low : highest;
+    const D shifted = clamped * splat<D>(kLog2E) + splat<D>(kShifter);
+    const D n = shifted - splat<D>(kShifter);
+    const D r = (clamped - n * splat<D>(kLn2Hi)) - n * splat<D>(kLn2Lo);
+    // Estrin's scheme: the Taylor terms in pairs, pairs of pairs, ... (depth 5, not Horner's 13).
+    const D r2 = r * r, r4 = r2 * r2, r8 = r4 * r4;
+    const auto pair = [&](double a, double b) { return splat<D>(a) + splat<D>(b) * r; };
+    const D p01 = pair(1.0, 1.0), p23 = pair(1.0 / 2, 1.0 / 6), p45 = pair(1.0 / 24, 1.0 / 120);
+    const D p67 = pair(1.0 / 720, 1.0 / 5040), p89 = pair(1.0 / 40320, 1.0 / 362880);
+    const D p1011 = pair(1.0 / 3628800, 1.0 / 39916800);
+    const D p1213 = pair(1.0 / 479001600, 1.0 / 6227020800.0);
+    const D low8 = (p01 + p23 * r2) + (p45 + p67 * r2) * r4;
+    const D high8 = (p89 + p1011 * r2) + p1213 * r4;
+    const D p = low8 + high8 * r8;
+    const I exponent = std::bit_cast<I>(shifted) + splat<I>(kExponentBias);
+    return p * std::bit_cast<D>(exponent << 52) * splat<D>(kUnscale);
+}
+
 } // namespace
 
 double computeExpNonPositive(double x)
 {
-    // Each step as evaluateSkyLobes's two-lane one takes it, so that both give the same bits.
-    const double low = x > kExpLowest ? x : kExpLowest;
-    const double clamped = low < kExpHighest ? low : kExpHighest;
-    const double shifted = clamped * kLog2E + kShifter;
-    const double n = shifted - kShifter;
-    const double r = (clamped - n * kLn2Hi) - n * kLn2Lo;
-    double p = kTaylor[13];
-    for (int i = 12; i >= 0; --i)
-        p = p * r + kTaylor[i];
-    const std::int64_t exponent = std::bit_cast<std::int64_t>(shifted) + kExponentBias;
-    return p * std::bit_cast<double>(std::uint64_t(exponent) << 52) * kUnscale;
+    return computeExpLanes<1>(x);
 }
 
 namespace {
 
-// The cone directions by coordinate, two lobes per SSE2 register.
+// The cone directions by coordinate, for the lanes of evaluateSkyLobes.
 struct ConeAxes {
-    alignas(16) double x[kConeDirectionCount];
-    alignas(16) double y[kConeDirectionCount];
-    alignas(16) double z[kConeDirectionCount];
+    alignas(32) double x[kConeDirectionCount];
+    alignas(32) double y[kConeDirectionCount];
+    alignas(32) double z[kConeDirectionCount];
     ConeAxes()
     {
         for (int i = 0; i < kConeDirectionCount; ++i) {
@@ -130,91 +166,72 @@ struct ConeAxes {
 };
 const ConeAxes kConeAxes;
 
-} // namespace
-
-#if defined(__x86_64__)
-namespace {
-
-// Four lobes at a time where the CPU has AVX2 (chosen at run time: the build targets baseline
-// x86-64). Every lane takes computeExpNonPositive's steps, so the bits are the same as SSE2's.
-__attribute__((target("avx2"))) void evaluateSkyLobesAvx2(const glm::dvec3& toSky, double sharpness,
-                                                          double values[kConeDirectionCount])
+template <int N>
+[[gnu::always_inline]] inline void evaluateSkyLobesIn(const glm::dvec3& toSky, double sharpness,
+                                                      double values[kConeDirectionCount])
 {
-    const __m256d dx = _mm256_set1_pd(toSky.x), dy = _mm256_set1_pd(toSky.y),
-                  dz = _mm256_set1_pd(toSky.z);
-    const __m256d k = _mm256_set1_pd(sharpness), one = _mm256_set1_pd(1.0);
-    const __m256d shifter = _mm256_set1_pd(kShifter);
-    for (int i = 0; i < kConeDirectionCount; i += 4) {
+    using D = typename Lanes<N>::D;
+    const D dx = splat<D>(toSky.x), dy = splat<D>(toSky.y), dz = splat<D>(toSky.z);
+    const D k = splat<D>(sharpness), one = splat<D>(1.0);
+    // All the lobes' lanes first, so that their exponentials overlap.
+    D x[kConeDirectionCount / N];
+    for (int i = 0; i < kConeDirectionCount / N; ++i) {
+        D ax, ay, az;
+        std::memcpy(&ax, kConeAxes.x + N * i, sizeof(D));
+        std::memcpy(&ay, kConeAxes.y + N * i, sizeof(D));
+        std::memcpy(&az, kConeAxes.z + N * i, sizeof(D));
         // glm::dot's order of operations: x, then y, then z (no fused multiply-adds).
-        const __m256d cosine =
-            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(dx, _mm256_load_pd(kConeAxes.x + i)),
-                                        _mm256_mul_pd(dy, _mm256_load_pd(kConeAxes.y + i))),
-                          _mm256_mul_pd(dz, _mm256_load_pd(kConeAxes.z + i)));
-        const __m256d x = _mm256_mul_pd(k, _mm256_sub_pd(cosine, one));
-        const __m256d clamped = _mm256_min_pd(_mm256_max_pd(x, _mm256_set1_pd(kExpLowest)),
-                                              _mm256_set1_pd(kExpHighest));
-        const __m256d shifted =
-            _mm256_add_pd(_mm256_mul_pd(clamped, _mm256_set1_pd(kLog2E)), shifter);
-        const __m256d n = _mm256_sub_pd(shifted, shifter);
-        const __m256d r =
-            _mm256_sub_pd(_mm256_sub_pd(clamped, _mm256_mul_pd(n, _mm256_set1_pd(kLn2Hi))),
-                          _mm256_mul_pd(n, _mm256_set1_pd(kLn2Lo)));
-        __m256d p = _mm256_set1_pd(kTaylor[13]);
-        for (int t = 12; t >= 0; --t)
-            p = _mm256_add_pd(_mm256_mul_pd(p, r), _mm256_set1_pd(kTaylor[t]));
-        const __m256i exponent =
-            _mm256_add_epi64(_mm256_castpd_si256(shifted), _mm256_set1_epi64x(kExponentBias));
-        const __m256d scale = _mm256_castsi256_pd(_mm256_slli_epi64(exponent, 52));
-        _mm256_storeu_pd(values + i,
-                         _mm256_mul_pd(_mm256_mul_pd(p, scale), _mm256_set1_pd(kUnscale)));
+        x[i] = k * ((dx * ax + dy * ay + dz * az) - one);
+    }
+    for (int i = 0; i < kConeDirectionCount / N; ++i) {
+        const D e = computeExpLanes<N>(x[i]);
+        std::memcpy(values + N * i, &e, sizeof(D));
     }
 }
 
+#if defined(__x86_64__)
+// Four lobes at a time where the CPU has AVX2, chosen at run time (the build targets baseline
+// x86-64, whose SSE2 takes two).
+__attribute__((target("avx2"))) void evaluateSkyLobesAvx2(const glm::dvec3& toSky, double sharpness,
+                                                          double values[kConeDirectionCount])
+{
+    evaluateSkyLobesIn<4>(toSky, sharpness, values);
+}
+
 const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+#endif
 
 } // namespace
-#endif
 
 void evaluateSkyLobes(const glm::dvec3& toSky, double sharpness, double values[kConeDirectionCount])
 {
 #if defined(__x86_64__)
-    if (kHasAvx2) {
+    if (kHasAvx2)
+        return evaluateSkyLobesAvx2(toSky, sharpness, values);
+#endif
+    evaluateSkyLobesIn<2>(toSky, sharpness, values);
+}
+
+bool evaluateSkyLobesInLanes(int lanes, const glm::dvec3& toSky, double sharpness,
+                             double values[kConeDirectionCount])
+{
+    switch (lanes) {
+    case 1:
+        evaluateSkyLobesIn<1>(toSky, sharpness, values);
+        return true;
+    case 2:
+        evaluateSkyLobesIn<2>(toSky, sharpness, values);
+        return true;
+#if defined(__x86_64__)
+    case 4:
+        if (!kHasAvx2)
+            return false;
         evaluateSkyLobesAvx2(toSky, sharpness, values);
-        return;
-    }
+        return true;
 #endif
-#if defined(__SSE2__)
-    // Two lobes at a time; the compiler keeps a scalar loop (a libm call would stop it anyway).
-    const __m128d dx = _mm_set1_pd(toSky.x), dy = _mm_set1_pd(toSky.y), dz = _mm_set1_pd(toSky.z);
-    const __m128d k = _mm_set1_pd(sharpness), one = _mm_set1_pd(1.0);
-    const __m128d shifter = _mm_set1_pd(kShifter);
-    for (int i = 0; i < kConeDirectionCount; i += 2) {
-        // glm::dot's order of operations: x, then y, then z.
-        const __m128d cosine = _mm_add_pd(_mm_add_pd(_mm_mul_pd(dx, _mm_load_pd(kConeAxes.x + i)),
-                                                     _mm_mul_pd(dy, _mm_load_pd(kConeAxes.y + i))),
-                                          _mm_mul_pd(dz, _mm_load_pd(kConeAxes.z + i)));
-        const __m128d x = _mm_mul_pd(k, _mm_sub_pd(cosine, one));
-        const __m128d clamped =
-            _mm_min_pd(_mm_max_pd(x, _mm_set1_pd(kExpLowest)), _mm_set1_pd(kExpHighest));
-        const __m128d shifted = _mm_add_pd(_mm_mul_pd(clamped, _mm_set1_pd(kLog2E)), shifter);
-        const __m128d n = _mm_sub_pd(shifted, shifter);
-        const __m128d r = _mm_sub_pd(_mm_sub_pd(clamped, _mm_mul_pd(n, _mm_set1_pd(kLn2Hi))),
-                                     _mm_mul_pd(n, _mm_set1_pd(kLn2Lo)));
-        __m128d p = _mm_set1_pd(kTaylor[13]);
-        for (int t = 12; t >= 0; --t)
-            p = _mm_add_pd(_mm_mul_pd(p, r), _mm_set1_pd(kTaylor[t]));
-        const __m128i exponent =
-            _mm_add_epi64(_mm_castpd_si128(shifted), _mm_set1_epi64x(kExponentBias));
-        const __m128d scale = _mm_castsi128_pd(_mm_slli_epi64(exponent, 52));
-        _mm_storeu_pd(values + i, _mm_mul_pd(_mm_mul_pd(p, scale), _mm_set1_pd(kUnscale)));
+    default:
+        return false;
     }
-#else
-    for (int i = 0; i < kConeDirectionCount; ++i) {
-        const double cosine =
-            toSky.x * kConeAxes.x[i] + toSky.y * kConeAxes.y[i] + toSky.z * kConeAxes.z[i];
-        values[i] = computeExpNonPositive(sharpness * (cosine - 1.0));
-    }
-#endif
 }
 
 glm::vec3 Sky::sumLobes(const double values[kConeDirectionCount]) const

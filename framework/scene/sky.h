@@ -29,6 +29,10 @@ double integrateSphericalGaussian(double sharpness);
 //! both take their lobes from here, so that they agree to the bit.
 void evaluateSkyLobes(const glm::dvec3& toSky, double sharpness,
                       double values[kConeDirectionCount]);
+//! evaluateSkyLobes in `lanes` lanes (1, 2, or 4 where the CPU has AVX2); false where that width
+//! is not available. For tests: every width gives the same bits.
+bool evaluateSkyLobesInLanes(int lanes, const glm::dvec3& toSky, double sharpness,
+                             double values[kConeDirectionCount]);
 //! exp(x) for x <= 1 to within 2 ulp of libm's (subnormals and 0 as libm rounds them); for x > 1
 //! it returns e. Without calls, so that evaluateSkyLobes can take it two lanes at a time.
 double computeExpNonPositive(double x);

@@ -141,7 +141,8 @@ TEST(Sky, ExpNonPositiveIsLibmsToTwoUlp)
 }
 
 // Whichever vector width the CPU gives evaluateSkyLobes, every lobe is computeExpNonPositive's
-// bits, also for sharpness so large or small that the exponent leaves the exponential's range.
+// bits, also for sharpness so large or small that the exponent leaves the exponential's range;
+// so are the widths this CPU does not pick (1, 2 and, with AVX2, 4 lanes).
 TEST(Sky, LobesAreTheScalarExponentialToTheBit)
 {
     const double sharpnesses[] = {1e-30, 0.01, 3.0, 4.0, 50.0, 1e4, 3.4e38};
@@ -160,6 +161,18 @@ TEST(Sky, LobesAreTheScalarExponentialToTheBit)
                           std::bit_cast<std::uint64_t>(expected))
                     << "direction " << j << ", sharpness " << k << ", lobe " << i;
                 ASSERT_LE(values[i], std::exp(1e-12 * k) * (1.0 + 1e-15));
+            }
+            for (const int lanes : {1, 2, 4}) {
+                double other[kConeDirectionCount];
+                if (!evaluateSkyLobesInLanes(lanes, d, k, other)) {
+                    ASSERT_EQ(lanes, 4) << "1 and 2 lanes exist everywhere";
+                    continue;
+                }
+                for (int i = 0; i < kConeDirectionCount; ++i)
+                    ASSERT_EQ(std::bit_cast<std::uint64_t>(other[i]),
+                              std::bit_cast<std::uint64_t>(values[i]))
+                        << lanes << " lanes, direction " << j << ", sharpness " << k << ", lobe "
+                        << i;
             }
         }
     }
