@@ -33,7 +33,7 @@ void evaluateSkyLobes(const glm::dvec3& toSky, double sharpness,
 //! is not available. For tests: every width gives the same bits.
 bool evaluateSkyLobesInLanes(int lanes, const glm::dvec3& toSky, double sharpness,
                              double values[kConeDirectionCount]);
-//! exp(x) for x <= 1 to within 2 ulp of libm's (subnormals and 0 as libm rounds them); for x > 1
+//! exp(x) for x <= 1 to within 1 ulp of libm's (subnormals and 0 as libm rounds them); for x > 1
 //! it returns e. Without calls, so that evaluateSkyLobes can take it two lanes at a time.
 double computeExpNonPositive(double x);
 
