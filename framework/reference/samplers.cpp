@@ -250,16 +250,12 @@ SkyLobeSampler::SkyLobeSampler(const scene::Sky& sky)
     for (const auto& peak : sky.lobes)
         weights.push_back(std::max(0.0, computeLuminance(glm::dvec3(peak))) * integral);
     mLobes = DiscreteDistribution(weights);
-    for (const auto& axis : scene::getConeDirections()) {
+    for (const auto& axis : scene::getConeDirections())
         mFrames.push_back(Frame::fromNormal(glm::normalize(axis)));
-        mAxes.push_back(axis);
-    }
-    for (std::size_t i = 0; i < mAxes.size(); ++i)
+    for (std::size_t i = 0; i < mFrames.size(); ++i)
         mPmf[i] = mLobes.pmf(i); // 0 for a black lobe: its term drops out of the pdf
-    if (mLobes.empty()) {
+    if (mLobes.empty())
         mFrames.clear();
-        mAxes.clear();
-    }
 }
 
 glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
@@ -272,8 +268,8 @@ glm::dvec3 SkyLobeSampler::sample(const glm::dvec2& u) const
 double SkyLobeSampler::evaluate(const glm::dvec3& direction, const scene::Sky& sky,
                                 glm::dvec3& radiance) const
 {
-    // The lobes as scene::Sky::radiance takes them (its axes, its sharpness), so that the radiance
-    // keeps its bits; the pdf's axes agree with the normalised frames' to an ulp.
+    // The lobes as scene::Sky::radiance takes them (its sharpness), so that the radiance keeps its
+    // bits; the cone axes agree with the sampling frames' normalised ones to an ulp.
     double values[scene::kConeDirectionCount];
     scene::evaluateSkyLobes(direction, double(sky.sharpness), values);
     radiance = glm::dvec3(sky.sumLobes(values));
@@ -289,8 +285,8 @@ double SkyLobeSampler::pdf(const glm::dvec3& direction) const
 
 double SkyLobeSampler::sumPdf(const double values[scene::kConeDirectionCount]) const
 {
-    double p = 0.0;
-    for (std::size_t i = 0; i < mAxes.size(); ++i)
+    double p = 0.0; // 0 for an inactive sampler: its pick probabilities are 0
+    for (std::size_t i = 0; i < mPmf.size(); ++i)
         p += mPmf[i] * (mNormalise * values[i]);
     return p;
 }

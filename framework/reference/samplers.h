@@ -110,7 +110,6 @@ private:
 
     DiscreteDistribution mLobes;
     std::vector<Frame> mFrames;
-    std::vector<glm::dvec3> mAxes; //!< the lobes' axes as scene::Sky's radiance takes them
     std::array<double, scene::kConeDirectionCount> mPmf{}; //!< each lobe's pick probability
     double mSharpness = 0.0;
     double mExpm1 = 0.0;     //!< expm1(-2 k), shared by every lobe's sample

@@ -199,7 +199,11 @@ __attribute__((target("avx2"))) void evaluateSkyLobesAvx2(const glm::dvec3& toSk
     evaluateSkyLobesIn<4>(toSky, sharpness, values);
 }
 
-const bool kHasAvx2 = __builtin_cpu_supports("avx2");
+// Read during static initialisation: __builtin_cpu_init first, as GCC asks of such callers.
+const bool kHasAvx2 = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2") != 0;
+}();
 #endif
 
 } // namespace
