@@ -265,6 +265,25 @@ private:
             }
     }
 
+    //! The largest of the ops' gradient bounds over the samples [first, last] (+inf for an
+    //! empty list or one with no bound known): what the leaf's proofs scale distances by.
+    double getLipschitzConstant(const std::vector<Op>& ops, const glm::ivec3& first,
+                                const glm::ivec3& last, Counters& c) const
+    {
+        if (ops.empty())
+            return kInf;
+        const glm::dvec3 lo = getSamplePosition(grid, first.x, first.y, first.z);
+        const glm::dvec3 hi = getSamplePosition(grid, last.x, last.y, last.z);
+        double l = 1.0;
+        for (const Op& op : ops) {
+            if (isLipschitzPrimitive(*op.edit))
+                continue; // 1, nothing computed
+            ++c.boundEvaluations;
+            l = std::max(l, boundLipschitzConstant(*op.edit, lo, hi));
+        }
+        return l;
+    }
+
     void evaluateLeaf(const glm::ivec3& first, const glm::ivec3& last, const std::vector<Op>& ops,
                       const std::vector<const CsgEdit*>& candidates, Counters& c,
                       const FaceSeeds* seeds = nullptr)
@@ -282,11 +301,9 @@ private:
                 for (int x = first.x; x <= last.x; ++x)
                     positions[i++] = getSamplePosition(grid, x, y, z);
         std::size_t evaluated = count;
-        const bool lipschitz = !outputs.materials && !ops.empty() &&
-                               std::all_of(ops.begin(), ops.end(), [](const Op& op) {
-                                   return isLipschitzPrimitive(*op.edit);
-                               });
-        if (!lipschitz) {
+        const double lipschitz =
+            outputs.materials ? kInf : getLipschitzConstant(ops, first, last, c);
+        if (!(lipschitz < kInf)) {
             // Edit-major: one primitive over the whole block, the coherent branch on primitive
             // type that the talk's 4x4x4 blocks are for.
             for (const Op& op : ops) {
@@ -296,9 +313,9 @@ private:
                         applyOp(op.kind, values[j], e.evaluatePrimitive(positions[j]), e.blend);
             }
         } else {
-            evaluated = evaluateLipschitzLeaf(n, ops, positions,
-                                              {band, grid.spacing + margin, reach, margin}, seeds,
-                                              values, work.bound, work.known);
+            evaluated = evaluateLipschitzLeaf(
+                n, ops, positions, {band, grid.spacing + margin, reach, margin, lipschitz}, seeds,
+                values, work.bound, work.known);
         }
         c.sampleEvaluations += evaluated * ops.size();
         c.samplesEvaluated += evaluated;
@@ -391,7 +408,7 @@ private:
             Interval d{0.0, 0.0};
             std::vector<Op> ops;
             int state = -1; // -1 outside the grid, 0 evaluated, 1 empty, 2 full
-            bool lipschitz = false;
+            bool exact = false; // the list holds exact distances only (1-Lipschitz)
         };
         std::array<Child, 64> children;
         const int size = cellSamples[level];
@@ -409,9 +426,9 @@ private:
             ch.lo = getSamplePosition(grid, ch.first.x, ch.first.y, ch.first.z);
             ch.hi = getSamplePosition(grid, boxLast.x, boxLast.y, boxLast.z);
             ch.d = pruneOps(parentOps, ch.lo, ch.hi, ch.ops, c);
-            ch.lipschitz = !outputs.materials && !ch.ops.empty() &&
-                           std::all_of(ch.ops.begin(), ch.ops.end(),
-                                       [](const Op& op) { return isLipschitzPrimitive(*op.edit); });
+            ch.exact = !outputs.materials && !ch.ops.empty() &&
+                       std::all_of(ch.ops.begin(), ch.ops.end(),
+                                   [](const Op& op) { return isLipschitzPrimitive(*op.edit); });
             if (ch.d.lo > band) {
                 ++c.cellsEmpty[level];
                 fill(ch.first, ch.last, band);
@@ -433,7 +450,9 @@ private:
             if (outputs.materials)
                 pruneCandidates(parentCandidates, ch.lo, ch.hi, ch.d, candidates, c);
             FaceSeeds seeds;
-            if (ch.lipschitz) {
+            // Seeds cross the gap between two siblings' samples, outside both boxes: only where
+            // the field is 1-Lipschitz everywhere, both lists of exact distances.
+            if (ch.exact) {
                 const glm::ivec3 at(i % 4, (i / 4) % 4, i / 16);
                 const int stride[3] = {1, 4, 16};
                 for (int axis = 0; axis < 3; ++axis)
@@ -441,7 +460,7 @@ private:
                         if (at[axis] + (side ? 1 : -1) < 0 || at[axis] + (side ? 1 : -1) > 3)
                             continue; // a cousin, in another cell: not known here
                         const Child& n = children[std::size_t(i + (side ? 1 : -1) * stride[axis])];
-                        if (!n.lipschitz || (n.state != 1 && n.state != 2))
+                        if (!n.exact || (n.state != 1 && n.state != 2))
                             continue;
                         seeds.bound[std::size_t(2 * axis + side)] = n.state == 1 ? n.d.lo : -n.d.hi;
                         seeds.sign[std::size_t(2 * axis + side)] = n.state == 1 ? 1.0 : -1.0;

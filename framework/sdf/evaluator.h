@@ -28,7 +28,7 @@
 //     bound s(centre) +- half-diagonal for exact distances, intersected with interval arithmetic
 //     in the primitive's frame (box, rounded box, cylinder, capsule, torus, sphere), and interval
 //     arithmetic alone for the ellipsoid (whose value is only a distance bound, not 1-Lipschitz,
-//     so Lipschitz culling would not be safe; primitive_bounds.h gives the derivation).
+//     so the half-diagonal bound would not be safe; primitive_bounds.h gives the derivation).
 //     The talk evaluates max-norm distances so that a cell is a max-norm ball; with the exact L2
 //     distances of scene/csg.h the cell is bounded by the ball of its half-diagonal instead.
 //   - With D the interval of the field before an edit and S the primitive's, an edit is dropped
@@ -52,6 +52,11 @@
 //     each also taking the bound of its neighbours one spacing back. On the gallery at 256 the
 //     culling rate is 0.4-1.2 points from the ideal (was 1.2-2.5 with the +x+y+z sweep alone,
 //     which saved 0.5-1.5 over none), at the same wall time.
+//   - A leaf with an ellipsoid in its list does the same with its distances scaled by a bound L
+//     of the field's gradient over the leaf (primitive_bounds.h: boundLipschitzConstant, 1 plus
+//     a term that vanishes at the ellipsoid's surface; the largest over the list's ops), without
+//     the siblings' face bounds (those cross the gap between two leaves, where no L is known).
+//     A list with no bound known (a box around an ellipsoid's centre) evaluates every sample.
 //   - Bounds are widened by a margin of 1e-10 x the largest coordinate or size involved, which
 //     absorbs floating-point rounding with a wide safety factor.
 //

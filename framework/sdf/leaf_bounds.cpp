@@ -18,7 +18,8 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
 {
     const std::size_t count = values.size();
     const double band = limits.band;
-    const double step = limits.step;
+    const double lipschitz = limits.lipschitz;
+    const double step = limits.step * lipschitz;
     const std::vector<double>& reach = limits.reach;
     const std::size_t strides[3] = {1, std::size_t(n.x), std::size_t(n.x) * std::size_t(n.y)};
     const auto evaluate = [&](std::size_t i) {
@@ -136,8 +137,9 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
                 double sign = values[i] < 0.0 ? -1.0 : 1.0;
                 for (int k = 0; k < useful; ++k) {
                     const glm::ivec3 d = at - cornerAt[std::size_t(k)];
-                    const double b = bound[corner[std::size_t(k)]] -
-                                     reach[std::size_t(d.x * d.x + d.y * d.y + d.z * d.z)];
+                    const double b =
+                        bound[corner[std::size_t(k)]] -
+                        lipschitz * reach[std::size_t(d.x * d.x + d.y * d.y + d.z * d.z)];
                     if (b > lowest) {
                         lowest = b;
                         sign = values[corner[std::size_t(k)]] < 0.0 ? -1.0 : 1.0;

@@ -38,12 +38,17 @@ struct LeafBand {
     const std::vector<double>& reach;
     //! The evaluator's rounding margin (world units), kept between a bound and the band.
     double margin = 0.0;
+    //! A bound of the field's gradient over the leaf (boundLipschitzConstant of its ops, the
+    //! largest: soft and hard min and max keep the largest of their inputs'); the distances
+    //! above are multiplied by it. 1 where the list holds exact distances only.
+    double lipschitz = 1.0;
 };
 
-//! The leaf's values where its pruned list holds exact distances only; returns the samples
-//! evaluated. Samples the band cannot reach are not evaluated: every op (hard or soft min and
-//! max, negation) keeps a field of exact distances 1-Lipschitz, so a sample at distance r from
-//! a sample of value v has |value| >= |v| - r and, while that exceeds the band, the sign of v:
+//! The leaf's values where its pruned list has a known gradient bound L (limits.lipschitz: 1 for
+//! exact distances); returns the samples evaluated. Samples the band cannot reach are not
+//! evaluated: every op (hard or soft min and max, negation) keeps a field of exact distances
+//! 1-Lipschitz (L-Lipschitz with the ellipsoid's bound), so a sample at distance r from
+//! a sample of value v has |value| >= |v| - L r and, while that exceeds the band, the sign of v:
 //! its clamped value (+-band) is known without evaluating it. Seeds are the leaf's 8 corners,
 //! evaluated first: each bounds every sample of the leaf by its ball (a corner far outside
 //! the band clears most of the leaf), unless a tight sibling's bound (`seeds`, may be null)

@@ -140,6 +140,39 @@ bool isLipschitzPrimitive(const scene::CsgEdit& edit)
            edit.rounding >= 0.0 && std::isfinite(edit.rounding);
 }
 
+double boundLipschitzConstant(const scene::CsgEdit& edit, const glm::dvec3& boxLo,
+                              const glm::dvec3& boxHi)
+{
+    constexpr double kNone = std::numeric_limits<double>::infinity();
+    if (isLipschitzPrimitive(edit))
+        return 1.0;
+    const glm::dvec3 s = edit.size;
+    if (edit.shape != scene::CsgShape::Ellipsoid || !isUnitRotation(edit.rotation) ||
+        !(s.x > 0.0 && s.y > 0.0 && s.z > 0.0) || !std::isfinite(s.x + s.y + s.z))
+        return kNone;
+    // f = rho (k0 - 1) with rho = k0 / k1 (q = p / s, r = p / s^2, w = p / s^4 componentwise;
+    // k0 = |q|, k1 = |r|). grad k0 = r / k0, so rho grad k0 = r / k1, a unit vector, and
+    //   grad f = r / k1 + (k0 - 1) grad rho,  |grad f| <= 1 + |k0 - 1| |grad rho|.
+    // rho is constant along rays from the centre; grad rho = (r / k1 - rho^2 w / k1) / k0.
+    // Writing t_i = q_i^2 / k0^2 (weights summing to 1) and Z_i = s_i^-2 / sum_j t_j s_j^-2
+    // (mean 1 under t, within [1/R^2, R^2]), |grad rho|^2 = E_t[Z (Z - 1)^2] / k0^2
+    // <= R^2 Var_t(Z) / k0^2 <= R^2 (R^2 - 1)(1 - 1/R^2) / k0^2 = (R^2 - 1)^2 / k0^2, the
+    // variance bounded by the Bhatia-Davis inequality [Bhatia & Davis 2000]. Hence
+    //   |grad f| <= 1 + |1 - 1/k0| (R^2 - 1),
+    // and |1 - 1/k0| is largest at an end of the box's range of k0.
+    const glm::dvec3 c = 0.5 * (boxLo + boxHi);
+    const glm::dvec3 half = 0.5 * (boxHi - boxLo);
+    const LocalRange range = getLocalRange(edit, c, half);
+    const double k0Lo = glm::length(range.minAbs / s), k0Hi = glm::length(range.maxAbs / s);
+    if (!(k0Lo > 0.0) || !std::isfinite(k0Hi))
+        return kNone;
+    const double ratio = std::max({s.x, s.y, s.z}) / std::min({s.x, s.y, s.z});
+    const double farthest = std::max(std::abs(1.0 - 1.0 / k0Lo), std::abs(1.0 - 1.0 / k0Hi));
+    // Rounded up well past the relative rounding of the terms (a few ulps each).
+    const double l = (1.0 + farthest * (ratio * ratio - 1.0)) * (1.0 + 1e-9);
+    return std::isfinite(l) ? l : kNone;
+}
+
 Interval boundPrimitive(const scene::CsgEdit& edit, const glm::dvec3& boxLo, const glm::dvec3& boxHi,
                         double margin)
 {

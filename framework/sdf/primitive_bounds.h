@@ -39,4 +39,13 @@ Interval boundPrimitive(const scene::CsgEdit& edit, const glm::dvec3& boxLo, con
 //! boundPrimitive uses the Lipschitz bound).
 bool isLipschitzPrimitive(const scene::CsgEdit& edit);
 
+//! An upper bound L of |grad edit.evaluatePrimitive| over the box [boxLo, boxHi], so that two
+//! points p, q of the box have values within L |p - q|: 1 for the exact distances
+//! (isLipschitzPrimitive). For the ellipsoid's k0 (k0 - 1) / k1 (see the top of this file),
+//! 1 + max|1 - 1/k0| (R^2 - 1) over the box, R = max(size) / min(size): near its surface
+//! (k0 ~ 1) the bound is barely above 1, and it grows without limit towards the centre, where
+//! +inf is returned (as for anything else with no bound known).
+double boundLipschitzConstant(const scene::CsgEdit& edit, const glm::dvec3& boxLo,
+                              const glm::dvec3& boxHi);
+
 } // namespace rtlab::sdf
