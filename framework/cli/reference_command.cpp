@@ -85,7 +85,14 @@ int referenceCommand(const ReferenceOptions& options)
                 reference::measureRayThroughput(renderScene, gbuffer, settings, options.throughputSamples);
             fmt::print("throughput ({} threads, {} samples per pixel, same run, medians of {} alternating rounds):\n",
                        t.threads, options.throughputSamples, t.repeats);
-            fmt::print("  reference estimator  {:8.2f} Mrays/s\n", t.referenceMraysPerSecond);
+            fmt::print("  reference estimator  {:8.2f} Mrays/s  ({:.3g} M samples/s, {:.2f} rays "
+                       "per sample)\n",
+                       t.referenceMraysPerSecond,
+                       t.referenceSeconds > 0
+                           ? double(t.referenceSamples) * 1e-6 / t.referenceSeconds
+                           : 0.0,
+                       t.referenceSamples > 0 ? double(t.referenceRays) / double(t.referenceSamples)
+                                              : 0.0);
             fmt::print("  raw rtcIntersect1    {:8.2f} Mrays/s  (reference / raw = {:.2f})\n",
                        t.rawIntersectMraysPerSecond, t.referenceMraysPerSecond / t.rawIntersectMraysPerSecond);
             fmt::print("  raw rtcOccluded1     {:8.2f} Mrays/s\n", t.rawOccludedMraysPerSecond);

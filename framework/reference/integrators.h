@@ -97,11 +97,22 @@ std::uint32_t evaluateOcclusionBatch(const TraceContext& context, const SurfaceP
                                      std::uint32_t count, SampleValue* values);
 //! direct, indirect, full: E/pi per colour (before albedo). Returns the number of rays traced.
 //! `streams` (optional): sequence.getStream(p) for the pairs p < streamCount, which a batch of
-//! the pixel's samples computes once; the samples are the same bits either way.
+//! the pixel's samples computes once; `firstVertexPointLights` (optional): what
+//! evaluateFirstVertexPointLights computed for the point, when it says it is shared. The samples
+//! are the same bits either way.
 std::uint32_t evaluateLightSample(const TraceContext& context, const SurfacePoint& point,
                                   const PixelSequence& sequence, std::uint32_t index,
                                   SampleValue& value, const SobolStream* streams = nullptr,
-                                  std::uint32_t streamCount = 0);
+                                  std::uint32_t streamCount = 0,
+                                  const glm::dvec3* firstVertexPointLights = nullptr);
+//! The point lights' term at the G-buffer point itself (the path's first vertex), where every
+//! point light is evaluated each sample (few lights, no pick): it uses no sample dimension, so
+//! every sample of the pixel computes the same value with the same shadow rays. `shared` says
+//! whether it applies (and the quantity keeps that light); then a batch of the pixel's samples
+//! traces those rays once and passes `sum` to evaluateLightSample. Returns the rays traced.
+std::uint32_t evaluateFirstVertexPointLights(const TraceContext& context, const SurfacePoint& point,
+                                             const PixelSequence& sequence, glm::dvec3& sum,
+                                             bool& shared);
 //! The pairs of the first vertices of a path, whose streams a batch computes once.
 constexpr std::uint32_t kLightStreamsPerBatch = 24;
 

@@ -43,17 +43,45 @@ struct Vertex {
     glm::vec3 origin{0.0f};          //!< position offset along the geometric normal
 };
 
+//! The G-buffer point as the path's first vertex.
+Vertex makeFirstVertex(const SurfacePoint& point, double rayEpsilon)
+{
+    Vertex v;
+    v.position = point.position;
+    v.shadingNormal = point.normal;
+    v.geometricNormal = point.normal; // the G-buffer has no other
+    v.origin = glm::vec3(v.position + rayEpsilon * v.geometricNormal);
+    return v;
+}
+
+//! Whether light arriving directly at the G-buffer point (bounce 0) is kept.
+bool recordsFirstVertex(Quantity q)
+{
+    return q != Quantity::Indirect;
+}
+
 class LightPathTracer {
 public:
     LightPathTracer(const TraceContext& context, const PixelSequence& sequence, std::uint32_t index,
-                    const SobolStream* streams, std::uint32_t streamCount)
+                    const SobolStream* streams, std::uint32_t streamCount,
+                    const glm::dvec3* firstVertexPointLights = nullptr)
         : mContext(context), mLights(*context.lights), mEmbree(*context.embree),
-          mSequence(sequence), mStreams(streams), mStreamCount(streamCount), mIndex(index)
+          mSequence(sequence), mStreams(streams), mStreamCount(streamCount), mIndex(index),
+          mFirstVertexPointLights(firstVertexPointLights)
     {
     }
 
     glm::dvec3 trace(const SurfacePoint& point);
     std::uint32_t getRayCount() const { return mRays; }
+    //! Every point light's term at `v` when all of them are evaluated (no pick): a sum that uses
+    //! no sample dimension, the same for every sample that starts at `v`.
+    glm::dvec3 sumAllPointLights(const Vertex& v)
+    {
+        glm::dvec3 sum(0.0);
+        for (std::size_t i = 0; i < mLights.getPointLights().size(); ++i)
+            sum += estimatePointLight(v, i, 1.0);
+        return sum;
+    }
 
 private:
     glm::dvec2 get2D(int vertex, std::uint32_t pair) const
@@ -82,6 +110,9 @@ private:
     const SobolStream* mStreams; //!< mSequence.getStream(p) for p < mStreamCount
     std::uint32_t mStreamCount;
     std::uint32_t mIndex;
+    //! sumAllPointLights at the first vertex, computed once for a batch of the pixel's samples
+    //! (same bits as computing it here); null: computed here.
+    const glm::dvec3* mFirstVertexPointLights;
     std::uint32_t mRays = 0;
 };
 
@@ -110,8 +141,9 @@ glm::dvec3 LightPathTracer::estimateDirect(int vertex, const Vertex& v)
     const std::size_t pointLights = mLights.getPointLights().size();
     if (pointLights > 0 && !mLights.pointLightPick.empty()) {
         if (mLights.evaluateAllPointLights) {
-            for (std::size_t i = 0; i < pointLights; ++i)
-                sum += estimatePointLight(v, i, 1.0);
+            // The sum starts from 0 either way, so the shared value is the same bits.
+            sum = vertex == 0 && mFirstVertexPointLights != nullptr ? *mFirstVertexPointLights
+                                                                    : sumAllPointLights(v);
         } else {
             const std::size_t i = mLights.pointLightPick.sample(get2D(vertex, kPairPointLight).x);
             sum += estimatePointLight(v, i, mLights.pointLightPick.pmf(i));
@@ -168,11 +200,7 @@ glm::dvec3 LightPathTracer::trace(const SurfacePoint& point)
     if (maxBounce < minBounce)
         return glm::dvec3(0.0); // indirect with 0 bounces
 
-    Vertex v;
-    v.position = point.position;
-    v.shadingNormal = point.normal;
-    v.geometricNormal = point.normal; // the G-buffer has no other
-    v.origin = glm::vec3(v.position + mContext.rayEpsilon * v.geometricNormal);
+    Vertex v = makeFirstVertex(point, mContext.rayEpsilon);
 
     glm::dvec3 sum(0.0);
     glm::dvec3 throughput(1.0); // product of the albedos of vertices 1..k (and roulette)
@@ -239,12 +267,28 @@ glm::dvec3 LightPathTracer::trace(const SurfacePoint& point)
 
 } // namespace
 
+std::uint32_t evaluateFirstVertexPointLights(const TraceContext& context, const SurfacePoint& point,
+                                             const PixelSequence& sequence, glm::dvec3& sum,
+                                             bool& shared)
+{
+    shared = context.lights->evaluateAllPointLights && !context.lights->getPointLights().empty() &&
+             !context.lights->pointLightPick.empty() && recordsFirstVertex(context.quantity);
+    if (!shared) {
+        sum = glm::dvec3(0.0);
+        return 0;
+    }
+    LightPathTracer tracer(context, sequence, 0, nullptr, 0);
+    sum = tracer.sumAllPointLights(makeFirstVertex(point, context.rayEpsilon));
+    return tracer.getRayCount();
+}
+
 std::uint32_t evaluateLightSample(const TraceContext& context, const SurfacePoint& point,
                                   const PixelSequence& sequence, std::uint32_t index,
                                   SampleValue& value, const SobolStream* streams,
-                                  std::uint32_t streamCount)
+                                  std::uint32_t streamCount,
+                                  const glm::dvec3* firstVertexPointLights)
 {
-    LightPathTracer tracer(context, sequence, index, streams, streamCount);
+    LightPathTracer tracer(context, sequence, index, streams, streamCount, firstVertexPointLights);
     const glm::dvec3 e = tracer.trace(point);
     value[0] = e.x;
     value[1] = e.y;

@@ -128,10 +128,16 @@ std::uint32_t PreparedReference::evaluateBatch(std::size_t pixel, std::uint32_t 
         std::array<SobolStream, kLightStreamsPerBatch> streams;
         for (std::uint32_t p = 0; p < kLightStreamsPerBatch; ++p)
             streams[p] = sequence.getStream(p);
-        std::uint32_t rays = 0;
+        // The point lights' shadow rays from the G-buffer point are the same for every sample:
+        // traced once for the batch.
+        glm::dvec3 pointLights(0.0);
+        bool shared = false;
+        std::uint32_t rays =
+            evaluateFirstVertexPointLights(mContext, mPoints[pixel], sequence, pointLights, shared);
         for (std::uint32_t i = 0; i < count; ++i)
             rays += evaluateLightSample(mContext, mPoints[pixel], sequence, first + i, values[i],
-                                        streams.data(), kLightStreamsPerBatch);
+                                        streams.data(), kLightStreamsPerBatch,
+                                        shared ? &pointLights : nullptr);
         return rays;
     }
     default:

@@ -188,6 +188,9 @@ struct RayThroughput {
     //! streams), each through the bare call it was traced with (rtcIntersect1 or rtcOccluded1).
     double replayMraysPerSecond = 0.0;
     std::uint64_t referenceRays = 0;
+    //! The estimator's samples per round (surface pixels x samples per pixel): rays per sample
+    //! differ between quantities and fall where rays shared by a pixel's samples are traced once.
+    std::uint64_t referenceSamples = 0;
     std::uint64_t rawRays = 0;
     std::uint64_t replayRays = 0;
     double referenceSeconds = 0.0;

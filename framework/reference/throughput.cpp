@@ -62,6 +62,8 @@ RayThroughput measureRayThroughput(const scene::RenderScene& scene, const scene:
         rule.channels = 1; // no early stop: the targets are 0
         rule.batchSize = s.batchSize;
         rule.maxSamples = s.maxSamples;
+        for (std::uint8_t active : prepared.getActive())
+            result.referenceSamples += active ? std::uint64_t(s.batchSize) : 0;
 
         const auto traceReference = [&] {
             const auto start = std::chrono::steady_clock::now();

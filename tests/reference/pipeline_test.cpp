@@ -121,6 +121,53 @@ TEST(ReferencePipeline, StreamedOcclusionBatchesEqualSingleSamples)
     }
 }
 
+// A batch of the light quantities traces the point lights' shadow rays from the G-buffer point
+// once (the same for every sample); every sample must still be the one evaluateLightSample gives
+// alone, and the rays saved exactly the repeats of those.
+TEST(ReferencePipeline, LightBatchesShareTheFirstVertexPointLightsAndEqualSingleSamples)
+{
+    const Room room;
+    ASSERT_FALSE(room.scene.pointLights.empty());
+    for (Quantity q : {Quantity::Direct, Quantity::Indirect, Quantity::Full}) {
+        SCOPED_TRACE(getQuantityName(q));
+        const ReferenceSettings s = makeQuickSettings(q);
+        const PreparedReference prepared(room.scene, room.gbuffer, s);
+        int pixels = 0, litPixels = 0;
+        std::uint64_t saved = 0;
+        for (std::size_t pixel = 0; pixel < prepared.getActive().size(); pixel += 5) {
+            if (!prepared.getActive()[pixel])
+                continue;
+            ++pixels;
+            const std::uint32_t first = std::uint32_t(pixel % 3), count = 40;
+            std::vector<SampleValue> batch(count, SampleValue{});
+            const std::uint32_t batchRays =
+                prepared.evaluateBatch(pixel, first, count, batch.data());
+            std::uint32_t singleRays = 0;
+            for (std::uint32_t i = 0; i < count; ++i) {
+                SampleValue one{};
+                singleRays += prepared.evaluate(pixel, first + i, one);
+                for (int c = 0; c < kMaxChannels; ++c)
+                    ASSERT_EQ(batch[i][std::size_t(c)], one[std::size_t(c)])
+                        << pixel << " sample " << first + i;
+            }
+            ASSERT_LE(batchRays, singleRays);
+            // Each sample alone traces the shared rays too: count - 1 repeats of them are saved.
+            const std::uint32_t perSample = (singleRays - batchRays) / (count - 1);
+            EXPECT_EQ(singleRays - batchRays, perSample * (count - 1));
+            EXPECT_LE(perSample, room.scene.pointLights.size());
+            if (q == Quantity::Indirect) {
+                EXPECT_EQ(batchRays, singleRays); // light at the point itself is not kept
+            }
+            litPixels += perSample > 0 ? 1 : 0;
+            saved += singleRays - batchRays;
+        }
+        EXPECT_GT(pixels, 20);
+        if (q != Quantity::Indirect) {
+            EXPECT_GT(litPixels, pixels / 2) << saved; // most of the room faces its light
+        }
+    }
+}
+
 TEST(ReferencePipeline, ProgressiveStopsAtTheTargetOrTheCap)
 {
     const Room room;
