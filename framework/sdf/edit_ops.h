@@ -9,7 +9,9 @@
 
 #include <glm/vec3.hpp>
 
+#include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace rtlab::sdf::detail {
@@ -21,6 +23,10 @@ enum class OpKind : std::uint8_t { Add, Subtract, Intersect, Set, SetNegated };
 struct Op {
     const scene::CsgEdit* edit = nullptr;
     OpKind kind = OpKind::Add;
+    //! The primitive's value over the cell the list was pruned for (the evaluator's bound), or
+    //! no bound: what lets one sample skip the op (isUnchangedBy).
+    double lo = -std::numeric_limits<double>::infinity();
+    double hi = std::numeric_limits<double>::infinity();
 };
 
 //! The edits of `model` that apply at `frame`, in order.
@@ -42,6 +48,27 @@ inline double applyOp(OpKind kind, double d, double s, double blend)
         return -s;
     }
     return d;
+}
+
+//! Whether applyOp(op.kind, d, s, blend) returns d itself for every s in [op.lo, op.hi]: the
+//! soft min is the hard one once |a - b| >= k (scene::computeSmoothMin), and min(d, s) = d for
+//! s >= d. `margin` (>= 0) covers the rounding of the bound. A sample whose running value is d
+//! then needs no evaluation of the op, and its value keeps every bit.
+inline bool isUnchangedBy(const Op& op, double d, double margin)
+{
+    const double need = std::max(op.edit->blend, 0.0) + margin;
+    switch (op.kind) {
+    case OpKind::Add:
+        return op.lo - d >= need; // min(d, s)
+    case OpKind::Subtract:
+        return op.lo + d >= need; // max(d, -s)
+    case OpKind::Intersect:
+        return d - op.hi >= need; // max(d, s)
+    case OpKind::Set:
+    case OpKind::SetNegated:
+        return false;
+    }
+    return false;
 }
 
 //! The pruned field at p.

@@ -218,11 +218,11 @@ private:
                 continue;
             if (replaced) {
                 ops.clear();
-                ops.push_back({op.edit, replacement});
+                ops.push_back({op.edit, replacement, s.lo, s.hi});
                 d = combine(replacement, d, s, k);
                 continue;
             }
-            ops.push_back(op);
+            ops.push_back({op.edit, op.kind, s.lo, s.hi});
             d = combine(op.kind, d, s, k);
         }
         return d;
@@ -301,6 +301,7 @@ private:
                 for (int x = first.x; x <= last.x; ++x)
                     positions[i++] = getSamplePosition(grid, x, y, z);
         std::size_t evaluated = count;
+        std::uint64_t primitiveEvaluations = 0;
         const double lipschitz =
             outputs.materials ? kInf : getLipschitzConstant(ops, first, last, c);
         if (!(lipschitz < kInf)) {
@@ -308,16 +309,20 @@ private:
             // type that the talk's 4x4x4 blocks are for.
             for (const Op& op : ops) {
                 const CsgEdit& e = *op.edit;
-                for (std::size_t j = 0; j < count; ++j)
+                for (std::size_t j = 0; j < count; ++j) {
+                    if (isUnchangedBy(op, values[j], margin))
+                        continue; // this sample's value is already final for this op
                     values[j] =
                         applyOp(op.kind, values[j], e.evaluatePrimitive(positions[j]), e.blend);
+                    ++primitiveEvaluations;
+                }
             }
         } else {
             evaluated = evaluateLipschitzLeaf(
                 n, ops, positions, {band, grid.spacing + margin, reach, margin, lipschitz}, seeds,
-                values, work.bound, work.known);
+                values, work.bound, work.known, primitiveEvaluations);
         }
-        c.sampleEvaluations += evaluated * ops.size();
+        c.sampleEvaluations += primitiveEvaluations;
         c.samplesEvaluated += evaluated;
         ++c.leavesEvaluated;
         SampledField& f = *outputs.field;

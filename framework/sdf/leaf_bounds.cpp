@@ -14,7 +14,8 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& ops,
                                   const std::vector<glm::dvec3>& positions, const LeafBand& limits,
                                   const FaceSeeds* seeds, std::vector<double>& values,
-                                  std::vector<double>& bound, std::vector<std::uint8_t>& known)
+                                  std::vector<double>& bound, std::vector<std::uint8_t>& known,
+                                  std::uint64_t& primitiveEvaluations)
 {
     const std::size_t count = values.size();
     const double band = limits.band;
@@ -24,8 +25,12 @@ std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& op
     const std::size_t strides[3] = {1, std::size_t(n.x), std::size_t(n.x) * std::size_t(n.y)};
     const auto evaluate = [&](std::size_t i) {
         double v = kInf;
-        for (const Op& op : ops)
+        for (const Op& op : ops) {
+            if (isUnchangedBy(op, v, limits.margin))
+                continue;
             v = applyOp(op.kind, v, op.edit->evaluatePrimitive(positions[i]), op.edit->blend);
+            ++primitiveEvaluations;
+        }
         return v;
     };
     bound.assign(count, -kInf); // |value| (evaluated) or a lower bound of it

@@ -64,10 +64,13 @@ struct LeafBand {
 //!
 //! `n` is the leaf's sample count per axis; positions and values are in x-fastest order, values
 //! filled with the exact value of the evaluated samples and +-(a bound above the band) for the
-//! others; bound and known are scratch arrays (resized here).
+//! others; bound and known are scratch arrays (resized here). An evaluated sample skips the ops
+//! that provably leave its running value unchanged (isUnchangedBy); primitiveEvaluations is
+//! increased by the primitives evaluated.
 std::size_t evaluateLipschitzLeaf(const glm::ivec3& n, const std::vector<Op>& ops,
                                   const std::vector<glm::dvec3>& positions, const LeafBand& limits,
                                   const FaceSeeds* seeds, std::vector<double>& values,
-                                  std::vector<double>& bound, std::vector<std::uint8_t>& known);
+                                  std::vector<double>& bound, std::vector<std::uint8_t>& known,
+                                  std::uint64_t& primitiveEvaluations);
 
 } // namespace rtlab::sdf::detail

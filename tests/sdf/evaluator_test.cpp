@@ -5,6 +5,7 @@
 // tests are in evaluator_culling_test.cpp.
 
 #include "evaluator_test_support.h"
+#include "sdf/edit_ops.h"
 #include "sdf/primitive_bounds.h"
 
 #include <glm/geometric.hpp>
@@ -206,6 +207,37 @@ TEST(SdfEvaluator, PrimitiveGradientBoundsHoldBetweenPointsOfTheBox)
         1.03);
     EXPECT_EQ(boundLipschitzConstant(e, glm::dvec3(-0.1), glm::dvec3(0.1)),
               std::numeric_limits<double>::infinity());
+}
+
+TEST(SdfEvaluator, AnOpSkippedAtASampleLeavesItsValueBitIdentical)
+{
+    // isUnchangedBy: where it lets a sample skip an op, applying the op to any value s in the op's
+    // bound [lo, hi] returns the running value d, every bit; and it does skip where the op is
+    // far on the losing side. Values near the blend radius, hard (k = 0) and soft blends, d of
+    // both signs, +inf (an empty list so far).
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-3.0, 3.0);
+    scene::CsgEdit edit;
+    std::uint64_t skipped = 0, tried = 0;
+    for (int trial = 0; trial < 200000; ++trial) {
+        edit.blend = trial % 3 == 0 ? 0.0 : std::abs(u(rng)) * 0.5;
+        const detail::OpKind kind = detail::OpKind(trial % 3); // Add, Subtract, Intersect
+        const double lo = u(rng), hi = lo + std::abs(u(rng)) * 0.5;
+        const double d = trial % 101 == 0 ? std::numeric_limits<double>::infinity() : u(rng);
+        const detail::Op op{&edit, kind, lo, hi};
+        ++tried;
+        if (!detail::isUnchangedBy(op, d, 1e-12))
+            continue;
+        ++skipped;
+        for (double t : {0.0, 0.25, 0.5, 1.0}) {
+            const double s = t == 1.0 ? hi : lo + t * (hi - lo);
+            const double v = detail::applyOp(kind, d, s, edit.blend);
+            ASSERT_EQ(std::memcmp(&v, &d, sizeof v), 0)
+                << "kind " << int(kind) << " d " << d << " s " << s << " k " << edit.blend;
+        }
+    }
+    EXPECT_GT(skipped, tried / 10);
+    EXPECT_LT(skipped, tried);
 }
 
 TEST(SdfEvaluator, OutputIndependentOfThreadCount)
