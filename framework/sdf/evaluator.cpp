@@ -266,7 +266,8 @@ private:
     }
 
     //! The largest of the ops' gradient bounds over the samples [first, last] (+inf for an
-    //! empty list or one with no bound known): what the leaf's proofs scale distances by.
+    //! empty list, one with no bound known, or an ellipsoid without
+    //! options.ellipsoidGradientBound): what the leaf's proofs scale distances by.
     double getLipschitzConstant(const std::vector<Op>& ops, const glm::ivec3& first,
                                 const glm::ivec3& last, Counters& c) const
     {
@@ -278,6 +279,8 @@ private:
         for (const Op& op : ops) {
             if (isLipschitzPrimitive(*op.edit))
                 continue; // 1, nothing computed
+            if (!options.ellipsoidGradientBound)
+                return kInf;
             ++c.boundEvaluations;
             l = std::max(l, boundLipschitzConstant(*op.edit, lo, hi));
         }

@@ -406,6 +406,12 @@ TEST(ReferencePipeline, ThroughputReportsBothRates)
     ReferenceSettings s = makeQuickSettings(Quantity::Ao);
     const RayThroughput t = measureRayThroughput(room.scene, room.gbuffer, s, 16);
     EXPECT_EQ(t.referenceRays, t.rawRays); // cosine AO: one ray per sample, same rays
+    std::uint64_t active = 0;
+    const PreparedReference prepared(room.scene, room.gbuffer, s);
+    for (std::uint8_t a : prepared.getActive())
+        active += a;
+    EXPECT_EQ(t.referenceSamples, active * 16);
+    EXPECT_EQ(t.referenceRays, t.referenceSamples);
     EXPECT_GT(t.referenceMraysPerSecond, 0.0);
     EXPECT_GT(t.rawIntersectMraysPerSecond, 0.0);
     EXPECT_GT(t.rawOccludedMraysPerSecond, 0.0);

@@ -34,9 +34,10 @@ TEST(SdfEvaluator, LeafSamplesOutOfTheBandsReachAreSkippedOnlyForLipschitzFields
         EXPECT_GE(r.stats.samplesEvaluated, r.stats.samplesInBand) << bandCells;
         expectMatchesBruteForce(sphere, grid, kAllFrames, o, "band " + std::to_string(bandCells));
     }
-    // An ellipsoid's value is not 1-Lipschitz, but its gradient has a bound over each leaf
-    // (boundLipschitzConstant, 1.3-2.7 over these leaves): its leaves skip samples too, with
-    // the distances scaled by it, and stay bit-identical. A sphere with a rotation that is not a
+    // An ellipsoid's value is not 1-Lipschitz: by default every sample of its evaluated leaves
+    // is evaluated. Its gradient has a bound over each leaf (boundLipschitzConstant, 1.3-2.7
+    // over these leaves): with ellipsoidGradientBound its leaves skip samples too, with the
+    // distances scaled by it, and stay bit-identical. A sphere with a rotation that is not a
     // unit quaternion has no bound known (boundPrimitive and boundLipschitzConstant give up on
     // it, whatever the quaternion does to points): every sample of an evaluated leaf is evaluated.
     SdfModel ellipsoid = sphere;
@@ -44,17 +45,23 @@ TEST(SdfEvaluator, LeafSamplesOutOfTheBandsReachAreSkippedOnlyForLipschitzFields
     ellipsoid.edits[0].size = glm::dvec3(0.7, 0.3, 0.5);
     EvaluationOptions o;
     o.computeHermite = false;
-    const EvaluationResult r = evaluateModel(ellipsoid, grid, kAllFrames, o);
-    EXPECT_GT(r.stats.leavesEvaluated, 0u);
+    const EvaluationResult full = evaluateModel(ellipsoid, grid, kAllFrames, o);
+    EXPECT_GT(full.stats.leavesEvaluated, 0u);
+    EXPECT_EQ(full.stats.samplesEvaluated, full.stats.leavesEvaluated * 64);
+    expectMatchesBruteForce(ellipsoid, grid, kAllFrames, o, "ellipsoid");
+    EvaluationOptions bounded = o;
+    bounded.ellipsoidGradientBound = true;
+    const EvaluationResult r = evaluateModel(ellipsoid, grid, kAllFrames, bounded);
+    EXPECT_EQ(r.stats.leavesEvaluated, full.stats.leavesEvaluated);
     EXPECT_LT(r.stats.samplesEvaluated, r.stats.leavesEvaluated * 64);
     EXPECT_GE(r.stats.samplesEvaluated, r.stats.samplesInBand);
-    expectMatchesBruteForce(ellipsoid, grid, kAllFrames, o, "ellipsoid");
+    expectMatchesBruteForce(ellipsoid, grid, kAllFrames, bounded, "ellipsoid, gradient bound");
     SdfModel scaled = sphere;
     scaled.edits[0].rotation = glm::dquat(1.5, 0.0, 0.0, 0.0);
-    const EvaluationResult u = evaluateModel(scaled, grid, kAllFrames, o);
+    const EvaluationResult u = evaluateModel(scaled, grid, kAllFrames, bounded);
     EXPECT_GT(u.stats.leavesEvaluated, 0u);
     EXPECT_EQ(u.stats.samplesEvaluated, u.stats.leavesEvaluated * 64);
-    expectMatchesBruteForce(scaled, grid, kAllFrames, o, "non-unit rotation");
+    expectMatchesBruteForce(scaled, grid, kAllFrames, bounded, "non-unit rotation");
 }
 
 TEST(SdfEvaluator, LeavesProveTheirOutOfBandSamplesWhicheverSideTheSurfaceFaces)

@@ -66,9 +66,14 @@ TEST(SdfEvaluator, LandscapeMatchesBruteForceOverFrames)
 {
     const SdfModel& land = getLandscape();
     ASSERT_FALSE(land.edits.empty());
-    for (int frame : {0, 2, 3, 5, 7})
+    EvaluationOptions bounded;
+    bounded.ellipsoidGradientBound = true;
+    for (int frame : {0, 2, 3, 5, 7}) {
         expectMatchesBruteForce(land, makeModelGrid(land, 56), frame);
+        expectMatchesBruteForce(land, makeModelGrid(land, 56), frame, bounded, "gradient bound");
+    }
     expectMatchesBruteForce(land, makeModelGrid(land, 100), 7);
+    expectMatchesBruteForce(land, makeModelGrid(land, 100), 7, bounded, "gradient bound");
 }
 
 TEST(SdfEvaluator, OptionsKeepValuesExact)
@@ -80,6 +85,7 @@ TEST(SdfEvaluator, OptionsKeepValuesExact)
             o.leafSamples = leaf;
             o.bandCells = bandCells;
             o.computeHermite = leaf % 2 == 0;
+            o.ellipsoidGradientBound = leaf != 3; // the landscape's hills are ellipsoids
             expectMatchesBruteForce(land, makeModelGrid(land, 44), 7, o,
                                     "leaf " + std::to_string(leaf) + " band " + std::to_string(bandCells));
         }
@@ -103,7 +109,12 @@ TEST(SdfEvaluator, AnisotropicEllipsoidsMatchBruteForce)
         SdfModel m = makeRandomModel(seed, 12, 12.0);
         for (auto& e : m.edits)
             e.shape = CsgShape::Ellipsoid;
-        expectMatchesBruteForce(m, makeCubeGrid(-1.5, 1.5, 41), kAllFrames);
+        for (bool gradientBound : {false, true}) {
+            EvaluationOptions o;
+            o.ellipsoidGradientBound = gradientBound;
+            expectMatchesBruteForce(m, makeCubeGrid(-1.5, 1.5, 41), kAllFrames, o,
+                                    gradientBound ? "gradient bound" : "");
+        }
     }
 }
 
