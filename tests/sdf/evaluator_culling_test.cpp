@@ -35,9 +35,9 @@ TEST(SdfEvaluator, LeafSamplesOutOfTheBandsReachAreSkippedOnlyForLipschitzFields
         expectMatchesBruteForce(sphere, grid, kAllFrames, o, "band " + std::to_string(bandCells));
     }
     // An ellipsoid's value is not 1-Lipschitz: by default every sample of its evaluated leaves
-    // is evaluated. Its gradient has a bound over each leaf (boundLipschitzConstant, 1.3-2.7
-    // over these leaves): with ellipsoidGradientBound its leaves skip samples too, with the
-    // distances scaled by it, and stay bit-identical. A sphere with a rotation that is not a
+    // is evaluated. Its gradient has a bound over each leaf (boundLipschitzConstant: 1 plus a
+    // term that vanishes at its surface): with ellipsoidGradientBound its leaves skip samples
+    // too, with the distances scaled by it, and stay bit-identical. A sphere with a rotation that is not a
     // unit quaternion has no bound known (boundPrimitive and boundLipschitzConstant give up on
     // it, whatever the quaternion does to points): every sample of an evaluated leaf is evaluated.
     SdfModel ellipsoid = sphere;
