@@ -1,5 +1,6 @@
 #include "sdf/evaluator.h"
 
+#include "sdf/cell_pruning.h"
 #include "sdf/edit_ops.h"
 #include "sdf/leaf_bounds.h"
 #include "sdf/primitive_bounds.h"
@@ -151,103 +152,6 @@ private:
         return c;
     }
 
-    Interval widen(Interval d) const
-    {
-        d.lo -= margin;
-        d.hi += margin;
-        if (!(d.lo <= d.hi))  // NaN
-            return {-kInf, kInf};
-        return d;
-    }
-
-    // The interval of an op's result from the intervals of its inputs; computeSmoothMin is
-    // non-decreasing in both arguments (its partial derivatives lie in [0, 1]).
-    Interval combine(OpKind kind, Interval d, Interval s, double k) const
-    {
-        using scene::computeSmoothMin;
-        switch (kind) {
-        case OpKind::Add: return widen({computeSmoothMin(d.lo, s.lo, k), computeSmoothMin(d.hi, s.hi, k)});
-        case OpKind::Subtract:
-            return widen({-computeSmoothMin(-d.lo, s.hi, k), -computeSmoothMin(-d.hi, s.lo, k)});
-        case OpKind::Intersect:
-            return widen({-computeSmoothMin(-d.lo, -s.lo, k), -computeSmoothMin(-d.hi, -s.hi, k)});
-        case OpKind::Set: return s;
-        case OpKind::SetNegated: return {-s.hi, -s.lo};
-        }
-        return {-kInf, kInf};
-    }
-
-    // Prunes `parentOps` to the box; returns the interval of the field over the box.
-    Interval pruneOps(const std::vector<Op>& parentOps, const glm::dvec3& lo, const glm::dvec3& hi,
-                      std::vector<Op>& ops, Counters& c) const
-    {
-        ops.clear();
-        Interval d{kInf, kInf};  // the empty list is +inf
-        for (const Op& op : parentOps) {
-            const Interval s = boundPrimitive(*op.edit, lo, hi, margin);
-            ++c.boundEvaluations;
-            // [Evans 2015] soft blend breaks the culling unless the soft min reverts to the hard
-            // one: the edit of blend radius k returns its input d unchanged once its primitive is
-            // at least k beyond d on the losing side, and returns its own value once the input is
-            // at least k beyond it. `need` includes that radius and the rounding margin.
-            const double k = std::max(op.edit->blend, 0.0);
-            const double need = k + margin;
-            bool unchanged = false, replaced = false;
-            OpKind replacement = OpKind::Set;
-            switch (op.kind) {
-            case OpKind::Add:  // min(d, s)
-                unchanged = s.lo - d.hi >= need;
-                replaced = d.lo - s.hi >= need;
-                break;
-            case OpKind::Subtract:  // max(d, -s)
-                unchanged = s.lo + d.lo >= need;
-                replaced = -d.hi - s.hi >= need;
-                replacement = OpKind::SetNegated;
-                break;
-            case OpKind::Intersect:  // max(d, s)
-                unchanged = d.lo - s.hi >= need;
-                replaced = s.lo - d.hi >= need;
-                break;
-            case OpKind::Set: replaced = true; break;
-            case OpKind::SetNegated:
-                replaced = true;
-                replacement = OpKind::SetNegated;
-                break;
-            }
-            if (unchanged)
-                continue;
-            if (replaced) {
-                ops.clear();
-                ops.push_back({op.edit, replacement, s.lo, s.hi});
-                d = combine(replacement, d, s, k);
-                continue;
-            }
-            ops.push_back({op.edit, op.kind, s.lo, s.hi});
-            d = combine(op.kind, d, s, k);
-        }
-        return d;
-    }
-
-    // Material candidates: the additive edits that can still be the material of a sample in the
-    // box (SdfModel::evaluateMaterial takes the last additive edit with s <= d + max(blend, tol)).
-    void pruneCandidates(const std::vector<const CsgEdit*>& parent, const glm::dvec3& lo,
-                         const glm::dvec3& hi, Interval d, std::vector<const CsgEdit*>& out,
-                         Counters& c) const
-    {
-        out.clear();
-        const double maxAbs = std::max(std::abs(d.lo), std::abs(d.hi));
-        for (const CsgEdit* e : parent) {
-            const Interval s = boundPrimitive(*e, lo, hi, margin);
-            ++c.boundEvaluations;
-            const double tol = std::max(e->blend, 1e-9 * (1.0 + maxAbs));
-            if (s.lo - d.hi > tol + margin)
-                continue;  // never chosen in the box
-            if (s.hi + margin < d.lo)
-                out.clear();  // always chosen in the box: the edits before it never win
-            out.push_back(e);
-        }
-    }
-
     void fill(const glm::ivec3& first, const glm::ivec3& last, double value)
     {
         const float v = toFieldValue(value);
@@ -265,16 +169,14 @@ private:
             }
     }
 
-    //! The largest of the ops' gradient bounds over the samples [first, last] (+inf for an
+    //! The largest of the ops' gradient bounds over the box [lo, hi] (+inf for an
     //! empty list, one with no bound known, or an ellipsoid without
     //! options.ellipsoidGradientBound): what the leaf's proofs scale distances by.
-    double getLipschitzConstant(const std::vector<Op>& ops, const glm::ivec3& first,
-                                const glm::ivec3& last, Counters& c) const
+    double getLipschitzConstant(const std::vector<Op>& ops, const glm::dvec3& lo,
+                                const glm::dvec3& hi, Counters& c) const
     {
         if (ops.empty())
             return kInf;
-        const glm::dvec3 lo = getSamplePosition(grid, first.x, first.y, first.z);
-        const glm::dvec3 hi = getSamplePosition(grid, last.x, last.y, last.z);
         double l = 1.0;
         for (const Op& op : ops) {
             if (isLipschitzPrimitive(*op.edit))
@@ -306,7 +208,8 @@ private:
         std::size_t evaluated = count;
         std::uint64_t primitiveEvaluations = 0;
         const double lipschitz =
-            outputs.materials ? kInf : getLipschitzConstant(ops, first, last, c);
+            outputs.materials ? kInf
+                              : getLipschitzConstant(ops, positions.front(), positions.back(), c);
         if (!(lipschitz < kInf)) {
             // Edit-major: one primitive over the whole block, the coherent branch on primitive
             // type that the talk's 4x4x4 blocks are for.
@@ -370,7 +273,7 @@ private:
         const glm::dvec3 lo = getSamplePosition(grid, first.x, first.y, first.z);
         const glm::dvec3 hi = getSamplePosition(grid, boxLast.x, boxLast.y, boxLast.z);
         std::vector<Op> ops;
-        const Interval d = pruneOps(parentOps, lo, hi, ops, c);
+        const Interval d = pruneOps(parentOps, lo, hi, margin, ops, c.boundEvaluations);
         // [Evans 2015] "empty cells and full cells are marked early in the tree".
         if (d.lo > band) {
             ++c.cellsEmpty[level];
@@ -384,7 +287,7 @@ private:
         }
         std::vector<const CsgEdit*> candidates;
         if (outputs.materials)
-            pruneCandidates(parentCandidates, lo, hi, d, candidates, c);
+            pruneCandidates(parentCandidates, lo, hi, d, margin, candidates, c.boundEvaluations);
         if (level + 1 == int(cellSamples.size())) {
             evaluateLeaf(first, last, ops, candidates, c);
             // Only a box whose values can be on both sides of 0 can hold a crossing.
@@ -433,7 +336,7 @@ private:
                 options.computeHermite ? glm::min(ch.first + size, grid.samples - 1) : ch.last;
             ch.lo = getSamplePosition(grid, ch.first.x, ch.first.y, ch.first.z);
             ch.hi = getSamplePosition(grid, boxLast.x, boxLast.y, boxLast.z);
-            ch.d = pruneOps(parentOps, ch.lo, ch.hi, ch.ops, c);
+            ch.d = pruneOps(parentOps, ch.lo, ch.hi, margin, ch.ops, c.boundEvaluations);
             ch.exact = !outputs.materials && !ch.ops.empty() &&
                        std::all_of(ch.ops.begin(), ch.ops.end(),
                                    [](const Op& op) { return isLipschitzPrimitive(*op.edit); });
@@ -456,7 +359,8 @@ private:
             Counters& c = getCounters();
             std::vector<const CsgEdit*> candidates;
             if (outputs.materials)
-                pruneCandidates(parentCandidates, ch.lo, ch.hi, ch.d, candidates, c);
+                pruneCandidates(parentCandidates, ch.lo, ch.hi, ch.d, margin, candidates,
+                                c.boundEvaluations);
             FaceSeeds seeds;
             // Seeds cross the gap between two siblings' samples, outside both boxes: only where
             // the field is 1-Lipschitz everywhere, both lists of exact distances.
