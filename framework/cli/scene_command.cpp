@@ -48,8 +48,10 @@ int sceneCommand(const SceneOptions& options)
         std::size_t meshTriangles = 0;
         for (const auto& m : scene.meshes) {
             meshTriangles += m.indices.size() / 3;
-            fmt::print("mesh:        {}: {} triangles, {} vertices\n", m.name, m.indices.size() / 3,
-                       m.positions.size());
+            fmt::print("mesh:        {}: {} triangles, {} vertices, normals: {}\n", m.name,
+                       m.indices.size() / 3, m.positions.size(),
+                       m.normalsSource.empty() ? std::string(m.normals.empty() ? "computed" : "given")
+                                               : m.normalsSource);
         }
         fmt::print("materials:   {}\n", scene.materials.size());
         fmt::print("sdf models:  {}\n", scene.sdfModels.size());

@@ -70,6 +70,8 @@ std::string RunConfig::toJson() const
                 .add("tonemapper", tonemapper)
                 .add("exposure_ev", exposureEv)
                 .add("shadow_map_size", shadowMapSize);
+        if (lighting && sky != "auto")
+            frame.add("sky", sky);
         json.addRaw("frame", frame.str());
     }
     return json.addRaw("reference", referenceJson.str())
@@ -270,6 +272,12 @@ struct Loader {
         return false;
     }
 
+    void readSky(const YAML::Node& node, RunConfig& run) const
+    {
+        run.sky = config::readString(file, node, "frame.sky");
+        config::checkName(file, node, run.sky, {"auto", "lobes"}, "frame.sky");
+    }
+
     void readFrame(const YAML::Node& node, RunConfig& run) const
     {
         if (!node.IsMap())
@@ -277,8 +285,10 @@ struct Loader {
                                 config::describeNode(node));
         config::checkKeys(file, node,
                           {"culling", "lighting", "gbuffer_on_gpu", "tonemapper", "exposure_ev",
-                           "shadow_map_size"},
+                           "shadow_map_size", "sky"},
                           {}, "frame");
+        if (node["sky"])
+            readSky(node["sky"], run);
         if (node["gbuffer_on_gpu"])
             run.gbufferOnGpu = readBool(node["gbuffer_on_gpu"], "frame.gbuffer_on_gpu");
         if (node["culling"])
@@ -393,6 +403,8 @@ struct Loader {
             run.culling = readBool(value, "frame.culling");
             return;
         }
+        if (key == "frame.sky")
+            return readSky(value, run);
         if (key == "frame.gbuffer_on_gpu") {
             run.gbufferOnGpu = readBool(value, "frame.gbuffer_on_gpu");
             return;
@@ -408,7 +420,7 @@ struct Loader {
                 keyNode,
                 "sweep: unknown axis '" + key +
                     "'; valid axes: scene, grid, resolution, frames, camera_path, frame.culling, "
-                    "frame.gbuffer_on_gpu, reference.max_samples, "
+                    "frame.gbuffer_on_gpu, frame.sky, reference.max_samples, "
                     "<family>.technique, <family>.<parameter>, zip");
         const std::string family = key.substr(0, dot);
         const std::string field = key.substr(dot + 1);

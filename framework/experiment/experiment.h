@@ -21,7 +21,8 @@
 //     frame: {culling: true,            # false: run every pass (frame graph ablation)
 //             lighting: false,          # true: compose the lit frame, measure it against Embree
 //             gbuffer_on_gpu: true,     # false: techniques read the G-buffer's CPU copy (ablation)
-//             tonemapper: aces, exposure_ev: 0, shadow_map_size: 256}
+//             tonemapper: aces, exposure_ev: 0, shadow_map_size: 256,
+//             sky: auto}                # lobes: the sky never through a voxel GI technique's cones
 //     techniques:                       # one technique per family; several screen families
 //                                       # share one frame
 //       isosurface: {technique: marching_cubes, params: {vertex_placement: linear}}
@@ -101,6 +102,10 @@ struct RunConfig {
     std::string tonemapper = "aces";
     double exposureEv = 0.0;
     int shadowMapSize = 256;
+    //! `frame: {sky: lobes}` lights the sky through the 16 lobes times the occlusion family's
+    //! visibility even when a voxel GI technique gives its cone sky; `auto` (the default) takes
+    //! the cone sky when there is one (pipeline/compose.h): the ablation of the talk's sky.
+    std::string sky = "auto";
     //! True when a family of the run works on a sampled volume (`grid`) rather than images; set
     //! by the loader from the families' domains (not part of the hash).
     bool volume = false;

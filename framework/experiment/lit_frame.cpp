@@ -49,7 +49,8 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
     : mRun(run), mContext(context)
 {
     mCompose = std::make_unique<pipeline::Compose>(
-        start, pipeline::ComposeOptions{run.tonemapper, run.exposureEv, run.shadowMapSize});
+        start, pipeline::ComposeOptions{run.tonemapper, run.exposureEv, run.shadowMapSize,
+                                        run.sky != "lobes"});
     mCompose->addPasses(graph);
     const int w = run.width, h = run.height;
     const auto geometry = start.geometry();
@@ -144,7 +145,8 @@ void LitFrame::endFrame(ResultRow& row)
         .set("frame.shadow_maps_rendered", std::int64_t(s.lightsRendered))
         .set("frame.shadow_faces_rendered", std::int64_t(s.shadowFacesRendered))
         .set("frame.shadow_skips", s.shadowSkips)
-        .set("frame.visibility", s.visibility);
+        .set("frame.visibility", s.visibility)
+        .set("frame.sky", s.sky);
     mRow = nullptr;
 }
 

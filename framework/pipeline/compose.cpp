@@ -232,6 +232,32 @@ void Compose::addSlotUploads(FrameGraph& graph)
     } else if (!graph.declares(kIndirectIrradianceGpu)) {
         graph.addExternal(indirectGpu, false, "no voxel_gi technique in the run");
     }
+    // The sky through the voxel GI technique's cones.
+    const auto coneSky = coneSkySlot(mWidth, mHeight);
+    const auto coneSkyGpu = coneSkyGpuSlot(mWidth, mHeight);
+    if (!graph.declares(kConeSkyGpu) && graph.declares(kConeSky)) {
+        const auto image = makeGpuImageResource(gpuContext, "cone_sky_upload",
+                                                gpu::Format::RGBA32Float, mWidth, mHeight);
+        graph.addPass({.name = "cone_sky_upload",
+                       .reads = {coneSky},
+                       .writes = {coneSkyGpu, image},
+                       .persistent = {image.name}},
+                      [coneSky, coneSkyGpu, image](PassContext& ctx) {
+                          const Image<glm::vec3>& sky = ctx.read(coneSky);
+                          const gpu::Image* slot = nullptr;
+                          if (sky.width > 0) { // empty: the technique gave none this frame
+                              gpu::Image& target = ctx.write(image);
+                              render::uploadInto(target, sky);
+                              slot = &target;
+                          }
+                          ctx.write(coneSkyGpu) = slot;
+                          return PassOutcome{};
+                      });
+    } else if (!graph.declares(kConeSkyGpu)) {
+        graph.addExternal(coneSkyGpu, false, "no voxel_gi technique in the run");
+    }
+    if (!graph.declares(kConeSky))
+        graph.addExternal(coneSky, false, "no voxel_gi technique in the run");
     // CPU slots nobody fills (CPU readers read them optionally).
     if (!graph.declares(kAmbientOcclusion))
         graph.addExternal(ao, false, "no occlusion technique in the run");
@@ -285,6 +311,7 @@ void Compose::addPasses(FrameGraph& graph)
     const auto aoGpu = ambientOcclusionGpuSlot(mWidth, mHeight);
     const auto conesGpu = coneVisibilityGpuSlot(mWidth, mHeight);
     const auto indirectGpu = indirectIrradianceGpuSlot(mWidth, mHeight);
+    const auto coneSkyGpu = coneSkyGpuSlot(mWidth, mHeight);
 
     graph.addPass(
         {.name = "shadow_maps",
@@ -385,10 +412,13 @@ void Compose::addPasses(FrameGraph& graph)
     graph.addPass(
         {.name = "lighting",
          .reads = {gbuffer, geometry},
-         .optionalReads = {shadowMaps, aoGpu, conesGpu, indirectGpu},
+         .optionalReads = mOptions.coneSky
+                              ? std::vector<ResourceRef>{shadowMaps, aoGpu, conesGpu, indirectGpu,
+                                                         coneSkyGpu}
+                              : std::vector<ResourceRef>{shadowMaps, aoGpu, conesGpu, indirectGpu},
          .writes = {hdr, direct},
          .timing = PassTiming::Repeated},
-        [this, gbuffer, geometry, shadowMaps, aoGpu, conesGpu, indirectGpu, hdr,
+        [this, gbuffer, geometry, shadowMaps, aoGpu, conesGpu, indirectGpu, coneSkyGpu, hdr,
          direct](PassContext& ctx) {
             gpu::Context& gpu = mStart.getGpu();
             if (!mLighting) {
@@ -419,6 +449,12 @@ void Compose::addPasses(FrameGraph& graph)
             }
             if (const auto* e = ctx.tryRead(indirectGpu))
                 inputs.indirectIrradiance = *e;
+            mStats.sky = "lobes";
+            if (const auto* c = mOptions.coneSky ? ctx.tryRead(coneSkyGpu) : nullptr;
+                c && *c != nullptr) {
+                inputs.coneSkyIrradiance = *c;
+                mStats.sky = "cones";
+            }
             inputs.outHdr = &ctx.write(hdr);
             inputs.outDirect = &ctx.write(direct);
             mLighting->draw(g, inputs);

@@ -72,6 +72,9 @@ struct ComposeOptions {
     std::string tonemapper = "aces"; //!< "aces" or "reinhard" (render/lighting_pass.h)
     double exposureEv = 0.0;
     int shadowMapSize = 256; //!< texels per cube face
+    //! Light the sky (and the emitters) through a voxel GI technique's cones when it gives them
+    //! (`cone_sky`); false: always the lobes times the occlusion family's visibility.
+    bool coneSky = true;
 };
 
 //! What the compose passes did in the last frame (columns of the row).
@@ -82,6 +85,10 @@ struct ComposeStats {
     std::string shadowSkips;     //!< the lights and faces whose maps were kept, and why
     std::string visibility;      //!< "none", "ambient_occlusion", "cones"
     std::string indirect;        //!< "none (...)" or the producer's slot
+    //! Where the lit frame's sky came from: "cones" (the voxel GI technique's cone sky: the sky
+    //! and the emitters through its voxels) or "lobes" (the 16 SRBF lobes times the occlusion
+    //! family's visibility, `visibility`).
+    std::string sky = "lobes";
 };
 
 class Compose {
@@ -93,6 +100,11 @@ public:
     static constexpr const char* kAmbientOcclusionGpu = "occlusion.ambient_gpu";
     static constexpr const char* kConeVisibilityGpu = "occlusion.cone_visibility_gpu";
     static constexpr const char* kIndirectIrradianceGpu = "indirect_irradiance_gpu";
+    //! The sky and the emitters' light that a voxel GI technique's cones see past its voxels
+    //! (render/lighting_pass.h LightingInputs::coneSkyIrradiance); an empty image when the
+    //! technique gives none this frame.
+    static constexpr const char* kConeSky = "cone_sky";
+    static constexpr const char* kConeSkyGpu = "cone_sky_gpu";
 
     Compose(FrameStart& start, ComposeOptions options);
     ~Compose();
@@ -115,6 +127,10 @@ public:
     {
         return {kIndirectIrradiance, ResourceType::cpuImage("vec3", width, height)};
     }
+    static Resource<Image<glm::vec3>> coneSkySlot(int width, int height)
+    {
+        return {kConeSky, ResourceType::cpuImage("vec3", width, height)};
+    }
     //! The GPU forms: the image (R32Float) holding the AO, null when the producer gives none.
     static Resource<const gpu::Image*> ambientOcclusionGpuSlot(int width, int height)
     {
@@ -132,6 +148,11 @@ public:
     static Resource<const gpu::Image*> indirectIrradianceGpuSlot(int width, int height)
     {
         return {kIndirectIrradianceGpu, ResourceType::gpuImage("rgba32f", width, height)};
+    }
+    //! RGBA32Float, irradiance in rgb; null when the producer gave none this frame.
+    static Resource<const gpu::Image*> coneSkyGpuSlot(int width, int height)
+    {
+        return {kConeSkyGpu, ResourceType::gpuImage("rgba32f", width, height)};
     }
     Resource<LitFrame> litFrame() const
     {

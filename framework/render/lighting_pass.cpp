@@ -169,6 +169,7 @@ struct LightingPass::State {
 
     SkyVisibility lastVisibility = SkyVisibility::None;
     bool lastIndirect = false;
+    bool lastConeSky = false;
     std::optional<double> lastGpuMs;
 
     void resize(std::uint32_t w, std::uint32_t h)
@@ -238,7 +239,7 @@ LightingPass::LightingPass(gpu::Context& context, LightingPassOptions options)
     const gpu::ShaderCompiler compiler(compilerOptions);
     using gpu::BindingType;
     std::vector<gpu::BindingSlot> slots;
-    for (std::uint32_t b = 0; b <= 14; ++b) {
+    for (std::uint32_t b = 0; b <= 15; ++b) {
         const bool buffer = b == 5 || b == 6;
         slots.push_back({b, buffer ? BindingType::StorageBuffer : BindingType::StorageImage});
     }
@@ -294,6 +295,9 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
     if (inputs.indirectIrradiance != nullptr)
         requireImage(*inputs.indirectIrradiance, gpu::Format::RGBA32Float, w, h,
                      "indirect irradiance");
+    if (inputs.coneSkyIrradiance != nullptr)
+        requireImage(*inputs.coneSkyIrradiance, gpu::Format::RGBA32Float, w, h,
+                     "cone sky irradiance");
 
     if (inputs.outHdr != nullptr)
         requireImage(*inputs.outHdr, gpu::Format::RGBA32Float, w, h, "HDR output");
@@ -341,7 +345,8 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
         glm::uvec4(w, h, std::uint32_t(lightCount), std::uint32_t(visibility));
     constants.flags =
         glm::uvec4(inputs.indirectIrradiance != nullptr ? 1u : 0u,
-                   inputs.shadows != nullptr ? inputs.shadows->getFaceSize() : 1, 0u, 0u);
+                   inputs.shadows != nullptr ? inputs.shadows->getFaceSize() : 1,
+                   inputs.coneSkyIrradiance != nullptr ? 1u : 0u, 0u);
     constants.shadowParameters = glm::vec4(s.options.pcfSpacingTexels, s.options.normalOffsetTexels,
                                            s.options.slopeOffsetTexels, 0.0f);
 
@@ -359,6 +364,8 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
     };
     const gpu::Image& indirect =
         inputs.indirectIrradiance != nullptr ? *inputs.indirectIrradiance : s.noIndirect;
+    const gpu::Image& coneSky =
+        inputs.coneSkyIrradiance != nullptr ? *inputs.coneSkyIrradiance : s.noIndirect;
     const gpu::GroupCount groups{gpu::computeGroupCount(w, kGroupSize),
                                  gpu::computeGroupCount(h, kGroupSize), 1};
 
@@ -377,7 +384,7 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
              gpu::Binding::storageImage(10, ownOutputs ? s.hdr : *inputs.outHdr),
              gpu::Binding::storageImage(11, ownOutputs ? s.direct : *inputs.outDirect),
              gpu::Binding::storageImage(12, cone(1)), gpu::Binding::storageImage(13, cone(2)),
-             gpu::Binding::storageImage(14, cone(3))},
+             gpu::Binding::storageImage(14, cone(3)), gpu::Binding::storageImage(15, coneSky)},
             gpu::PushConstants(constants), groups, kLightingLabel);
         if (ownOutputs)
             cmd.dispatch(
@@ -388,6 +395,7 @@ gpu::RunResult LightingPass::draw(const scene::RenderScene& scene, const Lightin
     s.drawn = s.drawn || ownOutputs;
     s.lastVisibility = visibility;
     s.lastIndirect = inputs.indirectIrradiance != nullptr;
+    s.lastConeSky = inputs.coneSkyIrradiance != nullptr;
     const auto copyMs = result.sumGpuMs(kCopyLabel);
     const auto lightingMs = result.sumGpuMs(kLightingLabel);
     const auto tonemapMs = ownOutputs ? result.sumGpuMs(kTonemapLabel) : std::optional<double>(0.0);
@@ -499,6 +507,11 @@ SkyVisibility LightingPass::getLastVisibility() const
 bool LightingPass::hadIndirect() const
 {
     return mState->lastIndirect;
+}
+
+bool LightingPass::hadConeSky() const
+{
+    return mState->lastConeSky;
 }
 
 std::optional<double> LightingPass::getLastGpuMs() const

@@ -17,6 +17,10 @@
 // Per pixel with a surface (x = G-buffer position, n = its normal as stored, rho = albedo):
 //   E_lights = Sum_i I_i max(0, n . l_i) / max(d_i, minLightDistance)^2 * shadow_i
 //   E_sky    = Sum_k V_k L_k I(n . a_k)           (render/sky_irradiance.h)
+//              or, with LightingInputs::coneSkyIrradiance, that image: the sky and the emissive
+//              surfaces seen through a voxel GI technique's 16 cones (Sum_k w_k(n) V_k
+//              (T_k Lsky_k + Le_k), families/voxel_gi/pixel_cones.h), as the Tomorrow Children
+//              lit pixels ("Sky Light": the sky gathered along the cones through the cascades)
 //   direct   = rho / pi * (E_lights + E_sky)
 //   hdr      = Le + direct + rho / pi * E_ind
 // V_k is 1 without a visibility input, the pixel's ambient occlusion for every k with
@@ -26,9 +30,8 @@
 // through the pixel's sample and direct = 0 (the conventions of reference/reference.h).
 //
 // Against the Embree ground truth: reference "direct" also contains light from emissive
-// triangles; this pass does not compute it. In the frame it arrives through the indirect slot
-// (voxel GI injects emission like any other light). Compare `direct` with a reference of a
-// scene without emissive triangles, or subtract their part.
+// triangles. Without a cone sky this pass does not compute it; with one, the cones' emitters are
+// part of E_sky and so of `direct`.
 //
 // Shadows (shaders/lighting.comp): the receiver moves along n by
 //   d * (2 / faceSize) * (normalOffsetTexels + slopeOffsetTexels * sin(theta))
@@ -117,6 +120,11 @@ struct LightingInputs {
     std::array<const gpu::Image*, 4> coneVisibility{};
     //! RGBA32Float image of the G-buffer's size: incident indirect irradiance (rgb). Null: none.
     const gpu::Image* indirectIrradiance = nullptr;
+    //! RGBA32Float image of the G-buffer's size: the irradiance from the sky and from emissive
+    //! surfaces that a voxel GI technique's 16 cones gathered past its voxels (rgb), already
+    //! multiplied per cone by the visibilities it was given. When set it replaces E_sky (the lobes
+    //! and V_k are not used for the sky). Null: E_sky from the lobes as above.
+    const gpu::Image* coneSkyIrradiance = nullptr;
     //! Where to write the frame: RGBA32Float images of the G-buffer's size, e.g. created by the
     //! frame graph (pipeline/gpu_resources.h). Null: the pass's own images (getHdr(), getDirect()),
     //! which draw() also tonemaps into getLdr(); with outputs given, call tonemap() yourself.
@@ -129,7 +137,7 @@ struct LightingConstants {
     glm::mat4 inverseRelativeViewProjection{1.0f}; //!< clip -> camera-relative world
     glm::vec4 cameraPosition{0.0f};                //!< xyz world units, w: minLightDistance
     glm::uvec4 sizeLightsVisibility{0u};           //!< width, height, light count, SkyVisibility
-    glm::uvec4 flags{0u};                          //!< x: has indirect, y: shadow face size
+    glm::uvec4 flags{0u}; //!< x: has indirect, y: shadow face size, z: has cone sky
     glm::vec4 shadowParameters{0.0f};              //!< pcf spacing, normal, slope offsets (texels)
 };
 static_assert(sizeof(LightingConstants) == 128, "must match lighting.comp");
@@ -188,6 +196,8 @@ public:
     //! The visibility mode and whether an indirect input was used in the last draw().
     SkyVisibility getLastVisibility() const;
     bool hadIndirect() const;
+    //! Whether the last draw() took its sky from LightingInputs::coneSkyIrradiance.
+    bool hadConeSky() const;
     //! GPU time of the last draw() (copies, lighting, tonemap) or tonemap() in milliseconds;
     //! empty before the first or without timestamps.
     std::optional<double> getLastGpuMs() const;

@@ -184,7 +184,8 @@ MatchedLines collectMatchedLines(const std::vector<RunSummary>& runs, const std:
     // Run settings that are not technique parameters but change the error as much: the camera
     // path (a still camera, eight frames with digs), the frame's switches and the frame count.
     // `names` picks among the parameters and these; `others` with every one of these is the key.
-    static const std::vector<std::string> kRunColumns = {"camera_path", "frame.culling", "frame.gbuffer_on_gpu"};
+    static const std::vector<std::string> kRunColumns = {"camera_path", "frame.culling", "frame.gbuffer_on_gpu",
+                                                         "frame.sky"};
     const auto describeSetting = [&](const RunSummary& run, const std::vector<std::string>& names, bool key) {
         std::vector<std::string> params;
         for (const auto& n : names)
@@ -234,7 +235,8 @@ MatchedLines collectMatchedLines(const std::vector<RunSummary>& runs, const std:
         }
         // The label names the other parameters that differ among this technique's lines.
         std::vector<std::string> candidates = others;
-        candidates.insert(candidates.end(), {"camera_path", "frame.culling", "frame.gbuffer_on_gpu", "frames"});
+        candidates.insert(candidates.end(),
+                          {"camera_path", "frame.culling", "frame.gbuffer_on_gpu", "frame.sky", "frames"});
         std::vector<std::string> differing;
         for (const auto& p : candidates) {
             std::set<std::string> values;

@@ -421,7 +421,9 @@ private:
 RawMesh readGltf(const std::string& path, const std::string& bytes, bool binary)
 {
     const tinygltf::Model model = parseModel(path, bytes, binary);
-    return GltfReader(path, model).read();
+    RawMesh raw = GltfReader(path, model).read();
+    raw.formatFlatReason = "no NORMAL"; // glTF 2.0, "Meshes": flat normals without NORMAL
+    return raw;
 }
 
 } // namespace rtlab::scene::detail

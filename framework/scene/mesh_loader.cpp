@@ -5,13 +5,16 @@
 #include <glm/geometric.hpp>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 #include <unordered_map>
 
 namespace rtlab::scene {
@@ -105,30 +108,20 @@ bool hasNonManifoldEdge(const std::vector<glm::vec3>& positions,
 
 } // namespace
 
-LoadedMesh finishMesh(const std::string& path, const RawMesh& raw)
+LoadedMesh finishMesh(const std::string& path, const RawMesh& raw, const NormalMode& mode)
 {
     const std::size_t rawTriangles = raw.cornerPosition.size() / 3;
     LoadedMesh mesh;
 
-    // Triangles that survive, and per position the area-weighted normal sum (|cross| = 2 area)
-    // and the first adjacent triangle's normal as a fallback where the sum cancels out.
+    // Triangles that survive, their area-weighted normals (|cross| = 2 area) and unit normals.
     std::vector<std::size_t> kept;
     kept.reserve(rawTriangles);
-    std::vector<glm::dvec3> normalSum(raw.positions.size(), glm::dvec3(0.0));
-    std::vector<glm::dvec3> firstNormal(raw.positions.size(), glm::dvec3(0.0));
     for (std::size_t t = 0; t < rawTriangles; ++t) {
         if (isDegenerate(raw, t)) {
             ++mesh.degenerateTrianglesDropped;
             continue;
         }
         kept.push_back(t);
-        const glm::dvec3 cross = computeTriangleCross(raw, t);
-        for (int c = 0; c < 3; ++c) {
-            const std::uint32_t p = raw.cornerPosition[3 * t + c];
-            normalSum[p] += cross;
-            if (firstNormal[p] == glm::dvec3(0.0))
-                firstNormal[p] = glm::normalize(cross);
-        }
     }
     if (kept.empty()) {
         std::string message = "contains no triangles";
@@ -140,43 +133,109 @@ LoadedMesh finishMesh(const std::string& path, const RawMesh& raw)
                        " triangles are degenerate: a repeated vertex or zero area)";
         throw InputError({path}, message);
     }
-
-    // Vertices: the distinct (position, normal) pairs of the kept corners, in file order.
-    auto makeKey = [&](std::size_t corner) {
-        return static_cast<std::uint64_t>(raw.cornerPosition[corner]) << 32 |
-               static_cast<std::uint64_t>(raw.cornerNormal[corner] + 1);
-    };
-    std::vector<std::uint64_t> vertexKeys;
-    vertexKeys.reserve(3 * kept.size());
-    for (std::size_t t : kept)
-        for (int c = 0; c < 3; ++c)
-            vertexKeys.push_back(makeKey(3 * t + c));
-    std::sort(vertexKeys.begin(), vertexKeys.end());
-    vertexKeys.erase(std::unique(vertexKeys.begin(), vertexKeys.end()), vertexKeys.end());
-
-    mesh.positions.reserve(vertexKeys.size());
-    mesh.normals.reserve(vertexKeys.size());
-    for (std::uint64_t key : vertexKeys) {
-        const auto p = static_cast<std::uint32_t>(key >> 32);
-        const auto n = static_cast<std::int64_t>(key & 0xffffffffull) - 1;
-        mesh.positions.push_back(raw.positions[p]);
-        glm::dvec3 normal(0.0);
-        if (n >= 0)
-            normal = glm::dvec3(raw.normals[static_cast<std::size_t>(n)]);
-        if (normal == glm::dvec3(0.0))
-            normal = normalSum[p] != glm::dvec3(0.0) ? normalSum[p] : firstNormal[p];
-        mesh.normals.push_back(glm::vec3(glm::normalize(normal)));
+    std::vector<glm::dvec3> cross(kept.size()), unit(kept.size());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        cross[i] = computeTriangleCross(raw, kept[i]);
+        unit[i] = glm::normalize(cross[i]);
     }
+    // The kept triangles around each position (compressed rows).
+    std::vector<std::size_t> rowStart(raw.positions.size() + 1, 0);
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            ++rowStart[raw.cornerPosition[3 * kept[i] + c] + 1];
+    for (std::size_t p = 0; p < raw.positions.size(); ++p)
+        rowStart[p + 1] += rowStart[p];
+    std::vector<std::size_t> around(rowStart.back()), fill(rowStart.begin(), rowStart.end() - 1);
+    for (std::size_t i = 0; i < kept.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            around[fill[raw.cornerPosition[3 * kept[i] + c]]++] = i;
+
+    // Each corner's normal (see mesh_loader.h, "Normals"), then the vertices: the distinct
+    // (position, normal) pairs, ordered by position.
+    using Kind = NormalMode::Kind;
+    const bool groups = mode.kind == Kind::FromFile && !raw.triangleSmoothing.empty();
+    const double creaseCos = mode.kind == Kind::CreaseAngle
+                                 ? std::cos(mode.creaseAngleDegrees * 3.14159265358979323846 / 180.0)
+                                 : 0.0;
+    std::vector<std::string> sources;
+    const auto note = [&](const std::string& s) {
+        if (std::find(sources.begin(), sources.end(), s) == sources.end())
+            sources.push_back(s);
+    };
+    struct Corner {
+        std::uint32_t position;
+        std::array<float, 3> normal;
+        bool operator<(const Corner& o) const
+        {
+            return std::tie(position, normal) < std::tie(o.position, o.normal);
+        }
+        bool operator==(const Corner& o) const
+        {
+            return position == o.position && normal == o.normal;
+        }
+    };
+    std::vector<Corner> corners(3 * kept.size());
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        const std::size_t t = kept[i];
+        for (int c = 0; c < 3; ++c) {
+            const std::uint32_t p = raw.cornerPosition[3 * t + c];
+            const std::int64_t fileNormal = raw.cornerNormal[3 * t + c];
+            glm::dvec3 n(0.0);
+            if (mode.kind == Kind::FromFile && fileNormal >= 0) {
+                n = glm::dvec3(raw.normals[static_cast<std::size_t>(fileNormal)]);
+                if (n != glm::dvec3(0.0))
+                    note("file (vn)");
+            }
+            if (n == glm::dvec3(0.0)) {
+                const std::uint32_t group = groups ? raw.triangleSmoothing[t] : 0u;
+                const bool smooth = mode.kind == Kind::Smooth || mode.kind == Kind::CreaseAngle ||
+                                    (mode.kind == Kind::FromFile && group != 0u);
+                if (smooth) {
+                    for (std::size_t a = rowStart[p]; a < rowStart[p + 1]; ++a) {
+                        const std::size_t j = around[a];
+                        const bool joins =
+                            mode.kind == Kind::Smooth ||
+                            (mode.kind == Kind::CreaseAngle
+                                 ? glm::dot(unit[i], unit[j]) >= creaseCos - 1e-12
+                                 : raw.triangleSmoothing[kept[j]] == group);
+                        if (joins)
+                            n += cross[j];
+                    }
+                    note(mode.kind == Kind::FromFile ? "smoothing groups" : mode.describe());
+                } else {
+                    note(mode.kind == Kind::FromFile ? "flat (" + raw.formatFlatReason + ")"
+                                                     : mode.describe());
+                }
+                // Flat, or a sum that cancels (faces wound against each other): the face's own.
+                if (!(glm::dot(n, n) > 0.0))
+                    n = cross[i];
+            }
+            const glm::vec3 u(glm::normalize(n));
+            corners[3 * i + std::size_t(c)] = {p, {u.x, u.y, u.z}};
+        }
+    }
+    std::vector<Corner> vertices = corners;
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    mesh.positions.reserve(vertices.size());
+    mesh.normals.reserve(vertices.size());
+    for (const Corner& v : vertices) {
+        mesh.positions.push_back(raw.positions[v.position]);
+        mesh.normals.push_back(glm::vec3(v.normal[0], v.normal[1], v.normal[2]));
+    }
+    for (std::size_t s = 0; s < sources.size(); ++s)
+        mesh.normalsSource += (s ? " and " : "") + sources[s];
 
     // Triangles and materials.
     std::vector<std::int64_t> outputMaterial(raw.materials.size(), -1);
     mesh.indices.reserve(3 * kept.size());
     mesh.triangleMaterial.reserve(kept.size());
-    for (std::size_t t : kept) {
+    for (std::size_t i = 0; i < kept.size(); ++i) {
+        const std::size_t t = kept[i];
         for (int c = 0; c < 3; ++c) {
-            const auto it =
-                std::lower_bound(vertexKeys.begin(), vertexKeys.end(), makeKey(3 * t + c));
-            mesh.indices.push_back(static_cast<std::uint32_t>(it - vertexKeys.begin()));
+            const auto it = std::lower_bound(vertices.begin(), vertices.end(),
+                                             corners[3 * i + std::size_t(c)]);
+            mesh.indices.push_back(static_cast<std::uint32_t>(it - vertices.begin()));
         }
         const std::uint32_t m = raw.triangleMaterial[t];
         const RawMaterial& material = raw.materials[m];
@@ -211,7 +270,25 @@ LoadedMesh loadMesh(const std::string& path, const MeshLoadOptions& options)
     const detail::RawMesh raw = extension == ".obj"
                                     ? detail::readObj(path, contents, options)
                                     : detail::readGltf(path, contents, extension == ".glb");
-    return detail::finishMesh(path, raw);
+    return detail::finishMesh(path, raw, options.normals);
+}
+
+std::string NormalMode::describe() const
+{
+    switch (kind) {
+    case Kind::FromFile:
+        return "from file";
+    case Kind::Flat:
+        return "flat";
+    case Kind::Smooth:
+        return "smooth";
+    case Kind::CreaseAngle: {
+        std::ostringstream s;
+        s << "crease angle " << creaseAngleDegrees;
+        return s.str();
+    }
+    }
+    return "?";
 }
 
 } // namespace rtlab::scene

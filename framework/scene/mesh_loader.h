@@ -11,8 +11,8 @@
 //   - an edge shared by more than two triangles: accepted, nonManifold is set;
 //   - a missing, unreadable or malformed file: error with the parser's message.
 //
-// OBJ: `v`, `vn`, `vt`, `f`, `o`, `g`, `usemtl` and `mtllib` are read; other statements (`s`,
-// `l`, `p`, free-form geometry, ...) are ignored. Polygons are fan-triangulated from their first
+// OBJ: `v`, `vn`, `vt`, `f`, `o`, `g`, `s`, `usemtl` and `mtllib` are read; other statements
+// (`l`, `p`, free-form geometry, ...) are ignored. Polygons are fan-triangulated from their first
 // corner. Indices may be negative (relative). Every `mtllib` must exist and every `usemtl` name
 // must be defined by one of them; an MTL gives Kd (albedo) and Ke (emission), RGB only. With
 // MeshLoadOptions::materialsOptional (a scene file that assigns its own material to the mesh) a
@@ -25,6 +25,16 @@
 // other primitive modes, sparse accessors, quantized (non-float) positions or normals and
 // required extensions other than KHR_materials_emissive_strength are refused. Skins and morph
 // targets are ignored (rest pose); textures are ignored.
+//
+// Normals, as the files mean them (NormalMode::FromFile): a corner's normal is the file's (OBJ
+// `vn`, glTF NORMAL) where given and non-zero; otherwise, in an OBJ with smoothing groups, the
+// area-weighted mean of the normals of the triangles around the vertex in the same group (`s 1`,
+// `s 2`, ...), and the triangle's own normal under `s off` / `s 0`; otherwise flat, the triangle's
+// own normal: an OBJ without `vn` and without `s` has flat faces, as Blender, Assimp and
+// tinyobjloader read it, and a glTF primitive without NORMAL is flat by the glTF 2.0
+// specification ("client implementations must calculate flat normals"). A scene file may
+// override this per mesh (NormalMode::Flat, Smooth, or CreaseAngle: smooth across edges whose
+// faces meet at less than the angle, as Blender's auto smooth), replacing the file's normals.
 
 #include <glm/vec3.hpp>
 
@@ -40,10 +50,14 @@ struct LoadedMesh {
     //! kept triangle uses are left out; an OBJ position used with several `vn` is repeated once per
     //! normal. Otherwise the file's order is kept.
     std::vector<glm::vec3> positions;
-    //! Unit normal per vertex: the file's (OBJ `vn`, glTF NORMAL, transformed by the inverse
-    //! transpose of the node matrix) where given and non-zero, else the area-weighted average of
-    //! the normals of the kept triangles around the vertex.
+    //! Unit normal per vertex, chosen by MeshLoadOptions::normals (see the header comment; file
+    //! normals: glTF NORMAL transformed by the inverse transpose of the node matrix). A position
+    //! with several normals is repeated once per normal.
     std::vector<glm::vec3> normals;
+    //! Where the normals came from, for `rtlab scene`: "file (vn)", "smoothing groups", "flat (no
+    //! vn, no smoothing groups)", "flat (no NORMAL)", or the override ("flat", "smooth",
+    //! "crease angle 60"); "file (vn) and flat" and the like when a mesh mixes them.
+    std::string normalsSource;
     //! Three per triangle, counter-clockwise seen from the front (glTF: also under a mirroring
     //! node transform, whose triangles are flipped back).
     std::vector<std::uint32_t> indices;
@@ -68,10 +82,20 @@ struct LoadedMesh {
     std::size_t triangleCount() const { return indices.size() / 3; }
 };
 
+//! How a mesh's normals are made (see the header comment).
+struct NormalMode {
+    enum class Kind { FromFile, Flat, Smooth, CreaseAngle };
+    Kind kind = Kind::FromFile;
+    double creaseAngleDegrees = 180.0; //!< CreaseAngle: in (0, 180]
+    //! "from file", "flat", "smooth", "crease angle 60".
+    std::string describe() const;
+};
+
 struct MeshLoadOptions {
     //! The caller assigns its own material: a missing MTL or material definition is a warning,
     //! and the triangles get the default material (albedo 0.8, no emission).
     bool materialsOptional = false;
+    NormalMode normals;
 };
 
 //! Loads the mesh at `path`, chosen by extension (case-insensitive): .obj, .gltf or .glb.
@@ -94,6 +118,10 @@ struct RawMesh {
     std::vector<std::uint32_t> cornerPosition;   //!< three per triangle, into positions
     std::vector<std::int64_t> cornerNormal;      //!< three per triangle, into normals; -1 for none
     std::vector<std::uint32_t> triangleMaterial; //!< into materials
+    //! Per triangle: its OBJ smoothing group, 0 for `s off` / `s 0` and before any `s`; empty
+    //! when the file has no smoothing groups (then flat where it gives no normals).
+    std::vector<std::uint32_t> triangleSmoothing;
+    std::string formatFlatReason = "no vn, no smoothing groups"; //!< why missing normals are flat
     std::vector<RawMaterial> materials;
     std::vector<std::string> warnings; //!< see LoadedMesh::warnings
 };
@@ -107,7 +135,7 @@ RawMesh readGltf(const std::string& path, const std::string& bytes, bool binary)
 std::string readWholeFile(const std::string& path);
 //! Drops degenerate triangles, merges corners into vertices, computes missing normals, resolves
 //! materials and checks manifoldness.
-LoadedMesh finishMesh(const std::string& path, const RawMesh& raw);
+LoadedMesh finishMesh(const std::string& path, const RawMesh& raw, const NormalMode& normals = {});
 
 } // namespace detail
 

@@ -231,7 +231,9 @@ private:
                          ? std::string(keyword == "o" ? "object " : "group ") + quote(s.getRest())
                          : std::string();
             mFaceInGroup = 0;
-        } else if (keyword == "usemtl")
+        } else if (keyword == "s")
+            readSmoothingGroup(s);
+        else if (keyword == "usemtl")
             readUseMaterial(s);
         else if (keyword == "mtllib")
             readMaterialLibraries(s);
@@ -366,7 +368,31 @@ private:
                 mRaw.cornerNormal.push_back(normals[c]);
             }
             mRaw.triangleMaterial.push_back(mMaterial);
+            if (mHasSmoothing)
+                mRaw.triangleSmoothing.push_back(mSmoothing);
         }
+    }
+
+    //! `s N` (N > 0: smoothing group N), `s 0` or `s off` (flat).
+    void readSmoothingGroup(const Statement& s)
+    {
+        if (s.size() != 2)
+            throw InputError(s.locate(mPath, 0),
+                             "s needs one smoothing group: a number, or 'off'");
+        const std::string_view g = s[1];
+        std::uint32_t group = 0;
+        if (g != "off") {
+            const auto [end, error] = std::from_chars(g.data(), g.data() + g.size(), group);
+            if (error != std::errc() || end != g.data() + g.size())
+                throw InputError(s.locate(mPath, 1), "smoothing group " + quote(g) +
+                                                         ": expected a number >= 0 or 'off'");
+        }
+        if (!mHasSmoothing) {
+            // Triangles before the first `s` are in no group.
+            mRaw.triangleSmoothing.assign(mRaw.triangleMaterial.size(), 0u);
+            mHasSmoothing = true;
+        }
+        mSmoothing = group;
     }
 
     void readUseMaterial(const Statement& s)
@@ -450,6 +476,8 @@ private:
     const MeshLoadOptions& mOptions;
     RawMesh mRaw;
     std::uint32_t mMaterial = kNoMaterial;
+    bool mHasSmoothing = false;  // some `s` statement was read
+    std::uint32_t mSmoothing = 0; // the current smoothing group, 0 = off
     std::unordered_map<std::string, std::uint32_t> mMaterialIndex;
     std::vector<SourceLocation> mFirstUse; //!< per raw material, its first usemtl
     std::unordered_map<std::string, MtlDefinition> mDefinitions;

@@ -24,6 +24,8 @@ struct MeshInstance {
     std::string sourceFile;                        //!< "" for procedural meshes
     std::vector<glm::vec3> positions;              //!< world units
     std::vector<glm::vec3> normals;                //!< per vertex, may be empty (then computed)
+    //! Where a loaded mesh's normals came from (LoadedMesh::normalsSource), "" for procedural ones.
+    std::string normalsSource;
     std::vector<std::uint32_t> indices;            //!< three per triangle
     std::vector<std::uint32_t> triangleMaterial;   //!< index into Scene::materials
 };

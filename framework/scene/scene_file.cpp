@@ -92,19 +92,49 @@ struct Parser {
         }
     }
 
+    //! A mesh's `normals`: from_file (the default: what the file means, mesh_loader.h), flat,
+    //! smooth, or {crease_angle: degrees in (0, 180]}.
+    NormalMode readNormalMode(const YAML::Node& node) const
+    {
+        NormalMode mode;
+        if (!node)
+            return mode;
+        const char* expected = "normals: expected from_file, flat, smooth or {crease_angle: degrees}";
+        if (node.IsMap()) {
+            config::checkKeys(file, node, {"crease_angle"}, {"crease_angle"}, "normals");
+            const double a = config::readFloat(file, node["crease_angle"], "crease_angle");
+            if (!(a > 0.0 && a <= 180.0))
+                file.fail(node["crease_angle"], "crease_angle: expected degrees in (0, 180], found " +
+                                                    std::to_string(a));
+            mode.kind = NormalMode::Kind::CreaseAngle;
+            mode.creaseAngleDegrees = a;
+            return mode;
+        }
+        if (!node.IsScalar())
+            file.fail(node, expected);
+        const std::string name = config::readString(file, node, "normals");
+        config::checkName(file, node, name, {"from_file", "flat", "smooth"}, "normals");
+        mode.kind = name == "flat"     ? NormalMode::Kind::Flat
+                    : name == "smooth" ? NormalMode::Kind::Smooth
+                                       : NormalMode::Kind::FromFile;
+        return mode;
+    }
+
     void readMeshes(const YAML::Node& list)
     {
         if (!list.IsSequence())
             file.fail(list, "meshes: expected a list of {file, material, translate, scale, rotate_y}");
         for (const auto& m : list) {
-            config::checkKeys(file, m, {"file", "name", "material", "translate", "scale", "rotate_y"}, {"file"},
-                              "mesh");
+            config::checkKeys(file, m,
+                              {"file", "name", "material", "translate", "scale", "rotate_y", "normals"},
+                              {"file"}, "mesh");
             const std::string rel = config::readString(file, m["file"], "mesh file");
             const std::string path = (folder / rel).lexically_normal().string();
             LoadedMesh loaded;
             try {
                 // A material assigned here makes the file's own materials optional.
-                loaded = loadMesh(path, {.materialsOptional = bool(m["material"])});
+                loaded = loadMesh(path, {.materialsOptional = bool(m["material"]),
+                                         .normals = readNormalMode(m["normals"])});
             } catch (const InputError& e) {
                 // Name both places: where the scene refers to the mesh, and the mesh's own error.
                 file.fail(m["file"], "mesh '" + rel + "': " + e.what());
@@ -113,6 +143,7 @@ struct Parser {
             MeshInstance inst;
             inst.name = m["name"] ? config::readString(file, m["name"], "mesh name") : rel;
             inst.sourceFile = path;
+            inst.normalsSource = loaded.normalsSource;
             const glm::dvec3 t = m["translate"] ? readVec3(m["translate"], "translate") : glm::dvec3(0.0);
             const double s = m["scale"] ? readPositive(m["scale"], "scale") : 1.0;
             const double ry = m["rotate_y"] ? config::readFloat(file, m["rotate_y"], "rotate_y") : 0.0;

@@ -176,6 +176,43 @@ TEST(SceneFile, AMeshWhoseMaterialTheSceneAssignsLoadsWithoutItsMtl)
     }
 }
 
+TEST(SceneFile, AMeshsNormalsAreWhatItsFileMeansUnlessTheSceneSaysOtherwise)
+{
+    // Two triangles meeting at 90 degrees along an edge, no vn, no smoothing groups.
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_scene_file_normals_test";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "hinge.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 4 2\n";
+    const auto load = [&](const std::string& normals) {
+        std::ofstream(dir / "hinge.yaml") << "scene: hinge\nmaterials: [{name: grey, albedo: 0.5}]\n"
+                                             "meshes: [{file: hinge.obj, material: grey"
+                                          << (normals.empty() ? "" : ", normals: " + normals) << "}]\n";
+        return loadScene((dir / "hinge.yaml").string());
+    };
+    const Scene file = load("");
+    EXPECT_EQ(file.meshes[0].positions.size(), 6u); // flat: each face its own vertices
+    EXPECT_EQ(file.meshes[0].normalsSource, "flat (no vn, no smoothing groups)");
+    const Scene smooth = load("smooth");
+    EXPECT_EQ(smooth.meshes[0].positions.size(), 4u);
+    EXPECT_EQ(smooth.meshes[0].normalsSource, "smooth");
+    EXPECT_EQ(load("{crease_angle: 60}").meshes[0].positions.size(), 6u);
+    EXPECT_EQ(load("{crease_angle: 120}").meshes[0].positions.size(), 4u);
+    EXPECT_EQ(load("flat").meshes[0].normalsSource, "flat");
+    // Bad values name the line and column and what was expected.
+    try {
+        load("smoth");
+        FAIL() << "expected an error";
+    } catch (const rtlab::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("hinge.yaml:3:"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("smooth"), std::string::npos) << e.what();
+    }
+    try {
+        load("{crease_angle: 0}");
+        FAIL() << "expected an error";
+    } catch (const rtlab::InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("expected degrees in (0, 180]"), std::string::npos) << e.what();
+    }
+}
+
 TEST(SceneFile, EveryShippedSceneFileLoadsAndBuilds)
 {
     // The scene files under scenes/ are part of the product: each must load and build every frame.

@@ -13,6 +13,7 @@
 #include "scene/render_scene.h"
 #include "scene/sky.h"
 
+#include <glm/common.hpp>
 #include <glm/exponential.hpp>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
@@ -72,12 +73,19 @@ struct ConeMarchSettings {
     double maxOpacity = 0.99;   //!< stop when the accumulated occupancy reaches it
     double maxDistance = 1e30;  //!< world units (point-light shadow cones stop at the light)
     int maxSteps = 1024;
+    //! World units along the cone from which its voxels shadow the sky (ConeResult::
+    //! skyTransmittance); nearer occluders are left to the occlusion family's visibilities.
+    double skyStartDistance = 0.0;
 };
 
 struct ConeResult {
     std::array<glm::vec3, kFieldCount> light{}; //!< radiance of each field seen along the cone
     double transmittance = 1.0;                 //!< 1 - accumulated occupancy
+    //! The same over the samples at or beyond ConeMarchSettings::skyStartDistance only.
+    double skyTransmittance = 1.0;
     bool escaped = false;                       //!< left the structure (sees the sky)
+    //! Left the structure, also after the light was done (marching on for the sky only).
+    bool skyEscaped = false;
     int steps = 0;
 };
 
@@ -92,6 +100,8 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
 {
     ConeResult r;
     double occupied = 0.0;
+    double skyTransmittance = 1.0;
+    bool lightDone = false; // the occupancy reached maxOpacity: no more light
     double t = s.startDistance;
     ConeSample sample;
     for (int step = 0; step < s.maxSteps; ++step) {
@@ -100,7 +110,8 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
         const double diameter = 2.0 * t * s.tanHalfAngle;
         const glm::dvec3 p = origin + t * dir;
         if (!sampler.sample(p, diameter, cone, dir, sample)) {
-            r.escaped = true;
+            r.escaped = !lightDone;
+            r.skyEscaped = true;
             break;
         }
         ++r.steps;
@@ -119,18 +130,50 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
             const double corrected = 1.0 - (exponent == 0.5   ? std::sqrt(transparent)
                                             : exponent == 1.0 ? transparent
                                                               : std::pow(transparent, exponent));
-            const double weight = (1.0 - occupied) * corrected / stepAlpha;
-            for (int f = 0; f < kFieldCount; ++f)
-                r.light[std::size_t(f)] += float(weight) * sample.light[std::size_t(f)];
-            occupied += (1.0 - occupied) * corrected;
-            if (occupied >= s.maxOpacity)
+            if (!lightDone) {
+                const double weight = (1.0 - occupied) * corrected / stepAlpha;
+                for (int f = 0; f < kFieldCount; ++f)
+                    r.light[std::size_t(f)] += float(weight) * sample.light[std::size_t(f)];
+                occupied += (1.0 - occupied) * corrected;
+                lightDone = occupied >= s.maxOpacity;
+            }
+            if (t >= s.skyStartDistance)
+                skyTransmittance *= 1.0 - corrected;
+            // Done when the light is (the occupancy) and so is the sky: occluders nearer than
+            // skyStartDistance do not end the cone's view of it.
+            if (lightDone && (s.skyStartDistance <= s.startDistance ||
+                              skyTransmittance <= 1.0 - s.maxOpacity))
                 break;
         }
         t += dt;
     }
     r.transmittance = 1.0 - occupied;
+    r.skyTransmittance = s.skyStartDistance <= s.startDistance ? r.transmittance : skyTransmittance;
     return r;
 }
+
+//! What a pixel's cone sees past the structure's voxels besides the reflected light: the sky,
+//! where the cone leaves the structure, times the transmittance of the voxels from
+//! ConeMarchSettings::skyStartDistance on (nearer ones, the surface the cone starts from among
+//! them at coarse levels, are the occlusion family's part), plus the emission of the
+//! voxels it meets (the field kEmission of the sampler's result). The Tomorrow Children lit
+//! pixels so ("Sky Light": the sky as 16 SRBF lobes on the cone directions, gathered along the
+//! same cones as the bounce light through the cascades; emission injected into the light the
+//! cones gather), so walls far beyond a screen-space radius shadow the sky.
+inline glm::vec3 computeConeSkyRadiance(const ConeResult& r, const glm::vec3& skyOfCone)
+{
+    glm::vec3 sky = r.light[kEmission];
+    if (r.skyEscaped)
+        sky += float(r.skyTransmittance) * skyOfCone;
+    return glm::max(sky, glm::vec3(0.0f));
+}
+
+//! Where traceGBufferCones also writes the cones' sky and emitters (computeConeSkyRadiance):
+//! `skyPerCone` the mean sky radiance of each cone (computeSkyPerCone), `out` [pixel * 16 + cone].
+struct ConeSkyOutput {
+    std::array<glm::vec3, kConeCount> skyPerCone{};
+    std::vector<glm::vec3>* out = nullptr;
+};
 
 //! The Tomorrow Children's extrapolated extra bounce ("Extra Magic": places that received more
 //! second bounce than first are surmised to get more from a third, and boosted): from the

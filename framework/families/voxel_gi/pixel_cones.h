@@ -14,6 +14,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -32,14 +33,18 @@ inline bool readPixelSurface(const scene::GBuffer& gbuffer, int x, int y, glm::d
 }
 
 //! The radiance of each cone above the surface at every pixel, [pixel * 16 + cone], 0 elsewhere
-//! (the field kDirect of the sampler's result: the gathered light). Returns the mean number of
-//! steps per cone traced.
+//! (the field kDirect of the sampler's result: the gathered light), and with `sky` the cones' sky
+//! and emitters in the same layout. Returns the mean number of steps per cone traced.
 template <class Prepare, class Sampler>
 double traceGBufferCones(const scene::GBuffer& gbuffer, const ConeSet& cones, const Prepare& prepare,
-                         const Sampler& sampler, std::vector<glm::vec3>& out)
+                         const Sampler& sampler, std::vector<glm::vec3>& out,
+                         const ConeSkyOutput* sky = nullptr)
 {
     const int W = gbuffer.width, H = gbuffer.height;
     out.assign(std::size_t(W) * std::size_t(H) * kConeCount, glm::vec3(0.0f));
+    std::vector<glm::vec3>* skyOut = sky != nullptr ? sky->out : nullptr;
+    if (skyOut != nullptr)
+        skyOut->assign(out.size(), glm::vec3(0.0f));
     // The pixels' cone origins first; then the cones one direction at a time over a block of
     // rows, so that a thread's lookups stay in one direction's data (a pre-combined structure
     // keeps a buffer per cone: 16 x 512 KiB per 32^3 level, against 1 MiB of L2 here).
@@ -80,6 +85,9 @@ double traceGBufferCones(const scene::GBuffer& gbuffer, const ConeSet& cones, co
                 ++conesPerTask[std::size_t(task)];
                 out[pixel * kConeCount + std::size_t(k)] =
                     glm::max(r.light[kDirect], glm::vec3(0.0f));
+                if (skyOut != nullptr)
+                    (*skyOut)[pixel * kConeCount + std::size_t(k)] =
+                        computeConeSkyRadiance(r, sky->skyPerCone[std::size_t(k)]);
             }
     });
     std::uint64_t steps = 0, traced = 0;

@@ -17,6 +17,7 @@ struct SparseConeParams {
     double coneAngle = 29.0;  //!< degrees, half-angle
     double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
+    double skyStart = 8.0;    //!< leaves along a pixel cone from which its voxels shadow the sky
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int traceStep = 4;        //!< pixels: one traced per trace_step^2 block, then upsampled
     //! The pixel gather's device: vulkan, cpu or auto (cone_combine_gpu.h shouldGatherOnGpu).
@@ -25,7 +26,7 @@ struct SparseConeParams {
     int innerLayers = 1;      //!< layers of solid leaves kept inside closed surfaces
 
     //! Declares resolution (described by `resolutionHelp`), voxel_size, supersampling, bounces,
-    //! cone_angle, start_offset, inject_offset, step_scale, trace_step, device,
+    //! cone_angle, start_offset, inject_offset, sky_start, step_scale, trace_step, device,
     //! capsule_resolution and inner_layers.
     static void declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault);
     static SparseConeParams read(const config::ParamSet& p);

@@ -71,6 +71,7 @@ public:
     {
         mGatheredOnGpu = shouldGatherOnGpu(input.gpu, mParams.device);
         mCombinedOnGpu = shouldCombineOnGpu(input.gpu, mGatheredOnGpu);
+        mSky.cones.clear();
         if (mCombinedOnGpu) {
             irradiance = gatherConesReducedOnGpu(
                 *input.gpu, mCombineGpu, *input.gbuffer, mParams.traceStep,
@@ -81,16 +82,33 @@ public:
                 &mCombineMs, mParams.capsules);
             return;
         }
+        ConeSkyOutput sky;
+        if (input.scene != nullptr)
+            sky.skyPerCone = computeSkyPerCone(input.scene->sky, mStructure->getCones());
         irradiance = gatherConesReduced(
             *input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
             input.coneVisibility, input.capsules,
-            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
-                if (mGatheredOnGpu)
+            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones,
+                std::vector<glm::vec3>* skyCones) {
+                if (mGatheredOnGpu) {
                     mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
-                else
-                    mStructure->gatherCones(reduced, cones);
+                } else {
+                    sky.out = skyCones;
+                    mStructure->gatherCones(reduced, cones, &sky);
+                }
             },
-            &mCombineMs, mParams.capsules);
+            &mCombineMs, mParams.capsules, &mSky);
+    }
+
+    std::string combineConeSky(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
+    {
+        if (mGatheredOnGpu)
+            return "the Vulkan gather traces no cone sky yet (device: cpu does)";
+        if (!mSky.isValid())
+            return "no cones traced in the last gather";
+        irradiance = voxelgi::combineConeSky(mSky, *input.gbuffer, mStructure->getCones().halfAngle,
+                                             input.coneVisibility, input.capsules);
+        return {};
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel, Image<glm::vec3>& irradiance) override
@@ -140,6 +158,7 @@ protected:
 private:
     Gpu mGpu;
     ConeCombineGpu mCombineGpu;
+    ConeSkyTrace mSky; // the last C++ gather's cone sky, for combineConeSky
     std::string mGeometryKey, mLightsKey;
     bool mBuilt = false;
     bool mGatheredOnGpu = false;

@@ -259,6 +259,9 @@ void SparseConeParams::declare(config::ParamSchema& schema, const char* resoluti
                     "the pixel cones' start distance and origin offset along the normal");
     schema.addFloat("inject_offset", 4.0, 0.0, 8.0, "leaves",
                     "the same for the leaves' cones of light injection");
+    schema.addFloat("sky_start", 8.0, 0.0, 64.0, "leaves",
+                    "distance along a pixel cone from which its voxels shadow the sky (nearer "
+                    "occluders, the pixel's own surface among them, are the occlusion family's)");
     schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
     schema.addInt("trace_step", 4, 1, 8, "pixels",
                   "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
@@ -299,6 +302,7 @@ SparseConeParams SparseConeParams::read(const config::ParamSet& p)
     s.coneAngle = p.getFloat("cone_angle");
     s.startOffset = p.getFloat("start_offset");
     s.injectOffset = p.getFloat("inject_offset");
+    s.skyStart = p.getFloat("sky_start");
     s.stepScale = p.getFloat("step_scale");
     s.traceStep = int(p.getInt("trace_step"));
     s.device = p.getString("device");
@@ -316,6 +320,7 @@ void SparseConeParams::write(config::ParamSet& p) const
     p.set("cone_angle", coneAngle);
     p.set("start_offset", startOffset);
     p.set("inject_offset", injectOffset);
+    p.set("sky_start", skyStart);
     p.set("step_scale", stepScale);
     p.set("trace_step", std::int64_t(traceStep));
     p.set("device", device);

@@ -83,7 +83,8 @@ struct SparsePayload {
     //! [element * 6 + face]: rgb = the light a pixel gathers (the reflected fields up to the
     //! bounces, premultiplied), a = occupancy.
     std::vector<glm::vec4> gathered;
-    //! [element * 6 + face], premultiplied: the light fields, during injection only.
+    //! [element * 6 + face], premultiplied: the light fields, during injection only (the
+    //! emission field is kept after it when some leaf emits).
     std::array<std::vector<glm::vec3>, kFieldCount> fields;
 
     std::size_t getElementCount() const { return gathered.size() / kFaceCount; }
@@ -169,6 +170,9 @@ void sampleSparseLevel(const Find& find, const glm::dvec3& origin, double cellSi
             out.alpha += aw * v.a;
             if constexpr (Gathered) {
                 out.light[kDirect] += aw * glm::vec3(v);
+                // The emitters the pixels' cones meet (kept only when some leaf emits).
+                if (!payload.fields[kEmission].empty())
+                    out.light[kEmission] += aw * payload.fields[kEmission][g];
             } else {
                 for (int field = 0; field < kFieldCount; ++field)
                     out.light[std::size_t(field)] += aw * payload.fields[std::size_t(field)][g];
@@ -257,8 +261,13 @@ void injectLeafLight(const scene::RenderScene& geometry, const ConeSet& cones, c
             sum += payload.fields[std::size_t(field)][g];
         payload.gathered[g] = glm::vec4(sum, payload.gathered[g].a);
     });
-    for (auto& field : payload.fields)
-        std::vector<glm::vec3>().swap(field);
+    // The reflected fields are released; the emission stays when some leaf emits, for the
+    // pixels' cones that meet the emitters (pixel_cones.h computeConeSkyRadiance).
+    const bool emits = std::any_of(payload.fields[kEmission].begin(), payload.fields[kEmission].end(),
+                                   [](const glm::vec3& e) { return e != glm::vec3(0.0f); });
+    for (int field = 0; field < kFieldCount; ++field)
+        if (field != kEmission || !emits)
+            std::vector<glm::vec3>().swap(payload.fields[std::size_t(field)]);
 }
 
 //! cone_tracing.h Samplers of a sparse structure S (its light fields during injection, its
@@ -283,11 +292,13 @@ struct SparseGatheredSampler {
 //! The 16 cones of every pixel through a sparse structure S (S::preparePixel says where they
 //! start): pixel_cones.h traceGBufferCones. Returns the mean number of steps per cone.
 template <class S>
-double traceSparsePixelCones(const S& structure, const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+double traceSparsePixelCones(const S& structure, const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                             const ConeSkyOutput* sky = nullptr)
 {
     const auto prepare = [&](const scene::GBuffer& g, int x, int y, glm::dvec3& origin, glm::dvec3& n,
                              ConeMarchSettings& march) { return structure.preparePixel(g, x, y, origin, n, march); };
-    return traceGBufferCones(gbuffer, structure.getCones(), prepare, SparseGatheredSampler<S>{&structure}, out);
+    return traceGBufferCones(gbuffer, structure.getCones(), prepare, SparseGatheredSampler<S>{&structure}, out,
+                             sky);
 }
 
 //! `rays` zero-aperture rays per pixel through a sparse structure S: pixel_cones.h traceGBufferRays.

@@ -473,21 +473,28 @@ void occludeTracedCones(const scene::GBuffer& traced, std::vector<glm::vec3>& co
 Image<glm::vec3> gatherConesReduced(
     const scene::GBuffer& full, int traceStep, double coneHalfAngle,
     const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
-    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones,
-    double* combineMs, CapsuleResolution capsuleResolution)
+    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&, std::vector<glm::vec3>*)>&
+        traceCones,
+    double* combineMs, CapsuleResolution capsuleResolution, ConeSkyTrace* sky)
 {
     using Clock = std::chrono::steady_clock;
     const auto start = Clock::now();
-    const ReducedGBuffer reduced = reduceGBuffer(full, traceStep);
+    ReducedGBuffer reduced = reduceGBuffer(full, traceStep);
     const auto reducedAt = Clock::now();
     std::vector<glm::vec3> cones;
-    traceCones(reduced.gbuffer, cones);
+    if (sky != nullptr)
+        sky->cones.clear();
+    traceCones(reduced.gbuffer, cones, sky != nullptr ? &sky->cones : nullptr);
     const auto tracedAt = Clock::now();
     // The capsules at the traced pixels in place (combineCones would copy the cones for them).
     const bool capsulesTraced =
         capsuleResolution == CapsuleResolution::Traced && capsules != nullptr;
     if (capsulesTraced)
         occludeTracedCones(reduced.gbuffer, cones, *capsules, coneHalfAngle);
+    // The sky's cones wait for the frame's compose (combineConeSky), which may not need them.
+    const bool keepSky = sky != nullptr && !sky->cones.empty();
+    if (keepSky && capsulesTraced)
+        occludeTracedCones(reduced.gbuffer, sky->cones, *capsules, coneHalfAngle);
     ConeCombineInputs combine;
     combine.coneRadiance = &cones;
     combine.reduced = &reduced;
@@ -498,7 +505,36 @@ Image<glm::vec3> gatherConesReduced(
     Image<glm::vec3> irradiance = combineCones(combine);
     if (combineMs != nullptr)
         *combineMs = std::chrono::duration<double, std::milli>((reducedAt - start) + (Clock::now() - tracedAt)).count();
+    if (keepSky) {
+        sky->reduced = std::move(reduced);
+        sky->capsulesApplied = capsulesTraced;
+    }
     return irradiance;
+}
+
+Image<glm::vec3> combineConeSky(const ConeSkyTrace& sky, const scene::GBuffer& full, double coneHalfAngle,
+                                const std::vector<Image<float>>* visibility,
+                                const std::vector<scene::PosedCapsule>* capsules)
+{
+    if (!sky.isValid())
+        throw Error("cone sky: no cones traced in the last gather (" + std::to_string(sky.cones.size()) +
+                    " cone values for a " + std::to_string(sky.reduced.gbuffer.width) + "x" +
+                    std::to_string(sky.reduced.gbuffer.height) + " traced G-buffer)");
+    const int factor = sky.reduced.factor;
+    if (full.width == 0 || (full.width + factor - 1) / factor != sky.reduced.gbuffer.width ||
+        (full.height + factor - 1) / factor != sky.reduced.gbuffer.height)
+        throw Error("cone sky: traced at " + std::to_string(sky.reduced.gbuffer.width) + "x" +
+                    std::to_string(sky.reduced.gbuffer.height) + ", not one pixel per " +
+                    std::to_string(factor) + "^2 block of the " + std::to_string(full.width) + "x" +
+                    std::to_string(full.height) + " G-buffer");
+    ConeCombineInputs combine;
+    combine.coneRadiance = &sky.cones;
+    combine.reduced = &sky.reduced;
+    combine.full = &full;
+    combine.visibility = visibility;
+    combine.capsules = sky.capsulesApplied ? nullptr : capsules;
+    combine.coneHalfAngle = coneHalfAngle;
+    return combineCones(combine);
 }
 
 Image<glm::vec3> traceRaysReduced(const scene::GBuffer& full, int traceStep,

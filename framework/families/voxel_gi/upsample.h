@@ -72,17 +72,47 @@ Image<glm::vec3> combineCones(const ConeCombineInputs& in);
 void occludeTracedCones(const scene::GBuffer& traced, std::vector<glm::vec3>& coneRadiance,
                         const std::vector<scene::PosedCapsule>& capsules, double coneHalfAngle);
 
+//! The sky and emitters the cones of a gather saw ([low-res pixel * 16 + cone], cone_tracing.h
+//! computeConeSkyRadiance) and the reduced G-buffer they were traced from, kept until the frame
+//! composes them (combineConeSky). Empty `cones` when the gather traced none.
+struct ConeSkyTrace {
+    std::vector<glm::vec3> cones;
+    ReducedGBuffer reduced;
+    bool capsulesApplied = false; //!< the capsules were multiplied into `cones` already
+
+    bool isValid() const
+    {
+        return !cones.empty() &&
+               cones.size() == std::size_t(reduced.gbuffer.width) *
+                                   std::size_t(reduced.gbuffer.height) * std::size_t(16);
+    }
+};
+
 //! A cone-traced structure's pixel gather as the family runs it (cascades, svo): the G-buffer
-//! reduced to one pixel per traceStep^2 block, `traceCones(reduced, coneRadiance)` fills
-//! [low-res pixel * 16 + cone] there, and combineCones brings it back to full resolution with the
-//! cone visibilities and capsules (either may be null), the capsules tested where
+//! reduced to one pixel per traceStep^2 block, `traceCones(reduced, coneRadiance, skyCones)`
+//! fills [low-res pixel * 16 + cone] there, and combineCones brings it back to full resolution
+//! with the cone visibilities and capsules (either may be null), the capsules tested where
 //! `capsuleResolution` says. `combineMs`, when given, receives the wall time of the reduction,
-//! the capsules and the combine (the gather's time beyond `traceCones`).
+//! the capsules and the combine (the gather's time beyond `traceCones`). With `sky`,
+//! `skyCones` points to sky->cones, which traceCones fills with the cones' sky and emitters (or
+//! leaves empty), kept with the reduced G-buffer for combineConeSky; without, it is null.
 Image<glm::vec3> gatherConesReduced(
     const scene::GBuffer& full, int traceStep, double coneHalfAngle,
     const std::vector<Image<float>>* visibility, const std::vector<scene::PosedCapsule>* capsules,
-    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&)>& traceCones,
-    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full);
+    const std::function<void(const scene::GBuffer&, std::vector<glm::vec3>&, std::vector<glm::vec3>*)>&
+        traceCones,
+    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full,
+    ConeSkyTrace* sky = nullptr);
+
+//! The irradiance from the sky and emitters of `sky` at every pixel of `full` (the G-buffer
+//! the gather was given): the same combine as the gather's light (combineCones: upsampled per
+//! cone, times the cone visibilities and the capsules' occlusion, integrated with the pixel's
+//! irradiance weights), so the occlusion family's 16 visibilities refine each direction at
+//! small scale as the Tomorrow Children's final combine did. Throws rtlab::Error when `sky`
+//! is not valid.
+Image<glm::vec3> combineConeSky(const ConeSkyTrace& sky, const scene::GBuffer& full, double coneHalfAngle,
+                                const std::vector<Image<float>>* visibility,
+                                const std::vector<scene::PosedCapsule>* capsules);
 
 //! The error split's rays (voxel_gi.h traceVoxelRays) at the same representative pixels as
 //! gatherConesReduced, upsampled the same way: `traceRays(reduced, irradiance)`.

@@ -93,6 +93,17 @@ public:
     //! Indirect diffuse irradiance at every G-buffer pixel (0 where there is no surface).
     virtual void gather(const VoxelGiInput& input, Image<glm::vec3>& irradiance) = 0;
     virtual VoxelGiMemory memory() const = 0;
+    //! The irradiance from the sky and from emissive surfaces that the 16 cones of the last
+    //! gather() saw past the technique's voxels (the sky where a cone leaves the structure, times
+    //! what the voxels let through; the emitters the cones meet), at every pixel of that gather's
+    //! G-buffer, with the same visibilities and capsules (`input`, as given to it). The lit frame
+    //! lights the sky and the emitters with it (render/lighting_pass.h), as the Tomorrow Children
+    //! did. Returns "" when written, else why there is none (the frame then lights the sky
+    //! through the lobes times the occlusion family's visibility, and records that).
+    virtual std::string combineConeSky(const VoxelGiInput& input, Image<glm::vec3>& irradiance)
+    {
+        return "the technique traces no cones toward the sky";
+    }
     //! For the split of the error: the technique's own voxels and light buffers gathered along
     //! `raysPerPixel` rays per pixel (zero aperture, no 16-direction quadrature, the finest voxels
     //! available) instead of its cones, at the same points. Technique vs this is the cone error;

@@ -260,6 +260,42 @@ private:
                           ctx.write(slot) = ctx.read(indirect);
                           return pipeline::PassOutcome{};
                       });
+        // The sky and the emitters through the technique's cones, for the lit frame (culled
+        // when no frame is lit: nothing reads the slot then).
+        const auto coneSky = pipeline::Compose::coneSkySlot(w, h);
+        graph.addPass(
+            {.name = "voxel_cone_sky",
+             .reads = {indirect, gbuffer},
+             .optionalReads = gatherOptional,
+             .writes = {coneSky}},
+            [this, gbuffer, cones, hasCones, capsules, hasCapsules,
+             coneSky](pipeline::PassContext& ctx) {
+                const scene::GBuffer& g = ctx.read(gbuffer);
+                plugin::VoxelGiInput input;
+                input.gbuffer = &g;
+                input.cameraPosition = glm::dvec3(g.camera.position);
+                input.frameIndex = ctx.frame();
+                input.gpu = &mContext.getGpu();
+                input.capsules = hasCapsules ? ctx.tryRead(capsules) : nullptr;
+                const auto* visibility = hasCones ? ctx.tryRead(cones) : nullptr;
+                input.coneVisibility =
+                    visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
+                        ? visibility
+                        : nullptr;
+                Image<glm::vec3>& out = ctx.write(coneSky);
+                out = Image<glm::vec3>();
+                const std::string whyNot = mTechnique->combineConeSky(input, out);
+                if (!whyNot.empty()) {
+                    out = Image<glm::vec3>(); // the frame lights its sky with the lobes
+                    mRow->set("voxel_cone_sky.none", whyNot);
+                } else if (out.width != g.width || out.height != g.height) {
+                    throw Error("technique '" + mTechniqueName + "' returned " +
+                                std::to_string(out.width) + "x" + std::to_string(out.height) +
+                                " cone sky for a " + std::to_string(g.width) + "x" +
+                                std::to_string(g.height) + " G-buffer");
+                }
+                return pipeline::PassOutcome{};
+            });
         graph.addPass(
             {.name = "reference_indirect",
              .reads = {geometry, gbuffer, view},

@@ -41,12 +41,14 @@ layout(binding = 14, rgba32f) uniform readonly image2D coneVisibility3;
 layout(binding = 9, rgba32f) uniform readonly image2D indirectIrradiance;
 layout(binding = 10, rgba32f) uniform writeonly image2D outHdr;
 layout(binding = 11, rgba32f) uniform writeonly image2D outDirect;
+// The sky and emitters seen through a voxel GI technique's cones (flags.z = 1).
+layout(binding = 15, rgba32f) uniform readonly image2D coneSkyIrradiance;
 
 layout(push_constant) uniform Frame {
     mat4 inverseRelativeViewProjection; // clip -> camera-relative world
     vec4 cameraPosition;                // xyz world units, w: min light distance
     uvec4 sizeLightsVisibility;         // width, height, lights, visibility (0 none, 1 ao, 2 cones)
-    uvec4 flags;                        // x: has indirect, y: shadow face size
+    uvec4 flags;                        // x: has indirect, y: shadow face size, z: has cone sky
     vec4 shadowParameters;              // PCF spacing, normal offset, slope offset (texels)
 } frame;
 
@@ -174,8 +176,13 @@ void main()
     // Sky: E = Sum_k V_k L_k I(n . a_k), V_k from the visibility input. The Tomorrow Children
     // intersect each pixel's SSDO visibility cone with the 16 cone directions "and modulate the
     // incoming light accordingly" [GDC 2015, "Screen Space Directional Occlusion"].
+    // With a cone sky (a voxel GI technique ran) the sky and the emitters come through its 16
+    // cones past its voxels, the visibilities V_k already applied per cone [GDC 2015, "Sky
+    // Light": the sky gathered along the same cones as the bounce light].
     vec3 skyIrradiance = vec3(0.0);
-    if (int(sky.parameters.x) != 0) {
+    if (frame.flags.z != 0u) {
+        skyIrradiance = imageLoad(coneSkyIrradiance, pixel).rgb;
+    } else if (int(sky.parameters.x) != 0) {
         const uint visibility = frame.sizeLightsVisibility.w;
         const float ao = visibility == 1u ? imageLoad(ambientOcclusion, pixel).r : 1.0;
         vec4 cones[4] = vec4[4](vec4(ao), vec4(ao), vec4(ao), vec4(ao));

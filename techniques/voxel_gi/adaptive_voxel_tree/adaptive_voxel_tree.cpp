@@ -30,7 +30,14 @@
 //    evaluated for the pixel's normal: E(n) = sum_i n_i^2 E_{axis i, sign n_i} for the ambient
 //    cube, a + b.n (clamped at 0) for sh_l1. `interpolation: plain` uses one level only (missing
 //    corners dropped), the comparison the talk makes.
-// Characters and the occlusion family's cone visibilities are not used (the probes are static).
+// Characters and the occlusion family's cone visibilities are not used for the indirect light
+// (the probes are static).
+// 4. the sky: the bake also stores, per probe and axis in the same payload form, the irradiance
+//    from the sky and the emissive surfaces straight (reference.h "direct" without the point
+//    lights), so walls and roofs beyond any screen-space radius shadow the sky: the sky transport
+//    of Quantum Break's probes. The lit frame takes it instead of the sky lobes (voxel_gi.h
+//    combineConeSky), times the cosine-weighted mean of the occlusion family's 16 visibilities
+//    when it gives them (the small-scale occlusion the probes' leaves are too coarse for).
 // The tree as the structure of the 16-cone tracing: technique adaptive_voxel_tree_cones.
 // Not yet: this gather on Vulkan (the tree's lookup is there: adaptive_voxel_tree_cones's
 // shaders/tree_find.glsl).
@@ -67,6 +74,7 @@
 
 #include <glm/common.hpp>
 #include <glm/geometric.hpp>
+#include <glm/gtc/constants.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -81,6 +89,7 @@ namespace {
 using namespace rtlab;
 
 constexpr int kAxes = 6; // +x, -x, +y, -y, +z, -z (voxelize.h's face order)
+constexpr int kProbesPerRow = 64; // probes per row of the bake's G-buffer (6 axes each)
 
 class AdaptiveVoxelTreeGi final : public plugin::VoxelGiTechnique {
 public:
@@ -159,6 +168,7 @@ public:
         mBakedKey.clear();
         mTree.reset();
         mPayload.clear();
+        mSkyPayload.clear();
         if (g.indices.empty())
             return plugin::VoxelGiStep::done("no geometry: an empty tree");
         // The box: the geometry's bounds padded by half a leaf, so that no surface lies on the
@@ -221,6 +231,37 @@ public:
         });
     }
 
+    std::string combineConeSky(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
+    {
+        if (!mTree || mSkyPayload.empty())
+            return "no probes baked";
+        const scene::GBuffer& g = *input.gbuffer;
+        const bool cones = input.coneVisibility != nullptr &&
+                           input.coneVisibility->size() == std::size_t(voxelgi::kConeCount);
+        const voxelgi::ConeSet coneSet = voxelgi::ConeSet::make(29.0);
+        irradiance = Image<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
+        tbb::parallel_for(0, g.height, [&](int y) {
+            for (int x = 0; x < g.width; ++x) {
+                if (!g.hasSurface(x, y))
+                    continue;
+                const glm::dvec3 n(g.normal.at(x, y));
+                const glm::dvec3 p(g.position.at(x, y));
+                double visible = 1.0;
+                if (cones) {
+                    // The visibilities' cosine-weighted mean (the weights sum to pi).
+                    const auto w = voxelgi::computeIrradianceWeights(coneSet, n);
+                    visible = 0.0;
+                    for (int k = 0; k < voxelgi::kConeCount; ++k)
+                        visible += w[std::size_t(k)] *
+                                   std::clamp(double((*input.coneVisibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
+                    visible /= glm::pi<double>();
+                }
+                irradiance.at(x, y) = glm::vec3(visible * evaluate(p, n, mSkyPayload));
+            }
+        });
+        return {};
+    }
+
     bool computeLookupLevels(const plugin::VoxelGiInput& input,
                              Image<std::uint8_t>& levels) override
     {
@@ -243,7 +284,7 @@ public:
         if (!mTree)
             return {};
         return {.topologyBytes = mTree->getTopologyBytes(),
-                .payloadBytes = mPayload.size() * sizeof(glm::vec3)};
+                .payloadBytes = (mPayload.size() + mSkyPayload.size()) * sizeof(glm::vec3)};
     }
 
     std::vector<std::pair<std::string, double>> counters() const override
@@ -268,7 +309,6 @@ private:
         const auto start = std::chrono::steady_clock::now();
         const std::vector<glm::ivec4> cells = mTree->listElementCells();
         const std::size_t probes = cells.size();
-        constexpr int kProbesPerRow = 64;
         scene::GBuffer g;
         g.width = kProbesPerRow * kAxes;
         g.height = int((probes + kProbesPerRow - 1) / kProbesPerRow);
@@ -289,14 +329,29 @@ private:
         }
         const reference::ReferenceSettings s = reference::makeFixedSampleSettings(
             reference::Quantity::Indirect, mBounces, mBakeSamples, 0xba4e0000ull);
-        const Image<glm::vec3> e = reference::computeReference(geometry, g, s).irradiance;
+        store(reference::computeReference(geometry, g, s).irradiance, probes, mPayload);
+        // The sky and the emitters straight: "direct" of the scene without its point lights
+        // (which the frame lights with their shadow maps).
+        scene::RenderScene skyAndEmitters = geometry;
+        skyAndEmitters.pointLights.clear();
+        const reference::ReferenceSettings sky = reference::makeFixedSampleSettings(
+            reference::Quantity::Direct, 1, mBakeSamples, 0xba4e5c00ull);
+        store(reference::computeReference(skyAndEmitters, g, sky).irradiance, probes, mSkyPayload);
+        mBakeSeconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    }
+
+    // The payload of every probe from its six axis irradiances (the bake's image, one row of
+    // kProbesPerRow probes x 6 axes).
+    void store(const Image<glm::vec3>& e, std::size_t probes, std::vector<glm::vec3>& payload) const
+    {
         const int m = payloadVectors();
-        mPayload.assign(probes * std::size_t(m), glm::vec3(0.0f));
+        payload.assign(probes * std::size_t(m), glm::vec3(0.0f));
         for (std::size_t i = 0; i < probes; ++i) {
             std::array<glm::vec3, kAxes> axis{};
             for (int a = 0; a < kAxes; ++a)
                 axis[std::size_t(a)] = e.at(int(i % kProbesPerRow) * kAxes + a, int(i / kProbesPerRow));
-            glm::vec3* out = &mPayload[i * std::size_t(m)];
+            glm::vec3* out = &payload[i * std::size_t(m)];
             if (!mShL1) {
                 std::copy(axis.begin(), axis.end(), out);
                 continue;
@@ -308,8 +363,6 @@ private:
             out[2] = 0.5f * (axis[2] - axis[3]);
             out[3] = 0.5f * (axis[4] - axis[5]);
         }
-        mBakeSeconds =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
 
     glm::dvec3 getCentre(const glm::ivec4& cell) const
@@ -329,13 +382,15 @@ private:
         return voxelgi::interpolate(*mTree, q, p + n * (mNormalOffset * mLeafSize));
     }
 
-    glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const
+    glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const { return evaluate(p, n, mPayload); }
+
+    glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n, const std::vector<glm::vec3>& values) const
     {
         const voxelgi::TreeStencil st = getStencil(p, n);
         const int m = payloadVectors();
         std::array<glm::dvec3, kAxes> v{};
         for (int i = 0; i < st.count; ++i) {
-            const glm::vec3* payload = &mPayload[std::size_t(st.index[std::size_t(i)]) * std::size_t(m)];
+            const glm::vec3* payload = &values[std::size_t(st.index[std::size_t(i)]) * std::size_t(m)];
             for (int k = 0; k < m; ++k)
                 v[std::size_t(k)] += double(st.weight[std::size_t(i)]) * glm::dvec3(payload[k]);
         }
@@ -366,6 +421,7 @@ private:
     glm::dvec3 mOrigin{0.0};
     double mLeafSize = 1.0;
     std::vector<glm::vec3> mPayload; //!< [probe * payloadVectors() + k]
+    std::vector<glm::vec3> mSkyPayload; //!< the same for the sky and the emitters
     double mBakeSeconds = 0.0;
 };
 

@@ -44,6 +44,7 @@
 // | bounces            | int   | 2        | [1, 3]            |                            |
 // | cone_angle         | float | 29       | [5, 60]           | degrees (half-angle)       |
 // | start_offset       | float | 4        | [0, 8]            | leaves (pixel cones)       |
+// | sky_start          | float | 8        | [0, 64]           | leaves (the sky)           |
 // | inject_offset      | float | 4        | [0, 8]            | leaves (the leaves' cones) |
 // | step_scale         | float | 0.5      | [0.1, 2]          | of the voxel size sampled  |
 // | trace_step         | int   | 4        | [1, 8]            | pixels                     |
@@ -116,6 +117,7 @@ public:
         settings.coneHalfAngleDegrees = mParams.coneAngle;
         settings.startOffset = mParams.startOffset;
         settings.injectOffset = mParams.injectOffset;
+        settings.skyStart = mParams.skyStart;
         settings.stepScale = mParams.stepScale;
         settings.innerLayers = mParams.innerLayers;
         mStructure.emplace(settings); // checks the settings

@@ -175,13 +175,15 @@ bool VoxelTreeCones::preparePixel(const scene::GBuffer& gbuffer, int x, int y, g
         return false;
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * mLeafSize;
+    march.skyStartDistance = mSettings.skyStart * mLeafSize;
     origin = p + n * (0.5 * mSettings.startOffset * mLeafSize);
     return true;
 }
 
-void VoxelTreeCones::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+void VoxelTreeCones::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                                        const ConeSkyOutput* sky)
 {
-    mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out);
+    mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out, sky);
 }
 
 void VoxelTreeCones::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const

@@ -37,6 +37,7 @@ struct TreeConeSettings {
     double coneHalfAngleDegrees = 29.0;
     double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
+    double skyStart = 8.0;    //!< leaves along a pixel cone from which its voxels shadow the sky
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
     int innerLayers = 1;      //!< layers of solid leaves inside closed surfaces (sparse_leaves.h)
@@ -83,7 +84,9 @@ public:
     bool sampleGathered(const glm::dvec3& p, double diameter, const glm::dvec3& dir, ConeSample& out) const;
 
     //! The radiance of each of the 16 cones at every pixel, [pixel * 16 + cone] (pixel_cones.h).
-    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! With `sky`, also the sky and emitters each cone sees (pixel_cones.h ConeSkyOutput).
+    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                     const ConeSkyOutput* sky = nullptr);
     //! Zero-aperture rays through the leaves (the error split of voxel_gi.h traceVoxelRays).
     void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
     bool preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin, glm::dvec3& n,

@@ -29,6 +29,7 @@ bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, gl
     const double v = mSettings.voxelSize * std::exp2(std::floor(start));
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
+    march.skyStartDistance = mSettings.skyStart * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);
     if (startLevel != nullptr)
         *startLevel = start;
@@ -75,10 +76,11 @@ double millisecondsSince(std::chrono::steady_clock::time_point start)
 
 } // namespace
 
-void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                                const ConeSkyOutput* sky)
 {
     if (mSettings.farStart > 0.0) {
-        gatherConesSplit(gbuffer, out);
+        gatherConesSplit(gbuffer, out, sky);
         return;
     }
     mCounters.farConesTraced = 0;
@@ -90,7 +92,7 @@ void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::
         return preparePixel(g, x, y, origin, n, march);
     };
     mCounters.meanStepsPerCone =
-        traceGBufferCones(gbuffer, mCones, prepare, GatheredSampler{this, true}, out);
+        traceGBufferCones(gbuffer, mCones, prepare, GatheredSampler{this, true}, out, sky);
     mCounters.pixelConesMs = millisecondsSince(start);
 }
 
@@ -127,6 +129,7 @@ void CascadeVolume::invalidateFarCones()
             continue;
         level.farSlot.assign(voxels, ~0u);
         level.far.clear();
+        level.farSky.clear();
         level.farStamp = mStamp;
     }
 }
@@ -140,15 +143,16 @@ CascadeVolume::FarNeighbourhood CascadeVolume::findFar(const Level& level,
 }
 
 glm::vec3 CascadeVolume::sampleFar(const Level& level, const FarNeighbourhood& around,
-                                   int cone) const
+                                   int cone, bool sky) const
 {
+    const std::vector<glm::vec3>& values = sky ? level.farSky : level.far;
     glm::dvec3 sum(0.0);
     for (int c = 0; c < 8; ++c)
         if (around.weights[std::size_t(c)] != 0.0)
             sum += around.weights[std::size_t(c)] *
-                   glm::dvec3(level.far[std::size_t(level.farSlot[around.voxels[std::size_t(c)]]) *
-                                            kConeCount +
-                                        std::size_t(cone)]);
+                   glm::dvec3(values[std::size_t(level.farSlot[around.voxels[std::size_t(c)]]) *
+                                         kConeCount +
+                                     std::size_t(cone)]);
     return glm::vec3(sum);
 }
 
@@ -206,7 +210,14 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
                 toTrace.emplace_back(i, std::uint32_t(v));
                 level.farSlot[v] = slot++;
             }
+        const std::size_t before = level.far.size();
         level.far.resize(std::size_t(slot) * kConeCount, glm::vec3(0.0f));
+        // The sky beside the light while every far cone of the level has one; far cones traced
+        // on Vulkan keep none, and the level's sky stays empty until its far cones are dropped.
+        if (!tracer && level.farSky.size() == before)
+            level.farSky.resize(level.far.size(), glm::vec3(0.0f));
+        else
+            level.farSky.clear();
     }
     const GatheredSampler sampler{this, true};
     const auto farStart = std::chrono::steady_clock::now();
@@ -233,10 +244,13 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
         march.tanHalfAngle = mCones.tanHalfAngle;
         march.stepScale = mSettings.stepScale;
         march.startDistance = mSettings.farStart * r.voxelSize;
+        march.skyStartDistance = mSettings.skyStart * r.voxelSize;
         for (int c = 0; c < kConeCount; ++c) {
             const ConeResult far = marchCone(sampler, centre, mCones.directions[std::size_t(c)], c, march);
-            level.far[std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c)] =
-                glm::max(far.light[kDirect], glm::vec3(0.0f));
+            const std::size_t at = std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c);
+            level.far[at] = glm::max(far.light[kDirect], glm::vec3(0.0f));
+            if (!level.farSky.empty())
+                level.farSky[at] = computeConeSkyRadiance(far, mFarSkyPerCone[std::size_t(c)]);
         }
     });
     mCounters.farConesMs = millisecondsSince(farStart);
@@ -257,8 +271,19 @@ CascadeVolume::StartLevels CascadeVolume::getStartLevels(double start) const
     return s;
 }
 
-void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                                     const ConeSkyOutput* sky)
 {
+    std::vector<glm::vec3>* skyOut = sky != nullptr ? sky->out : nullptr;
+    if (skyOut != nullptr && sky->skyPerCone != mFarSkyPerCone) {
+        // Another sky: the far cones' sky is stale, so all far cones are traced again.
+        mFarSkyPerCone = sky->skyPerCone;
+        for (Level& level : mLevels) {
+            level.farSlot.assign(level.region.getVoxelCount(), ~0u);
+            level.far.clear();
+            level.farSky.clear();
+        }
+    }
     prepareFarCones(gbuffer);
     const int W = gbuffer.width, H = gbuffer.height;
     const GatheredSampler sampler{this, true};
@@ -270,6 +295,16 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
     // The pixels: near parts, composited with the far cones.
     const auto pixelStart = std::chrono::steady_clock::now();
     out.assign(std::size_t(W) * std::size_t(H) * kConeCount, glm::vec3(0.0f));
+    if (skyOut != nullptr) {
+        skyOut->clear();
+        const bool farSky = std::all_of(mLevels.begin(), mLevels.end(), [](const Level& l) {
+            return l.farSky.size() == l.far.size();
+        });
+        if (farSky)
+            skyOut->assign(out.size(), glm::vec3(0.0f));
+        else
+            skyOut = nullptr; // far cones traced on Vulkan: no sky this frame
+    }
     std::vector<std::uint64_t> stepsPerRow(std::size_t(H), 0), conesPerRow(std::size_t(H), 0);
     tbb::parallel_for(0, H, [&](int y) {
         for (int x = 0; x < W; ++x) {
@@ -299,23 +334,49 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                 if (!a.escaped)
                     la +=
                         a.transmittance * glm::dvec3(sampleFar(mLevels[std::size_t(l0)], far0, k));
-                glm::dvec3 result = la;
+                // The sky and emitters the same way (computeConeSkyRadiance): the near part's
+                // emitters, then the sky where it left the cascade, else the far cones' sky and
+                // emitters, through the near part's sky transmittance.
+                const glm::dvec3 skyOfCone(mFarSkyPerCone[std::size_t(k)]);
+                glm::dvec3 sa(0.0);
+                if (skyOut != nullptr)
+                    sa = glm::dvec3(a.light[kEmission]) +
+                         a.skyTransmittance *
+                             (a.skyEscaped ? skyOfCone
+                                           : glm::dvec3(sampleFar(mLevels[std::size_t(l0)], far0, k, true)));
+                glm::dvec3 result = la, skyResult = sa;
                 if (l1 >= 0) {
-                    glm::dvec3 lb(a.light[kDirect]);
+                    glm::dvec3 lb(a.light[kDirect]), sb(a.light[kEmission]);
+                    ConeResult b;
                     if (!a.escaped) {
                         ConeMarchSettings segment = march;
                         segment.startDistance = split0;
                         segment.maxDistance = 2.0 * split0;
-                        const ConeResult b = marchCone(sampler, s.origin, dir, k, segment);
+                        b = marchCone(sampler, s.origin, dir, k, segment);
                         stepsPerRow[std::size_t(y)] += std::uint64_t(b.steps);
                         lb += a.transmittance * glm::dvec3(b.light[kDirect]);
                         if (!b.escaped)
                             lb += a.transmittance * b.transmittance *
                                   glm::dvec3(sampleFar(mLevels[std::size_t(l1)], far1, k));
                     }
+                    if (skyOut != nullptr) {
+                        if (a.skyEscaped) {
+                            sb += a.skyTransmittance * skyOfCone;
+                        } else { // then a.escaped is false too: b was marched
+                            sb += a.transmittance * glm::dvec3(b.light[kEmission]) +
+                                  a.skyTransmittance * b.skyTransmittance *
+                                      (b.skyEscaped ? skyOfCone
+                                                    : glm::dvec3(sampleFar(mLevels[std::size_t(l1)],
+                                                                           far1, k, true)));
+                        }
+                    }
                     result = la + frac * (lb - la);
+                    skyResult = sa + frac * (sb - sa);
                 }
                 out[pixel * kConeCount + std::size_t(k)] = glm::max(glm::vec3(result), glm::vec3(0.0f));
+                if (skyOut != nullptr)
+                    (*skyOut)[pixel * kConeCount + std::size_t(k)] =
+                        glm::max(glm::vec3(skyResult), glm::vec3(0.0f));
             }
         }
     });

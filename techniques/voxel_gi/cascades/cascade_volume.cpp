@@ -231,9 +231,11 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         for (auto& field : level.light)
             field.assign(faces, glm::vec3(0.0f));
         level.lightRevision = ++mRevision;
+        level.emits = false;
         for (std::size_t f = 0; f < faces; ++f) {
             level.alpha[f] = level.grid.faces[f].a;
             level.light[kEmission][f] = level.alpha[f] * level.grid.emission[f];
+            level.emits = level.emits || level.light[kEmission][f] != glm::vec3(0.0f);
         }
         // Light carried over (the one-pass update builds on it): the same voxels when only the
         // geometry changed; shifted when the level scrolled, the missing edge taken from the
@@ -612,6 +614,11 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
             const glm::vec4& v = coneRow[vox];
             out.alpha += fw * v.a;
             out.light[kDirect] += fw * glm::vec3(v);
+            if (level.emits)
+                for (int axis = 0; axis < 3; ++axis) {
+                    const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
+                    out.light[kEmission] += fw * float(dir[axis] * dir[axis]) * level.light[kEmission][f];
+                }
             continue;
         }
         for (int axis = 0; axis < 3; ++axis) {
@@ -622,6 +629,8 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
             out.alpha += aw * level.alpha[f];
             if (gathered) {
                 out.light[kDirect] += aw * getGatheredLight(level, f);
+                if (level.emits)
+                    out.light[kEmission] += aw * level.light[kEmission][f];
             } else {
                 for (int field = 0; field < kFieldCount; ++field)
                     out.light[std::size_t(field)] += aw * level.light[std::size_t(field)][f];

@@ -36,6 +36,9 @@ struct CascadeSettings {
     bool oneLevelPerFrame = true;       //!< level i every 2^(i+1) frames
     double coneHalfAngleDegrees = 29.0;
     double startOffset = 1.0; //!< voxels
+    //! Voxels (of the pixel's start level; of their own level for far cones) along a pixel cone
+    //! from which its voxels shadow the sky (cone_tracing.h ConeMarchSettings::skyStartDistance).
+    double skyStart = 4.0;
     double stepScale = 0.5;
     bool precombine = true;
     //! Split near/far cones ("Split Cone Trace"): the pixel traces its cones up to farStart
@@ -69,6 +72,9 @@ public:
         std::vector<glm::vec4> combined;
         std::string geometryKey;         //!< of the voxelized geometry
         bool voxelized = false;
+        //! Some voxel emits: the pixels' cones then sample light[kEmission] too (their sky and
+        //! emitters, pixel_cones.h ConeSkyOutput).
+        bool emits = false;
         std::uint64_t voxelStamp = 0; //!< when it was last voxelized (CascadeVolume's counter)
         std::uint64_t lightStamp = 0; //!< when its light buffers last changed
         //! Changes whenever the light buffers change, between the passes of one update too (what
@@ -88,6 +94,10 @@ public:
         //! since farStamp.
         std::vector<std::uint32_t> farSlot;
         std::vector<glm::vec3> far;
+        //! The same far cones' sky and emitters (cone_tracing.h computeConeSkyRadiance, against
+        //! the sky of the volume's farSky key), [s * 16 + cone]; empty when they were traced
+        //! on Vulkan (which keeps no transmittance).
+        std::vector<glm::vec3> farSky;
         std::uint64_t farStamp = 0;
     };
 
@@ -127,8 +137,10 @@ public:
     InjectionSettings getInjectionSettings() const;
     //! The radiance each of the 16 cones gathers at every pixel of `gbuffer`, [pixel * 16 +
     //! cone]; 0 for cones below the surface and for pixels without a surface or outside the
-    //! cascade.
-    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! cascade. With `sky`, also the sky and emitters each cone sees (cone_tracing.h
+    //! ConeSkyOutput); with split near/far cones the far cones keep theirs beside their light.
+    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                     const ConeSkyOutput* sky = nullptr);
     //! The same light gathered along `rays` cosine-distributed rays per pixel (zero aperture:
     //! every sample at the finest level holding it), E = pi * mean radiance; the directions are
     //! a stratified grid turned per pixel, so the result is deterministic.
@@ -212,7 +224,8 @@ private:
     };
     StartLevels getStartLevels(double start) const;
     // gatherCones with split near/far cones (settings.farStart > 0).
-    void gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    void gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                          const ConeSkyOutput* sky);
     // Drops the far cones of every level whose sampled levels changed since they were traced.
     void invalidateFarCones();
     // The trilinear neighbourhood of a point in a level's far cones, found once for its 16 cones.
@@ -222,7 +235,9 @@ private:
     };
     FarNeighbourhood findFar(const Level& level, const glm::dvec3& p) const;
     // Trilinear far radiance of cone `cone` in `level` (its traced voxel centres) over `around`.
-    glm::vec3 sampleFar(const Level& level, const FarNeighbourhood& around, int cone) const;
+    //! The far cones' light at `around` (or, with `sky`, their sky and emitters).
+    glm::vec3 sampleFar(const Level& level, const FarNeighbourhood& around, int cone,
+                        bool sky = false) const;
     // The 8 voxels (of the trilinear neighbourhood of p in `region`) and their weights.
     static void getTrilinear(const VoxelRegion& region, const glm::dvec3& p,
                              std::array<std::size_t, 8>& voxels, std::array<double, 8>& weights);
@@ -242,6 +257,9 @@ private:
 
     CascadeSettings mSettings;
     ConeSet mCones;
+    //! The sky per cone the far cones' farSky was computed with (all far cones are dropped when
+    //! a gather asks for another).
+    std::array<glm::vec3, kConeCount> mFarSkyPerCone{};
     std::vector<Level> mLevels;
     bool isStale(int level) const;
     // Records the triangles that appeared or disappeared since the last geometry (their bounds,

@@ -78,6 +78,7 @@
 // | update         | enum  | one_level_per_frame | one_level_per_frame, all_levels     |        |
 // | cone_angle     | float | 29                | [5, 60]                               | degrees (half-angle) |
 // | start_offset   | float | 1                 | [0, 4]                                | voxels |
+// | sky_start      | float | 4                 | [0, 64]                               | voxels of the pixel's start level |
 // | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
 // | precombine     | bool  | true              |                                       |        |
 // | solid          | bool  | true              |                                       |        |
@@ -153,6 +154,10 @@ public:
         schema.addFloat("cone_angle", 29.0, 5.0, 60.0, "degrees", "cone half-angle");
         schema.addFloat("start_offset", 1.0, 0.0, 4.0, "voxels",
                         "cone start distance and origin offset along the normal");
+        schema.addFloat("sky_start", 4.0, 0.0, 64.0, "voxels",
+                        "distance along a pixel cone (voxels of its start level) from which its "
+                        "voxels shadow the sky (nearer occluders, the pixel's own surface among "
+                        "them, are the occlusion family's)");
         schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
         schema.addBool("precombine", true,
                        "pre-combined direction buffers for the pixel cones (3x fewer lookups)");
@@ -199,6 +204,7 @@ public:
         mSettings.oneLevelPerFrame = p.getString("update") == "one_level_per_frame";
         mSettings.coneHalfAngleDegrees = p.getFloat("cone_angle");
         mSettings.startOffset = p.getFloat("start_offset");
+        mSettings.skyStart = p.getFloat("sky_start");
         mSettings.stepScale = p.getFloat("step_scale");
         mSettings.precombine = p.getBool("precombine");
         mSettings.solid = p.getBool("solid");
@@ -230,6 +236,7 @@ public:
         p.set("update", std::string(mSettings.oneLevelPerFrame ? "one_level_per_frame" : "all_levels"));
         p.set("cone_angle", mSettings.coneHalfAngleDegrees);
         p.set("start_offset", mSettings.startOffset);
+        p.set("sky_start", mSettings.skyStart);
         p.set("step_scale", mSettings.stepScale);
         p.set("precombine", mSettings.precombine);
         p.set("solid", mSettings.solid);
@@ -322,6 +329,10 @@ public:
                         mGpu.traceFarCones(*input.gpu, *mVolume, centres, far);
                     });
         };
+        mSky.cones.clear();
+        mSkyWhyNot = mGatheredOnGpu   ? "the Vulkan gather traces no cone sky yet (device: cpu does)"
+                     : mCombinedOnGpu ? "the Vulkan combine takes no cone sky yet (combine_device: cpu does)"
+                                    : "";
         if (mCombinedOnGpu) {
             // The combine on Vulkan (cone_combine_gpu.h): the cones of the Vulkan gather stay on
             // the device, those of the C++ gather go up.
@@ -343,15 +354,32 @@ public:
         irradiance = voxelgi::gatherConesReduced(
             *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle, input.coneVisibility,
             input.capsules,
-            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones) {
+            [&](const scene::GBuffer& reduced, std::vector<glm::vec3>& cones,
+                std::vector<glm::vec3>* skyCones) {
                 if (mGatheredOnGpu) {
                     prepareGpuCones(reduced);
                     mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
                 } else {
-                    mVolume->gatherCones(reduced, cones);
+                    voxelgi::ConeSkyOutput sky;
+                    if (input.scene != nullptr)
+                        sky.skyPerCone =
+                            voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
+                    sky.out = skyCones;
+                    mVolume->gatherCones(reduced, cones, &sky);
                 }
             },
-            &mCombineMs, mCapsuleResolution);
+            &mCombineMs, mCapsuleResolution, &mSky);
+    }
+
+    std::string combineConeSky(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
+    {
+        if (!mSkyWhyNot.empty())
+            return mSkyWhyNot;
+        if (!mSky.isValid())
+            return "no cone sky in the last gather (far cones traced on Vulkan keep none)";
+        irradiance = voxelgi::combineConeSky(mSky, *input.gbuffer, mVolume->getCones().halfAngle,
+                                             input.coneVisibility, input.capsules);
+        return {};
     }
 
     bool traceVoxelRays(const plugin::VoxelGiInput& input, int raysPerPixel,
@@ -437,6 +465,8 @@ private:
     bool mCombinedOnGpu = false;
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;
+    voxelgi::ConeSkyTrace mSky; // the last C++ gather's cone sky, for combineConeSky
+    std::string mSkyWhyNot;     // why the last gather traced no cone sky, "" when it did
     bool mGatheredOnGpu = false;
     double mCombineMs = std::nan(""); // the gather beyond its cones: reduction and combine
     voxelgi::CapsuleResolution mCapsuleResolution = voxelgi::CapsuleResolution::Traced;

@@ -365,13 +365,15 @@ bool SparseVoxelOctree::preparePixel(const scene::GBuffer& gbuffer, int x, int y
     const double v = getLeafSize();
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
+    march.skyStartDistance = mSettings.skyStart * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);
     return true;
 }
 
-void SparseVoxelOctree::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
+void SparseVoxelOctree::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                                           const ConeSkyOutput* sky)
 {
-    mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out);
+    mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out, sky);
 }
 
 void SparseVoxelOctree::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const

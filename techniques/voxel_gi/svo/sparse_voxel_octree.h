@@ -57,6 +57,7 @@ struct OctreeSettings {
     double coneHalfAngleDegrees = 29.0;
     double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
+    double skyStart = 8.0;    //!< leaves along a pixel cone from which its voxels shadow the sky
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
     int innerLayers = 1;      //!< layers of solid leaves inside closed surfaces (sparse_leaves.h)
@@ -153,7 +154,9 @@ public:
 
     //! The radiance of each of the 16 cones at every pixel, [pixel * 16 + cone]; 0 for cones
     //! below the surface and pixels without a surface or outside the cube.
-    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out);
+    //! With `sky`, also the sky and emitters each cone sees (pixel_cones.h ConeSkyOutput).
+    void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
+                     const ConeSkyOutput* sky = nullptr);
     //! The gathered light along `rays` cosine-distributed rays per pixel (zero aperture: the
     //! leaves), E = pi * mean radiance (the error split of voxel_gi.h traceVoxelRays).
     void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
