@@ -76,6 +76,10 @@ struct ConeMarchSettings {
     //! World units along the cone from which its voxels shadow the sky (ConeResult::
     //! skyTransmittance); nearer occluders are left to the occlusion family's visibilities.
     double skyStartDistance = 0.0;
+    //! The surface the cone leaves (unit normal, 0 for none) and the origin's height above it:
+    //! the part of a sample below that plane is left out of the sky's occupancy (see marchCone).
+    glm::dvec3 skyPlaneNormal{0.0};
+    double skyPlaneHeight = 0.0;
 };
 
 struct ConeResult {
@@ -137,18 +141,45 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
                 occupied += (1.0 - occupied) * corrected;
                 lightDone = occupied >= s.maxOpacity;
             }
-            if (t >= s.skyStartDistance)
-                skyTransmittance *= 1.0 - corrected;
+            if (t >= s.skyStartDistance) {
+                // The sky through the part of the sample the surface the cone leaves does not
+                // fill. Voxels of size v hold the box average of the occupancy, and a trilinear
+                // sample averages them again: the solid half-space below a plane (the surface,
+                // voxelized solid) read h above it is the step filtered by the degree-1 B-spline
+                // of width 2v, b = (1 - h/v)^2 / 2 for 0 <= h <= v (1/2 on it, 0 a voxel above).
+                // What occludes the sky seen from the surface is the rest of the union,
+                // max(0, alpha - b) / (1 - b). This takes the surface's own occupancy out of
+                // the samples just above it; a wide cone at a low angle still reads its surface
+                // through coarse voxels (h/v tends to sin(elevation) / (2 tan(half-angle))), the
+                // part that skyStartDistance leaves out.
+                double skyCorrected = corrected;
+                if (s.skyPlaneNormal != glm::dvec3(0.0)) {
+                    const double h = s.skyPlaneHeight + t * glm::dot(dir, s.skyPlaneNormal);
+                    const double u = std::clamp(h / sample.voxelSize, -1.0, 1.0);
+                    const double below = u >= 0.0 ? 0.5 * (1.0 - u) * (1.0 - u)
+                                                  : 1.0 - 0.5 * (1.0 + u) * (1.0 + u);
+                    const double skyAlpha =
+                        below < 1.0 ? std::max(0.0, stepAlpha - below) / (1.0 - below) : 0.0;
+                    skyCorrected =
+                        skyAlpha > 0.0
+                            ? 1.0 - std::pow(1.0 - std::min(skyAlpha, 0.999999), exponent)
+                            : 0.0;
+                }
+                skyTransmittance *= 1.0 - skyCorrected;
+            }
             // Done when the light is (the occupancy) and so is the sky: occluders nearer than
             // skyStartDistance do not end the cone's view of it.
-            if (lightDone && (s.skyStartDistance <= s.startDistance ||
+            if (lightDone && ((s.skyStartDistance <= s.startDistance &&
+                               s.skyPlaneNormal == glm::dvec3(0.0)) ||
                               skyTransmittance <= 1.0 - s.maxOpacity))
                 break;
         }
         t += dt;
     }
     r.transmittance = 1.0 - occupied;
-    r.skyTransmittance = s.skyStartDistance <= s.startDistance ? r.transmittance : skyTransmittance;
+    r.skyTransmittance = s.skyStartDistance <= s.startDistance && s.skyPlaneNormal == glm::dvec3(0.0)
+                             ? r.transmittance
+                             : skyTransmittance;
     return r;
 }
 

@@ -94,7 +94,7 @@ public:
                     mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
                 } else {
                     sky.out = skyCones;
-                    mStructure->gatherCones(reduced, cones, &sky);
+                    mStructure->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
                 }
             },
             &mCombineMs, mParams.capsules, &mSky);
@@ -105,7 +105,7 @@ public:
         if (mGatheredOnGpu)
             return "the Vulkan gather traces no cone sky yet (device: cpu does)";
         if (!mSky.isValid())
-            return "no cones traced in the last gather";
+            return "the last gather traced no cone sky";
         irradiance = voxelgi::combineConeSky(mSky, *input.gbuffer, mStructure->getCones().halfAngle,
                                              input.coneVisibility, input.capsules);
         return {};

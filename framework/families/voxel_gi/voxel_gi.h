@@ -76,6 +76,9 @@ struct VoxelGiInput {
     const std::vector<scene::PosedCapsule>* capsules = nullptr;
     int frameIndex = 0;
     gpu::Context* gpu = nullptr;
+    //! The frame will ask for the cones' sky (combineConeSky): the gather traces it too. False
+    //! when nothing reads it (no lit frame, or `frame: {sky: lobes}`).
+    bool coneSky = false;
 };
 
 //! Sizes the family reports for the data-structure metrics.

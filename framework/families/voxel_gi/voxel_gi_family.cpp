@@ -244,6 +244,7 @@ private:
                     visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
                         ? visibility
                         : nullptr;
+                input.coneSky = mRun.lighting && mRun.sky != "lobes";
                 Image<glm::vec3>& out = ctx.write(indirect);
                 mTechnique->gather(input, out);
                 if (out.width != g.width || out.height != g.height)

@@ -30,6 +30,8 @@ bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, gl
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
     march.skyStartDistance = mSettings.skyStart * v;
+    march.skyPlaneNormal = n;
+    march.skyPlaneHeight = 0.5 * mSettings.startOffset * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);
     if (startLevel != nullptr)
         *startLevel = start;
@@ -213,8 +215,9 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
         const std::size_t before = level.far.size();
         level.far.resize(std::size_t(slot) * kConeCount, glm::vec3(0.0f));
         // The sky beside the light while every far cone of the level has one; far cones traced
-        // on Vulkan keep none, and the level's sky stays empty until its far cones are dropped.
-        if (!tracer && level.farSky.size() == before)
+        // on Vulkan, or for a gather that wants no sky, keep none, and the level's sky stays
+        // empty until its far cones are dropped.
+        if (!tracer && mTraceSky && level.farSky.size() == before)
             level.farSky.resize(level.far.size(), glm::vec3(0.0f));
         else
             level.farSky.clear();
@@ -244,7 +247,7 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
         march.tanHalfAngle = mCones.tanHalfAngle;
         march.stepScale = mSettings.stepScale;
         march.startDistance = mSettings.farStart * r.voxelSize;
-        march.skyStartDistance = mSettings.skyStart * r.voxelSize;
+        march.skyStartDistance = mTraceSky ? mSettings.skyStart * r.voxelSize : 0.0;
         for (int c = 0; c < kConeCount; ++c) {
             const ConeResult far = marchCone(sampler, centre, mCones.directions[std::size_t(c)], c, march);
             const std::size_t at = std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c);
@@ -275,6 +278,7 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                                      const ConeSkyOutput* sky)
 {
     std::vector<glm::vec3>* skyOut = sky != nullptr ? sky->out : nullptr;
+    mTraceSky = skyOut != nullptr;
     if (skyOut != nullptr && sky->skyPerCone != mFarSkyPerCone) {
         // Another sky: the far cones' sky is stale, so all far cones are traced again.
         mFarSkyPerCone = sky->skyPerCone;
@@ -326,6 +330,10 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                 ConeMarchSettings march = s.march;
                 march.tanHalfAngle = mCones.tanHalfAngle;
                 march.maxDistance = split0;
+                if (skyOut == nullptr) { // no cone marches on for the sky alone
+                    march.skyStartDistance = 0.0;
+                    march.skyPlaneNormal = glm::dvec3(0.0);
+                }
                 const ConeResult a = marchCone(sampler, s.origin, dir, k, march);
                 glm::dvec3 la(a.light[kDirect]);
                 stepsPerRow[std::size_t(y)] += std::uint64_t(a.steps);

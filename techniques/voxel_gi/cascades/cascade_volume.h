@@ -260,6 +260,7 @@ private:
     //! The sky per cone the far cones' farSky was computed with (all far cones are dropped when
     //! a gather asks for another).
     std::array<glm::vec3, kConeCount> mFarSkyPerCone{};
+    bool mTraceSky = false; //!< the current gather wants the cones' sky (far cones keep theirs)
     std::vector<Level> mLevels;
     bool isStale(int level) const;
     // Records the triangles that appeared or disappeared since the last geometry (their bounds,

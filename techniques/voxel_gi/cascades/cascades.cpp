@@ -365,7 +365,7 @@ public:
                         sky.skyPerCone =
                             voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
                     sky.out = skyCones;
-                    mVolume->gatherCones(reduced, cones, &sky);
+                    mVolume->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
                 }
             },
             &mCombineMs, mCapsuleResolution, &mSky);
@@ -376,7 +376,7 @@ public:
         if (!mSkyWhyNot.empty())
             return mSkyWhyNot;
         if (!mSky.isValid())
-            return "no cone sky in the last gather (far cones traced on Vulkan keep none)";
+            return "the last gather traced no cone sky (or its far cones were traced on Vulkan)";
         irradiance = voxelgi::combineConeSky(mSky, *input.gbuffer, mVolume->getCones().halfAngle,
                                              input.coneVisibility, input.capsules);
         return {};

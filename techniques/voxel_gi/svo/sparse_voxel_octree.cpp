@@ -366,6 +366,8 @@ bool SparseVoxelOctree::preparePixel(const scene::GBuffer& gbuffer, int x, int y
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
     march.skyStartDistance = mSettings.skyStart * v;
+    march.skyPlaneNormal = n;
+    march.skyPlaneHeight = 0.5 * mSettings.startOffset * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);
     return true;
 }
