@@ -251,6 +251,59 @@ TEST_F(LightingPassTest, SkyLobesMatchQuadratureAndScaleWithVisibility)
     EXPECT_THROW(drawFrame(s, camera, kSize, kSize, partial), Error);
 }
 
+TEST_F(LightingPassTest, ConeSkyReplacesTheLobesAndTheirVisibility)
+{
+    // With a cone sky image (a voxel GI technique's sky and emitters through its cones) the
+    // sky term is that image, exactly: direct = albedo / pi * E_cone, whatever the lobes and
+    // the visibility inputs say; hdr adds emission and the indirect slot as before.
+    constexpr int kSize = 32;
+    SceneBuilder b;
+    addFloor(b, 3.0f, b.addMaterial(kAlbedo));
+    scene::RenderScene s = b.getScene();
+    s.sky.kind = scene::Sky::Kind::Constant;
+    s.sky.constant = glm::vec3(5.0f); // would dominate if the lobes were still added
+    const scene::Camera camera = makeCamera({0, 1.5f, 3}, {0, 0.5f, -1});
+    Image<glm::vec3> coneSky(kSize, kSize, glm::vec3(0.0f));
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x)
+            coneSky.at(x, y) = glm::vec3(0.1f + 0.01f * float(x), 0.2f, 0.05f * float(y % 7));
+    const gpu::Image coneImage = createImageFrom(getContext(), coneSky, "cone sky");
+    const gpu::Image ao = createImageFrom(getContext(), Image<float>(kSize, kSize, 0.5f), "ao");
+    const gpu::Image indirect =
+        createImageFrom(getContext(), Image<glm::vec3>(kSize, kSize, glm::vec3(0.25f)), "indirect");
+    LightingInputs in;
+    in.coneSkyIrradiance = &coneImage;
+    in.ambientOcclusion = &ao;
+    in.indirectIrradiance = &indirect;
+    const scene::GBuffer g = drawFrame(s, camera, kSize, kSize, in);
+    EXPECT_TRUE(getLighting().hadConeSky());
+    const Image<glm::vec3> direct = getLighting().readBackDirect();
+    const Image<glm::vec3> hdr = getLighting().readBackHdr();
+    int surfaces = 0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            if (!g.hasSurface(x, y))
+                continue;
+            ++surfaces;
+            const glm::vec3 expected = kAlbedo / float(kPi) * coneSky.at(x, y);
+            for (int c = 0; c < 3; ++c) {
+                // float32: one product and one division.
+                ASSERT_NEAR(direct.at(x, y)[c], expected[c], 1e-6f) << x << "," << y;
+                ASSERT_NEAR(hdr.at(x, y)[c], expected[c] + kAlbedo[c] / float(kPi) * 0.25f, 1e-6f)
+                    << x << "," << y;
+            }
+        }
+    EXPECT_GT(surfaces, kSize * kSize / 4);
+    // A cone sky of the wrong size is refused.
+    const gpu::Image small = createImageFrom(getContext(), Image<glm::vec3>(8, 8, glm::vec3(0.0f)), "small");
+    LightingInputs wrong;
+    wrong.coneSkyIrradiance = &small;
+    EXPECT_THROW(drawFrame(s, camera, kSize, kSize, wrong), Error);
+    // Without it the lobes come back.
+    drawFrame(s, camera, kSize, kSize);
+    EXPECT_FALSE(getLighting().hadConeSky());
+}
+
 TEST_F(LightingPassTest, ConstantAndGradientSkiesAreProjectedOntoTheLobes)
 {
     // The fit's own error is reported; the lit floor must match the exact irradiance within it

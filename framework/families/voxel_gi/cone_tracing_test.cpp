@@ -1,5 +1,6 @@
 // The shared cone machinery: irradiance weights (exact for a constant radiance, zero below the
-// surface), the sky per cone, and the march's step-length-corrected opacity.
+// surface), the sky per cone, the march's step-length-corrected opacity, and the sky a cone sees
+// past the voxels (sky start, the surface's own occupancy, emitters).
 
 #include "families/voxel_gi/cone_tracing.h"
 
@@ -8,6 +9,7 @@
 #include <glm/gtc/constants.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace rtlab;
@@ -113,6 +115,87 @@ TEST(ConeTracing, AConeThatLeavesTheStructureEscapes)
     EXPECT_FALSE(o.escaped);
     EXPECT_LE(o.transmittance, 1.0 - s.maxOpacity);
     EXPECT_TRUE(std::isfinite(o.light[kDirect].x));
+}
+
+// A wall of occupancy 1 (emission `emission` in field kEmission) across [wall, wall + 1] in y,
+// nothing else, the structure ending at y = 10.
+struct Wall {
+    double wall = 2.0;
+    glm::vec3 emission{0.0f};
+    bool sample(const glm::dvec3& p, double, int, const glm::dvec3&, ConeSample& out) const
+    {
+        if (p.y > 10.0)
+            return false;
+        out = ConeSample{};
+        out.voxelSize = 0.25;
+        if (p.y >= wall && p.y <= wall + 1.0) {
+            out.alpha = 1.0f;
+            out.light[kEmission] = emission;
+        }
+        return true;
+    }
+};
+
+TEST(ConeTracing, TheSkyIsSeenPastTheVoxelsFromSkyStartOn)
+{
+    const glm::vec3 skyOfCone(2.0f, 1.0f, 0.5f);
+    ConeMarchSettings s;
+    s.tanHalfAngle = 0.0;
+    s.stepScale = 0.5;
+    // No occluder: the sky, whole.
+    const ConeResult open = marchCone(Wall{20.0}, glm::dvec3(0.0), glm::dvec3(0, 1, 0), 0, s);
+    EXPECT_TRUE(open.skyEscaped);
+    EXPECT_EQ(computeConeSkyRadiance(open, skyOfCone), skyOfCone);
+    // A wall beyond sky start hides it, and its emission is seen instead.
+    const Wall glowing{2.0, glm::vec3(3.0f)};
+    const ConeResult hidden = marchCone(glowing, glm::dvec3(0.0), glm::dvec3(0, 1, 0), 0, s);
+    EXPECT_FALSE(hidden.skyEscaped);
+    // (premultiplied emission 3 composited until the wall is opaque: 3 times its occupancy)
+    EXPECT_NEAR(computeConeSkyRadiance(hidden, skyOfCone).x, 3.0 * (1.0 - hidden.transmittance), 1e-5);
+    EXPECT_GT(hidden.transmittance, 0.0);
+    EXPECT_LE(hidden.transmittance, 1.0 - s.maxOpacity);
+    // The same wall nearer than sky start is the occlusion family's: the cone's light stops
+    // there, its sky does not (it marches on to the end of the structure).
+    s.skyStartDistance = 4.0;
+    const ConeResult near = marchCone(Wall{2.0}, glm::dvec3(0.0), glm::dvec3(0, 1, 0), 0, s);
+    EXPECT_FALSE(near.escaped);
+    EXPECT_TRUE(near.skyEscaped);
+    EXPECT_LE(near.transmittance, 1.0 - s.maxOpacity);
+    EXPECT_EQ(near.skyTransmittance, 1.0);
+    EXPECT_EQ(computeConeSkyRadiance(near, skyOfCone), skyOfCone);
+}
+
+TEST(ConeTracing, TheSurfaceTheConeLeavesDoesNotHideItsSky)
+{
+    // A cone along a floor's plane at height h reads the floor's own occupancy as the filtered
+    // half-space, (1 - h/v)^2 / 2 for 0 <= h <= v (cone_tracing.h); a floor read exactly so is
+    // taken out, and the sky stays whole. A real occluder on top of it still hides the sky.
+    struct Floor {
+        double extra = 0.0; // occupancy of something else in every sample (union)
+        bool sample(const glm::dvec3& p, double, int, const glm::dvec3&, ConeSample& out) const
+        {
+            if (p.x > 20.0)
+                return false;
+            out = ConeSample{};
+            out.voxelSize = 1.0;
+            const double u = std::clamp(p.y / out.voxelSize, 0.0, 1.0);
+            const double floor = 0.5 * (1.0 - u) * (1.0 - u);
+            out.alpha = float(1.0 - (1.0 - floor) * (1.0 - extra));
+            return true;
+        }
+    };
+    ConeMarchSettings s;
+    s.tanHalfAngle = 0.0;
+    s.skyPlaneNormal = glm::dvec3(0, 1, 0);
+    s.skyPlaneHeight = 0.25;
+    const glm::dvec3 along(1, 0, 0);
+    const ConeResult own = marchCone(Floor{}, glm::dvec3(0, 0.25, 0), along, 0, s);
+    EXPECT_TRUE(own.skyEscaped);
+    EXPECT_NEAR(own.skyTransmittance, 1.0, 1e-5); // float occupancy
+    EXPECT_LT(own.transmittance, 0.5);           // the light's march still sees it
+    const ConeResult other = marchCone(Floor{0.1}, glm::dvec3(0, 0.25, 0), along, 0, s);
+    // 0.1 more per voxel along 20 voxels: (1 - 0.1)^20 of the sky left.
+    EXPECT_NEAR(other.skyTransmittance, std::pow(0.9, 20.0), 0.01);
 }
 
 } // namespace
