@@ -12,7 +12,11 @@
 #include <glm/geometric.hpp>
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <filesystem>
+#include <vector>
 
 namespace rtlab::render::test {
 namespace {
@@ -65,6 +69,100 @@ TEST_F(BackFaceTest, BothGBuffersTurnEveryNormalTowardTheCamera)
     EXPECT_GT(surface, kW * kH); // both images mostly covered
     // Silhouette pixels may hit different faces in the two; everywhere else the normals agree.
     EXPECT_GT(agreeing, int(0.97 * both)) << agreeing << " of " << both;
+}
+
+//! A faceted UV sphere (10 segments, 6 rings) whose quads are wound either way (every third
+//! flipped), with vertex normals summed across the faces around each vertex as wound: where
+//! windings disagree the sum points anywhere, into the surface too, as a downloaded model
+//! smoothed without regard to winding. `flat`: each face its own normal, as wound.
+scene::RenderScene makeFacetedSphere(bool flat)
+{
+    scene::RenderScene s;
+    s.materials.push_back({"grey", glm::vec3(0.6f), glm::vec3(0.0f)});
+    constexpr int kRings = 6, kSegments = 10;
+    const auto at = [](int i, int j) {
+        const double th = 3.14159265358979 * i / kRings, ph = 2.0 * 3.14159265358979 * j / kSegments;
+        return glm::vec3(glm::dvec3(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph)));
+    };
+    std::vector<std::array<glm::vec3, 3>> triangles;
+    for (int i = 0; i < kRings; ++i)
+        for (int j = 0; j < kSegments; ++j) {
+            const glm::vec3 a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+            std::array<std::array<glm::vec3, 3>, 2> quad{{{a, b, c}, {a, c, d}}};
+            if ((i * kSegments + j) % 3 == 0)
+                for (auto& t : quad)
+                    std::swap(t[1], t[2]);
+            for (const auto& t : quad)
+                if (glm::length(glm::cross(t[1] - t[0], t[2] - t[0])) > 1e-6f)
+                    triangles.push_back(t);
+        }
+    // Shared vertices by position (smooth) or per face (flat).
+    std::vector<glm::vec3> sums;
+    const auto vertex = [&](const glm::vec3& p) -> std::uint32_t {
+        if (!flat)
+            for (std::size_t v = 0; v < s.positions.size(); ++v)
+                if (glm::length(s.positions[v] - p) < 1e-5f)
+                    return std::uint32_t(v);
+        s.positions.push_back(p);
+        sums.push_back(glm::vec3(0.0f));
+        return std::uint32_t(s.positions.size() - 1);
+    };
+    for (const auto& t : triangles) {
+        const glm::vec3 cross = glm::cross(t[1] - t[0], t[2] - t[0]);
+        for (const glm::vec3& p : t) {
+            const std::uint32_t v = vertex(p);
+            s.indices.push_back(v);
+            sums[v] += cross;
+        }
+        s.triangleMaterial.push_back(0);
+    }
+    for (const glm::vec3& n : sums)
+        s.normals.push_back(glm::length(n) > 0.0f ? glm::normalize(n) : glm::vec3(0.0f, 1.0f, 0.0f));
+    s.sky.kind = scene::Sky::Kind::Constant;
+    s.sky.constant = glm::vec3(1.0f);
+    s.updateBounds();
+    return s;
+}
+
+TEST_F(BackFaceTest, AFacetedSphereHasNoBlackAmbientOcclusionFlatOrSmooth)
+{
+    // A lone convex sphere: a point on it sees its whole hemisphere when the hemisphere faces
+    // out of the sphere (AO 1 with flat normals), and at least half of it with a smoothed normal
+    // tilted up to half a facet's angle. A shading normal that points into the surface gives a
+    // hemisphere inside the solid: every ray hits the sphere's far side (unbounded radius), AO
+    // 0, the black streaks of smoothed downloaded models. Both G-buffers turn normals to the camera side of
+    // the triangle's own plane, and the ground truth is traced from the rasterised one.
+    scene::Camera camera;
+    camera.position = {0.4f, 1.2f, 3.0f};
+    camera.target = {0.0f, 0.0f, 0.0f};
+    camera.verticalFovDegrees = 45.0f;
+    constexpr int kW = 64, kH = 48;
+    for (const bool flat : {true, false}) {
+        const scene::RenderScene sphere = makeFacetedSphere(flat);
+        getPass().setScene(sphere);
+        const scene::GBuffer raster = getPass().render(camera, kW, kH);
+        const scene::GBuffer cast = reference::castGBuffer(sphere, camera, kW, kH);
+        reference::ReferenceSettings settings =
+            reference::makeFixedSampleSettings(reference::Quantity::Ao, 1, 256, 7);
+        for (const scene::GBuffer* g : {&raster, &cast}) {
+            const Image<float> ao = reference::computeReference(sphere, *g, settings).occlusion;
+            int surface = 0, black = 0;
+            float lowest = 1.0f;
+            for (int y = 0; y < kH; ++y)
+                for (int x = 0; x < kW; ++x) {
+                    if (!g->hasSurface(x, y))
+                        continue;
+                    ++surface;
+                    lowest = std::min(lowest, ao.at(x, y));
+                    black += ao.at(x, y) < 0.02f;
+                }
+            EXPECT_GT(surface, kW * kH / 8);
+            // 256 rays: the AO of a pixel that sees half its hemisphere is below 0.02 with
+            // probability far below 1e-30; 0.02 only catches a hemisphere inside the surface.
+            EXPECT_EQ(black, 0) << (flat ? "flat" : "smooth") << (g == &raster ? " raster" : " cast")
+                                << ": lowest AO " << lowest;
+        }
+    }
 }
 
 } // namespace

@@ -20,19 +20,29 @@ void main()
 {
     const float depth = dot(inRelative, frame.viewForward.xyz);
 
+    // The geometric normal (the triangle's plane: the derivatives of one primitive's position),
+    // facing the camera.
+    const vec3 edge = cross(dFdx(inRelative), dFdy(inRelative));
+    const float edgeLength = length(edge);
+    vec3 geometric = edgeLength > 0.0 ? edge / edgeLength : vec3(0.0);
+    if (dot(geometric, inRelative) > 0.0)
+        geometric = -geometric;
     // Interpolated shading normal, turned to the side of the surface that faces the camera:
-    // a triangle seen from its back (clockwise on screen) gets its normals negated.
+    // a triangle seen from its back (clockwise on screen) gets its normals negated, and a
+    // shading normal that still points into the surface (vertex normals averaged across faces
+    // wound against each other) is turned to the geometric normal's side, as the Embree
+    // G-buffer does (reference/primary_rays.cpp), so no hemisphere lies inside the surface.
     vec3 normal = inNormal;
     const float len = length(normal);
     if (len > 0.0) {
         normal /= len;
         if (!gl_FrontFacing)
             normal = -normal;
-    } else {
-        // No usable shading normal: the geometric normal, facing the camera.
-        normal = normalize(cross(dFdx(inRelative), dFdy(inRelative)));
-        if (dot(normal, inRelative) > 0.0)
+        if (dot(normal, geometric) < 0.0)
             normal = -normal;
+    } else {
+        // No usable shading normal: the geometric normal.
+        normal = geometric;
     }
 
     outPositionDepth = vec4(frame.cameraPosition.xyz + inRelative, depth);
