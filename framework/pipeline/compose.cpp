@@ -215,49 +215,38 @@ void Compose::addSlotUploads(FrameGraph& graph)
             graph.addExternal(conesGpu, false, "the occlusion technique gives no cones");
     }
 
-    // Indirect irradiance.
-    if (!graph.declares(kIndirectIrradianceGpu) && graph.declares(kIndirectIrradiance)) {
-        const auto image = makeGpuImageResource(gpuContext, "indirect_irradiance_upload",
+    // The voxel GI family's images: indirect irradiance, and the sky through its cones (an empty
+    // CPU image when the technique gave none this frame: the GPU slot is then null).
+    const auto addUpload = [&](const Resource<Image<glm::vec3>>& cpu,
+                               const Resource<const gpu::Image*>& gpuSlot, const char* pass,
+                               const char* imageName) {
+        if (graph.declares(gpuSlot.name))
+            return;
+        if (!graph.declares(cpu.name)) {
+            graph.addExternal(gpuSlot, false, "no voxel_gi technique in the run");
+            return;
+        }
+        const auto image = makeGpuImageResource(gpuContext, imageName,
                                                 gpu::Format::RGBA32Float, mWidth, mHeight);
-        graph.addPass({.name = "indirect_upload",
-                       .reads = {indirect},
-                       .writes = {indirectGpu, image},
+        graph.addPass({.name = pass,
+                       .reads = {cpu},
+                       .writes = {gpuSlot, image},
                        .persistent = {image.name}},
-                      [indirect, indirectGpu, image](PassContext& ctx) {
-                          gpu::Image& target = ctx.write(image);
-                          render::uploadInto(target, ctx.read(indirect));
-                          ctx.write(indirectGpu) = &target;
-                          return PassOutcome{};
-                      });
-    } else if (!graph.declares(kIndirectIrradianceGpu)) {
-        graph.addExternal(indirectGpu, false, "no voxel_gi technique in the run");
-    }
-    // The sky through the voxel GI technique's cones.
-    const auto coneSky = coneSkySlot(mWidth, mHeight);
-    const auto coneSkyGpu = coneSkyGpuSlot(mWidth, mHeight);
-    if (!graph.declares(kConeSkyGpu) && graph.declares(kConeSky)) {
-        const auto image = makeGpuImageResource(gpuContext, "cone_sky_upload",
-                                                gpu::Format::RGBA32Float, mWidth, mHeight);
-        graph.addPass({.name = "cone_sky_upload",
-                       .reads = {coneSky},
-                       .writes = {coneSkyGpu, image},
-                       .persistent = {image.name}},
-                      [coneSky, coneSkyGpu, image](PassContext& ctx) {
-                          const Image<glm::vec3>& sky = ctx.read(coneSky);
+                      [cpu, gpuSlot, image](PassContext& ctx) {
+                          const Image<glm::vec3>& data = ctx.read(cpu);
                           const gpu::Image* slot = nullptr;
-                          if (sky.width > 0) { // empty: the technique gave none this frame
+                          if (data.width > 0) {
                               gpu::Image& target = ctx.write(image);
-                              render::uploadInto(target, sky);
+                              render::uploadInto(target, data);
                               slot = &target;
                           }
-                          ctx.write(coneSkyGpu) = slot;
+                          ctx.write(gpuSlot) = slot;
                           return PassOutcome{};
                       });
-    } else if (!graph.declares(kConeSkyGpu)) {
-        graph.addExternal(coneSkyGpu, false, "no voxel_gi technique in the run");
-    }
-    if (!graph.declares(kConeSky))
-        graph.addExternal(coneSky, false, "no voxel_gi technique in the run");
+    };
+    addUpload(indirect, indirectGpu, "indirect_upload", "indirect_irradiance_upload");
+    addUpload(coneSkySlot(mWidth, mHeight), coneSkyGpuSlot(mWidth, mHeight), "cone_sky_upload",
+              "cone_sky_upload_image");
     // CPU slots nobody fills (CPU readers read them optionally).
     if (!graph.declares(kAmbientOcclusion))
         graph.addExternal(ao, false, "no occlusion technique in the run");
@@ -265,6 +254,8 @@ void Compose::addSlotUploads(FrameGraph& graph)
         graph.addExternal(cones, false, "no occlusion technique in the run");
     if (!graph.declares(kIndirectIrradiance))
         graph.addExternal(indirect, false, "no voxel_gi technique in the run");
+    if (!graph.declares(kConeSky))
+        graph.addExternal(coneSkySlot(mWidth, mHeight), false, "no voxel_gi technique in the run");
 }
 
 void Compose::addPasses(FrameGraph& graph)

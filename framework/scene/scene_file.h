@@ -10,7 +10,9 @@
 //     - {name: white, albedo: [0.8, 0.8, 0.8]}
 //     - {name: lamp, albedo: [0, 0, 0], emission: [4, 4, 4]}
 //   meshes:
-//     - {file: models/bunny.obj, material: white, translate: [0, 0, 0], scale: 1, rotate_y: 0}
+//     - {file: models/bunny.obj, material: white, translate: [0, 0, 0], scale: 1, rotate_y: 0,
+//        normals: from_file}          # from_file (default: what the file means, mesh_loader.h),
+//                                     # flat, smooth, or {crease_angle: 60} (degrees, (0, 180])
 //   sdf_models:
 //     - name: rock
 //       bounds: [[-1, -1, -1], [1, 1, 1]]

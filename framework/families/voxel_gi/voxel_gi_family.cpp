@@ -224,34 +224,44 @@ private:
         const bool hasCapsules = graph.declares(capsules.name);
         if (hasCapsules)
             gatherOptional.push_back(capsules);
+        // What the gather and the cone sky read: the G-buffer, the visibilities, the capsules.
+        const auto makeInput = [this, cones, hasCones, capsules,
+                                hasCapsules](pipeline::PassContext& ctx, const scene::GBuffer& g) {
+            plugin::VoxelGiInput input;
+            input.gbuffer = &g;
+            input.cameraPosition = glm::dvec3(g.camera.position);
+            input.frameIndex = ctx.frame();
+            input.gpu = &mContext.getGpu();
+            input.capsules = hasCapsules ? ctx.tryRead(capsules) : nullptr;
+            const auto* visibility = hasCones ? ctx.tryRead(cones) : nullptr;
+            input.coneVisibility =
+                visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
+                    ? visibility
+                    : nullptr;
+            input.coneSky = mRun.lighting && mRun.sky != "lobes";
+            return input;
+        };
+        // A technique's image must be the G-buffer's size.
+        const auto checkSize = [this](const Image<glm::vec3>& out, const scene::GBuffer& g,
+                                      const char* what) {
+            if (out.width != g.width || out.height != g.height)
+                throw Error("technique '" + mTechniqueName + "' returned " +
+                            std::to_string(out.width) + "x" + std::to_string(out.height) + " " +
+                            what + " for a " + std::to_string(g.width) + "x" +
+                            std::to_string(g.height) + " G-buffer");
+        };
         graph.addPass(
             {.name = "voxel_gather",
              .reads = {voxelLight, gbuffer, geometry},
              .optionalReads = gatherOptional,
              .writes = {indirect}},
-            [this, gbuffer, geometry, cones, hasCones, capsules, hasCapsules,
-             indirect](pipeline::PassContext& ctx) {
+            [this, gbuffer, geometry, makeInput, checkSize, indirect](pipeline::PassContext& ctx) {
                 const scene::GBuffer& g = ctx.read(gbuffer);
-                plugin::VoxelGiInput input;
-                input.gbuffer = &g;
+                plugin::VoxelGiInput input = makeInput(ctx, g);
                 input.scene = &ctx.read(geometry);
-                input.cameraPosition = glm::dvec3(g.camera.position);
-                input.frameIndex = ctx.frame();
-                input.gpu = &mContext.getGpu();
-                input.capsules = hasCapsules ? ctx.tryRead(capsules) : nullptr;
-                const auto* visibility = hasCones ? ctx.tryRead(cones) : nullptr;
-                input.coneVisibility =
-                    visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
-                        ? visibility
-                        : nullptr;
-                input.coneSky = mRun.lighting && mRun.sky != "lobes";
                 Image<glm::vec3>& out = ctx.write(indirect);
                 mTechnique->gather(input, out);
-                if (out.width != g.width || out.height != g.height)
-                    throw Error("technique '" + mTechniqueName + "' returned " +
-                                std::to_string(out.width) + "x" + std::to_string(out.height) +
-                                " irradiance for a " + std::to_string(g.width) + "x" +
-                                std::to_string(g.height) + " G-buffer");
+                checkSize(out, g, "irradiance");
                 mRow->set("gather.cone_visibility", input.coneVisibility != nullptr);
                 return pipeline::PassOutcome{};
             });
@@ -269,31 +279,17 @@ private:
              .reads = {indirect, gbuffer},
              .optionalReads = gatherOptional,
              .writes = {coneSky}},
-            [this, gbuffer, cones, hasCones, capsules, hasCapsules,
-             coneSky](pipeline::PassContext& ctx) {
+            [this, gbuffer, makeInput, checkSize, coneSky](pipeline::PassContext& ctx) {
                 const scene::GBuffer& g = ctx.read(gbuffer);
-                plugin::VoxelGiInput input;
-                input.gbuffer = &g;
-                input.cameraPosition = glm::dvec3(g.camera.position);
-                input.frameIndex = ctx.frame();
-                input.gpu = &mContext.getGpu();
-                input.capsules = hasCapsules ? ctx.tryRead(capsules) : nullptr;
-                const auto* visibility = hasCones ? ctx.tryRead(cones) : nullptr;
-                input.coneVisibility =
-                    visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
-                        ? visibility
-                        : nullptr;
+                const plugin::VoxelGiInput input = makeInput(ctx, g);
                 Image<glm::vec3>& out = ctx.write(coneSky);
                 out = Image<glm::vec3>();
                 const std::string whyNot = mTechnique->combineConeSky(input, out);
                 if (!whyNot.empty()) {
                     out = Image<glm::vec3>(); // the frame lights its sky with the lobes
                     mRow->set("voxel_cone_sky.none", whyNot);
-                } else if (out.width != g.width || out.height != g.height) {
-                    throw Error("technique '" + mTechniqueName + "' returned " +
-                                std::to_string(out.width) + "x" + std::to_string(out.height) +
-                                " cone sky for a " + std::to_string(g.width) + "x" +
-                                std::to_string(g.height) + " G-buffer");
+                } else {
+                    checkSize(out, g, "cone sky");
                 }
                 return pipeline::PassOutcome{};
             });

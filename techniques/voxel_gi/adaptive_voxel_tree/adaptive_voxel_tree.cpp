@@ -216,49 +216,16 @@ public:
 
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
-        const scene::GBuffer& g = *input.gbuffer;
-        irradiance = Image<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
-        if (!mTree || mPayload.empty())
-            return;
-        tbb::parallel_for(0, g.height, [&](int y) {
-            for (int x = 0; x < g.width; ++x) {
-                if (!g.hasSurface(x, y))
-                    continue;
-                const glm::dvec3 n(g.normal.at(x, y));
-                const glm::dvec3 p(g.position.at(x, y));
-                irradiance.at(x, y) = glm::vec3(evaluate(p, n));
-            }
-        });
+        irradiance = evaluateAtPixels(*input.gbuffer, mPayload, nullptr);
     }
 
     std::string combineConeSky(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
         if (!mTree || mSkyPayload.empty())
             return "no probes baked";
-        const scene::GBuffer& g = *input.gbuffer;
         const bool cones = input.coneVisibility != nullptr &&
                            input.coneVisibility->size() == std::size_t(voxelgi::kConeCount);
-        const voxelgi::ConeSet coneSet = voxelgi::ConeSet::make(29.0);
-        irradiance = Image<glm::vec3>(g.width, g.height, glm::vec3(0.0f));
-        tbb::parallel_for(0, g.height, [&](int y) {
-            for (int x = 0; x < g.width; ++x) {
-                if (!g.hasSurface(x, y))
-                    continue;
-                const glm::dvec3 n(g.normal.at(x, y));
-                const glm::dvec3 p(g.position.at(x, y));
-                double visible = 1.0;
-                if (cones) {
-                    // The visibilities' cosine-weighted mean (the weights sum to pi).
-                    const auto w = voxelgi::computeIrradianceWeights(coneSet, n);
-                    visible = 0.0;
-                    for (int k = 0; k < voxelgi::kConeCount; ++k)
-                        visible += w[std::size_t(k)] *
-                                   std::clamp(double((*input.coneVisibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
-                    visible /= glm::pi<double>();
-                }
-                irradiance.at(x, y) = glm::vec3(visible * evaluate(p, n, mSkyPayload));
-            }
-        });
+        irradiance = evaluateAtPixels(*input.gbuffer, mSkyPayload, cones ? input.coneVisibility : nullptr);
         return {};
     }
 
@@ -383,6 +350,37 @@ private:
     }
 
     glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n) const { return evaluate(p, n, mPayload); }
+
+    // `values` (a payload) evaluated at every pixel with a surface, 0 elsewhere (and everywhere
+    // before a bake); with `visibility` (16 images) times the pixel's cosine-weighted mean of
+    // them (the cone irradiance weights sum to pi).
+    Image<glm::vec3> evaluateAtPixels(const scene::GBuffer& g, const std::vector<glm::vec3>& values,
+                                      const std::vector<Image<float>>* visibility) const
+    {
+        Image<glm::vec3> out(g.width, g.height, glm::vec3(0.0f));
+        if (!mTree || values.empty())
+            return out;
+        const voxelgi::ConeSet coneSet = voxelgi::ConeSet::make(29.0);
+        tbb::parallel_for(0, g.height, [&](int y) {
+            for (int x = 0; x < g.width; ++x) {
+                if (!g.hasSurface(x, y))
+                    continue;
+                const glm::dvec3 n(g.normal.at(x, y));
+                const glm::dvec3 p(g.position.at(x, y));
+                double visible = 1.0;
+                if (visibility != nullptr) {
+                    const auto w = voxelgi::computeIrradianceWeights(coneSet, n);
+                    visible = 0.0;
+                    for (int k = 0; k < voxelgi::kConeCount; ++k)
+                        visible += w[std::size_t(k)] *
+                                   std::clamp(double((*visibility)[std::size_t(k)].at(x, y)), 0.0, 1.0);
+                    visible /= glm::pi<double>();
+                }
+                out.at(x, y) = glm::vec3(visible * evaluate(p, n, values));
+            }
+        });
+        return out;
+    }
 
     glm::dvec3 evaluate(const glm::dvec3& p, const glm::dvec3& n, const std::vector<glm::vec3>& values) const
     {
