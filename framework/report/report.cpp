@@ -111,14 +111,20 @@ std::vector<Group> groupRuns(const std::vector<experiment::Row>& rows,
             git->second.columns = getFamilyColumns(registry, family);
             groupOrder.push_back(key);
         }
-        // Runs of the lit frame (frame: {lighting: true}) add its columns to the tables.
+        // Runs of the lit frame (frame: {lighting: true}) add its columns to the tables, and its
+        // errors to the charts against each swept parameter.
         if (std::isfinite(run.get("frame.rmse")) &&
             std::find(git->second.columns.tableColumns.begin(),
                       git->second.columns.tableColumns.end(),
-                      "frame.rmse") == git->second.columns.tableColumns.end())
+                      "frame.rmse") == git->second.columns.tableColumns.end()) {
             for (const char* c : {"frame.cpu_ms", "frame.rmse", "frame.flip",
-                                  "frame.mean_signed_error", "direct.rmse", "frame.culling"})
+                                  "frame.mean_signed_error", "direct.rmse", "frame.culling",
+                                  "frame.sky"})
                 git->second.columns.tableColumns.push_back(c);
+            auto& paramErrors = git->second.columns.paramErrors;
+            paramErrors.emplace_back("frame.rmse", "final frame RMSE against Embree full (radiance)");
+            paramErrors.emplace_back("direct.rmse", "direct term RMSE against Embree direct (radiance)");
+        }
         git->second.runs.push_back(run);
     }
     std::vector<Group> out;
