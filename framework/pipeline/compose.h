@@ -11,9 +11,12 @@
 //                   skip recorded with its reason (ComposeStats::shadowSkips); a kept face holds
 //                   what re-rendering it would give, so the frame is bitwise that of a run
 //                   without culling. Skipped when neither geometry nor lights changed.
-//   lighting        point lights with filtered shadows, the 16-lobe SRBF sky attenuated by the
-//                   frame's directional occlusion, emission, and the indirect slot
-//                   (render/lighting_pass.h). The occlusion family fills `occlusion.ambient`
+//   lighting        point lights with filtered shadows, the sky, emission, and the indirect slot
+//                   (render/lighting_pass.h). The sky is `cone_sky` when a voxel GI technique
+//                   fills it (the sky and the emitters through its cones, each cone already
+//                   times the occlusion family's visibility of its direction; ComposeStats::sky
+//                   "cones"), else the 16-lobe SRBF sky attenuated by the frame's directional
+//                   occlusion ("lobes"). The occlusion family fills `occlusion.ambient`
 //                   and, when its technique gives them, the 16 per-direction cone visibilities
 //                   `occlusion.cone_visibility` (used instead, as the Tomorrow Children did:
 //                   shared/seeds/000_3da000e866ebc485.txt); `indirect_irradiance` is the voxel GI

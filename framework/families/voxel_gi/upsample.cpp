@@ -512,6 +512,15 @@ Image<glm::vec3> gatherConesReduced(
     return irradiance;
 }
 
+void keepConeSky(ConeSkyTrace& sky, const scene::GBuffer& full, int traceStep, double coneHalfAngle,
+                 const std::vector<scene::PosedCapsule>* capsules, CapsuleResolution capsuleResolution)
+{
+    sky.reduced = reduceGBuffer(full, traceStep);
+    sky.capsulesApplied = capsuleResolution == CapsuleResolution::Traced && capsules != nullptr;
+    if (sky.capsulesApplied && !sky.cones.empty())
+        occludeTracedCones(sky.reduced.gbuffer, sky.cones, *capsules, coneHalfAngle);
+}
+
 Image<glm::vec3> combineConeSky(const ConeSkyTrace& sky, const scene::GBuffer& full, double coneHalfAngle,
                                 const std::vector<Image<float>>* visibility,
                                 const std::vector<scene::PosedCapsule>* capsules)

@@ -104,6 +104,13 @@ Image<glm::vec3> gatherConesReduced(
     double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full,
     ConeSkyTrace* sky = nullptr);
 
+//! Completes `sky` for cones traced at the representative pixels of `full` reduced by
+//! `traceStep` outside gatherConesReduced (a gather whose light is combined on Vulkan): the
+//! reduced G-buffer, and the capsules multiplied into the cones when `capsuleResolution` says
+//! they are tested at the traced pixels.
+void keepConeSky(ConeSkyTrace& sky, const scene::GBuffer& full, int traceStep, double coneHalfAngle,
+                 const std::vector<scene::PosedCapsule>* capsules, CapsuleResolution capsuleResolution);
+
 //! The irradiance from the sky and emitters of `sky` at every pixel of `full` (the G-buffer
 //! the gather was given): the same combine as the gather's light (combineCones: upsampled per
 //! cone, times the cone visibilities and the capsules' occlusion, integrated with the pixel's

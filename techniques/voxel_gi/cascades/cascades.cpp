@@ -330,9 +330,10 @@ public:
                     });
         };
         mSky.cones.clear();
-        mSkyWhyNot = mGatheredOnGpu   ? "the Vulkan gather traces no cone sky yet (device: cpu does)"
-                     : mCombinedOnGpu ? "the Vulkan combine takes no cone sky yet (combine_device: cpu does)"
-                                    : "";
+        mSkyWhyNot = mGatheredOnGpu ? "the Vulkan gather traces no cone sky yet (device: cpu does)" : "";
+        voxelgi::ConeSkyOutput sky;
+        if (input.scene != nullptr)
+            sky.skyPerCone = voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
         if (mCombinedOnGpu) {
             // The combine on Vulkan (cone_combine_gpu.h): the cones of the Vulkan gather stay on
             // the device, those of the C++ gather go up.
@@ -341,14 +342,20 @@ public:
                 input.coneVisibility, input.capsules,
                 [&](const scene::GBuffer& reduced) -> const gpu::Buffer& {
                     if (!mGatheredOnGpu) {
+                        // The C++ gather's cones go up; their sky stays here, for the C++
+                        // combine of combineConeSky (float against double: within 1e-5).
                         std::vector<glm::vec3> cones;
-                        mVolume->gatherCones(reduced, cones);
+                        sky.out = &mSky.cones;
+                        mVolume->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
                         return mCombineGpu.uploadCones(*input.gpu, cones);
                     }
                     prepareGpuCones(reduced);
                     return mGpu.gatherConesOnDevice(*input.gpu, *mVolume, reduced);
                 },
                 &mCombineMs, mCapsuleResolution);
+            if (!mSky.cones.empty())
+                voxelgi::keepConeSky(mSky, *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle,
+                                     input.capsules, mCapsuleResolution);
             return;
         }
         irradiance = voxelgi::gatherConesReduced(
@@ -360,10 +367,6 @@ public:
                     prepareGpuCones(reduced);
                     mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
                 } else {
-                    voxelgi::ConeSkyOutput sky;
-                    if (input.scene != nullptr)
-                        sky.skyPerCone =
-                            voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
                     sky.out = skyCones;
                     mVolume->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
                 }
