@@ -10,6 +10,7 @@
 #include "render/lighting_pass.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 namespace rtlab::experiment {
@@ -82,6 +83,69 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
                                          : pipeline::PassOutcome{};
             });
     }
+    // The truth's direct light from the sky and the emitters alone (the scene without its
+    // point lights): with `direct` and `full` it splits the truth into the frame's terms.
+    const pipeline::Resource<reference::ReferenceResult> skyTruth{
+        "truth_sky", pipeline::ResourceType::cpuImage("radiance direct, no point lights", w, h)};
+    graph.addPass(
+        {.name = "reference_sky", .reads = {geometry, gbuffer}, .writes = {skyTruth}, .measurement = true},
+        [this, skyTruth, geometry, gbuffer, fromCache](pipeline::PassContext& ctx) {
+            scene::RenderScene g = ctx.read(geometry);
+            g.pointLights.clear();
+            reference::ReferenceResult& t = ctx.write(skyTruth);
+            t = reference::computeReference(g, ctx.read(gbuffer),
+                                            makeRadianceSettings(mRun, reference::Quantity::Direct));
+            mRow->set("reference_sky.seconds", t.stats.seconds)
+                .set("reference_sky.from_cache", t.stats.fromCache);
+            return t.stats.fromCache ? pipeline::PassOutcome::skipped(fromCache)
+                                     : pipeline::PassOutcome{};
+        });
+    // What the frame's light is made of, in the technique and in the truth: the mean over the
+    // surface pixels of each term's radiance (luminance, Rec. 709), so an error is traced to its
+    // term. Emission is the G-buffer's in both; direct splits into the point lights' part and
+    // the sky's (with the emitters' light where the technique's sky comes through its cones,
+    // and always in the truth); indirect is the rest of the frame.
+    graph.addPass({.name = "metric.frame_terms",
+                   .reads = {lit, full, direct, skyTruth, gbuffer, view},
+                   .writes = {"metric.frame_terms"},
+                   .measurement = true},
+                  [this, lit, full, direct, skyTruth, gbuffer, view](pipeline::PassContext& ctx) {
+                      const pipeline::LitFrame& f = ctx.read(lit);
+                      const scene::GBuffer& g = ctx.read(gbuffer);
+                      const Image<std::uint8_t>& surface = ctx.read(view).surface;
+                      const auto lum = [](const glm::vec3& c) {
+                          return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+                      };
+                      const Image<glm::vec3>& tFull = ctx.read(full).radiance;
+                      const Image<glm::vec3>& tDirect = ctx.read(direct).radiance;
+                      const Image<glm::vec3>& tSky = ctx.read(skyTruth).radiance;
+                      // technique: emission, point lights, sky, indirect; then the truth's
+                      double sums[8] = {};
+                      std::size_t n = 0;
+                      for (std::size_t i = 0; i < f.hdr.pixels.size(); ++i) {
+                          if (surface.pixels[i] == 0)
+                              continue;
+                          ++n;
+                          const double e = lum(g.emission.pixels[i]);
+                          const double d = lum(f.direct.pixels[i]), s = f.directSky.pixels[i];
+                          sums[0] += e;
+                          sums[1] += d - s;
+                          sums[2] += s;
+                          sums[3] += lum(f.hdr.pixels[i]) - e - d;
+                          const double td = lum(tDirect.pixels[i]), ts = lum(tSky.pixels[i]);
+                          sums[4] += e;
+                          sums[5] += td - ts;
+                          sums[6] += ts;
+                          sums[7] += lum(tFull.pixels[i]) - e - td;
+                      }
+                      static const char* kTerms[4] = {"emission", "point_lights", "sky", "indirect"};
+                      for (int k = 0; k < 4; ++k) {
+                          const double scale = n > 0 ? 1.0 / double(n) : std::nan("");
+                          mRow->set(std::string("frame.term.") + kTerms[k], sums[k] * scale)
+                              .set(std::string("truth.term.") + kTerms[k], sums[4 + k] * scale);
+                      }
+                      return pipeline::PassOutcome{};
+                  });
     graph.addPass({.name = "metric.frame",
                    .reads = {lit, full, direct, view},
                    .writes = {"metric.frame"},
@@ -124,6 +188,7 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
             return pipeline::PassOutcome{};
         });
     outputs.push_back("metric.frame");
+    outputs.push_back("metric.frame_terms");
     outputs.push_back("frame_images");
 }
 

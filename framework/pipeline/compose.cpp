@@ -467,6 +467,7 @@ void Compose::addPasses(FrameGraph& graph)
                       LitFrame& out = ctx.write(lit);
                       out.hdr = render::downloadRgb(ctx.read(hdr));
                       out.direct = render::downloadRgb(ctx.read(direct));
+                      out.directSky = render::downloadScalar(ctx.read(direct), 3);
                       out.ldr = render::downloadRgb(ctx.read(ldr));
                       return PassOutcome{};
                   });

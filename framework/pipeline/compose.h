@@ -69,6 +69,9 @@ struct LitFrame {
     Image<glm::vec3> hdr;    //!< linear radiance: emission + direct + indirect
     Image<glm::vec3> direct; //!< albedo/pi * (point lights + sky), no emission, no indirect
     Image<glm::vec3> ldr;    //!< tonemapped, sRGB-encoded, [0, 1]
+    //! Luminance (Rec. 709) of the sky's part of `direct` (the cones' sky and emitters, or the
+    //! lobes'); the rest of `direct` is the point lights'.
+    Image<float> directSky;
 };
 
 struct ComposeOptions {

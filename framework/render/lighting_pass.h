@@ -182,7 +182,8 @@ public:
 
     //! RGBA32Float: emission + direct + sky + indirect (alpha 1). Valid after draw().
     const gpu::Image& getHdr() const;
-    //! RGBA32Float: albedo / pi * (point lights + sky), 0 without surface.
+    //! RGBA32Float: albedo / pi * (point lights + sky), 0 without surface; alpha the luminance
+    //! (Rec. 709) of the sky's part, albedo / pi * E_sky.
     const gpu::Image& getDirect() const;
     //! RGBA8Unorm: the tonemapped, sRGB-encoded frame.
     const gpu::Image& getLdr() const;

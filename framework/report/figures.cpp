@@ -76,8 +76,8 @@ plot::PixelRect findWorstRegion(const Image<float>& error)
             w, h};
 }
 
-// Bar labels that do not fit under their bars become numbers; returns the key for the caption
-// (" Bars: 1 = ...; 2 = ..."), empty when they fit.
+} // namespace
+
 std::string numberBarsThatDoNotFit(plot::StackedBarSpec& bars)
 {
     std::string key;
@@ -91,8 +91,6 @@ std::string numberBarsThatDoNotFit(plot::StackedBarSpec& bars)
     }
     return key;
 }
-
-} // namespace
 
 Figures writeGroupFigures(const Group& group, const std::vector<EqualErrorRow>& equal,
                           const std::string& directory, const std::vector<std::string>& techniques)

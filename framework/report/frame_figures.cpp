@@ -132,6 +132,48 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory,
             group.title + ". A pass that was skipped (reused work, nothing changed) is 0.");
     }
 
+    // 2b. What the frame's light is made of (experiment/lit_frame.cpp metric.frame_terms): per
+    //     run with culling on, the mean radiance of each term over the surface pixels and the
+    //     frames, the technique's bar beside the truth's, so an error is traced to its term.
+    {
+        static const char* kTerms[] = {"emission", "point_lights", "sky", "indirect"};
+        plot::StackedBarSpec bars;
+        bars.title = group.title + ": what the lit frame is made of";
+        bars.yLabel = "mean radiance over the surface pixels (luminance)";
+        bars.passes = {"emission", "point lights", "sky and emitters", "indirect"};
+        bars.totalDecimals = 3;
+        for (const auto& run : group.runs) {
+            if (isCullingOff(run) || !std::isfinite(run.get("frame.term.sky")))
+                continue;
+            const std::string label = describeRun(run, group.varyingParams);
+            const std::string sky = getText(run.frames.front(), "frame.sky");
+            for (const char* side : {"frame", "truth"}) {
+                bars.bars.push_back(std::string(side) == "truth"
+                                        ? "truth (" + run.technique + (label.empty() ? "" : " " + label) + ")"
+                                        : run.technique + (label.empty() ? "" : " " + label) +
+                                              (sky.empty() ? "" : " sky=" + sky));
+                std::vector<double> values;
+                for (const char* term : kTerms) {
+                    const double v = run.get(std::string(side) + ".term." + term);
+                    values.push_back(std::isfinite(v) ? v : 0.0);
+                }
+                bars.values.push_back(values);
+            }
+        }
+        if (!bars.bars.empty()) {
+            const std::string key = numberBarsThatDoNotFit(bars);
+            const std::string path = plots + "/frame_terms_" + stem;
+            plot::writeStackedBars(bars, path);
+            figures.plots.push_back(path);
+            figures.captions.push_back(
+                "What the lit frame is made of on " + group.title +
+                ", per run and beside the Embree truth of the same frames: the mean radiance of "
+                "emission, point lights, the sky (with the emitters' light, which the truth and "
+                "the cones' sky carry) and indirect light over the surface pixels, averaged over "
+                "the frames." + key);
+        }
+    }
+
     // 3. Culling on against off: total time, and whether the final frames are bitwise the same.
     {
         plot::StackedBarSpec bars;

@@ -10,6 +10,10 @@
 #include <string>
 #include <vector>
 
+namespace rtlab::plot {
+struct StackedBarSpec;
+}
+
 namespace rtlab::report::detail {
 
 //! `s` with &, <, >, " escaped for HTML text and attributes.
@@ -115,6 +119,10 @@ Figures writeGroupFigures(const Group& group, const std::vector<EqualErrorRow>& 
 std::string makeFileName(std::string s);
 
 //! The lit frame's figures of `group` (runs with frame.rmse), or none.
+//! Bar labels that do not fit under their bars become numbers; returns the key for the caption
+//! (" Bars: 1 = ...; 2 = ..."), empty when they fit.
+std::string numberBarsThatDoNotFit(plot::StackedBarSpec& bars);
+
 Figures writeLitFrameFigures(const Group& group, const std::string& directory, const plot::ColorTable& colors);
 
 //! technique.png, reference.png and error.png (|error| through viridis over [0, errorRange])

@@ -146,7 +146,7 @@ void main()
         const vec4 far = frame.inverseRelativeViewProjection * vec4(ndc, 1.0, 1.0);
         const vec3 w = normalize(far.xyz / far.w);
         imageStore(outHdr, pixel, vec4(evaluateSkyRadiance(w), 1.0));
-        imageStore(outDirect, pixel, vec4(0.0, 0.0, 0.0, 1.0));
+        imageStore(outDirect, pixel, vec4(0.0));
         return;
     }
 
@@ -208,5 +208,7 @@ void main()
     const vec3 direct = rho / kPi * (lightIrradiance + skyIrradiance);
     const vec3 hdr = emission + direct + rho / kPi * indirect;
     imageStore(outHdr, pixel, vec4(hdr, 1.0));
-    imageStore(outDirect, pixel, vec4(direct, 1.0));
+    // Alpha: the luminance (Rec. 709) of the sky's part of direct, for the frame's terms.
+    const vec3 skyPart = rho / kPi * skyIrradiance;
+    imageStore(outDirect, pixel, vec4(direct, dot(skyPart, vec3(0.2126, 0.7152, 0.0722))));
 }
