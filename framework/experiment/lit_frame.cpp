@@ -119,8 +119,9 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
                       const Image<glm::vec3>& tFull = ctx.read(full).radiance;
                       const Image<glm::vec3>& tDirect = ctx.read(direct).radiance;
                       const Image<glm::vec3>& tSky = ctx.read(skyTruth).radiance;
-                      // technique: emission, point lights, sky, indirect; then the truth's
-                      double sums[8] = {};
+                      // technique: emission, point lights, sky, indirect; then the truth's; and
+                      // the squared per-pixel differences of the last three
+                      double sums[8] = {}, squares[3] = {};
                       std::size_t n = 0;
                       for (std::size_t i = 0; i < f.hdr.pixels.size(); ++i) {
                           if (surface.pixels[i] == 0)
@@ -137,12 +138,22 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
                           sums[5] += td - ts;
                           sums[6] += ts;
                           sums[7] += lum(tFull.pixels[i]) - e - td;
+                          const double terms[3] = {d - s - (td - ts), s - ts,
+                                                   (lum(f.hdr.pixels[i]) - e - d) -
+                                                       (lum(tFull.pixels[i]) - e - td)};
+                          for (int k = 0; k < 3; ++k)
+                              squares[k] += terms[k] * terms[k];
                       }
                       static const char* kTerms[4] = {"emission", "point_lights", "sky", "indirect"};
                       for (int k = 0; k < 4; ++k) {
                           const double scale = n > 0 ? 1.0 / double(n) : std::nan("");
                           mRow->set(std::string("frame.term.") + kTerms[k], sums[k] * scale)
                               .set(std::string("truth.term.") + kTerms[k], sums[4 + k] * scale);
+                          // Each lit term's own error, per pixel (the point lights' part: their
+                          // shadows against the truth's, apart from the sky's).
+                          if (k > 0)
+                              mRow->set(std::string("frame.term_rmse.") + kTerms[k],
+                                        std::sqrt(squares[k - 1] * scale));
                       }
                       return pipeline::PassOutcome{};
                   });

@@ -64,6 +64,20 @@ TEST(VoxelGiDriver, CascadesFillTheIndirectSlotOfTheLitFrame)
         const auto& row = culled[i];
         EXPECT_EQ(row.at("frame.indirect"), "indirect_irradiance");
         EXPECT_EQ(row.at("gather.cone_visibility"), "true");
+        // The sky and the ceiling's light come through the cascades' cones.
+        EXPECT_EQ(row.at("frame.sky"), "cones");
+        // What the frame is made of: the Cornell box has no point lights, so their part is 0 in
+        // the truth (the same reference twice) and in the lit frame (direct is all sky: float
+        // rounding of one luminance against another); its ceiling is emissive and in view.
+        EXPECT_EQ(experiment::getNumber(row, "truth.term.point_lights"), 0.0);
+        EXPECT_NEAR(experiment::getNumber(row, "frame.term.point_lights"), 0.0, 1e-5);
+        EXPECT_GT(experiment::getNumber(row, "frame.term.emission"), 0.0);
+        EXPECT_EQ(experiment::getNumber(row, "frame.term.emission"),
+                  experiment::getNumber(row, "truth.term.emission"));
+        EXPECT_GT(experiment::getNumber(row, "frame.term.sky"), 0.0);
+        EXPECT_GT(experiment::getNumber(row, "truth.term.sky"), 0.0);
+        EXPECT_GE(experiment::getNumber(row, "frame.term.indirect"), -1e-5);
+        EXPECT_TRUE(std::isfinite(experiment::getNumber(row, "frame.term_rmse.sky")));
         EXPECT_EQ(row.at("reference.bounces"), "2");
         const double rmse = experiment::getNumber(row, "indirect.rmse");
         EXPECT_TRUE(std::isfinite(rmse) && rmse >= 0.0) << rmse;
