@@ -83,7 +83,7 @@ public:
             return;
         }
         ConeSkyOutput sky;
-        if (input.scene != nullptr)
+        if (input.coneSky && input.scene != nullptr)
             sky.skyPerCone = computeSkyPerCone(input.scene->sky, mStructure->getCones());
         irradiance = gatherConesReduced(
             *input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,

@@ -91,6 +91,7 @@ bool runConeSky(const TechniqueEntry& entry, const scene::RenderScene& s, const 
     frame.geometry = &s;
     frame.geometryKey = s.computeContentHash();
     frame.cameraPosition = glm::dvec3(g.camera.position);
+    frame.coneSky = true;
     gi.voxelize(frame);
     gi.injectLight(frame);
     plugin::VoxelGiInput input;

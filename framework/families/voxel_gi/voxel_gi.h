@@ -54,6 +54,9 @@ struct VoxelGiFrame {
     int frameIndex = 0;
     bool force = false; //!< do the whole step even where nothing changed (culling off)
     gpu::Context* gpu = nullptr;
+    //! The frame will ask for the cones' sky (VoxelGiInput::coneSky): a step that prepares it
+    //! (a bake of the sky) does so only then.
+    bool coneSky = false;
 };
 
 //! What a step did: ran (and what it did, for the row), or skipped with the reason.

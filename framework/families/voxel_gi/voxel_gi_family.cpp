@@ -137,8 +137,12 @@ private:
         f.frameIndex = ctx.frame();
         f.force = !ctx.mayReuse();
         f.gpu = &mContext.getGpu();
+        f.coneSky = wantsConeSky();
         return f;
     }
+
+    //! Whether the run's lit frame takes its sky from the technique's cones.
+    bool wantsConeSky() const { return mRun.lighting && mRun.sky != "lobes"; }
 
     void addPasses(experiment::RunSetup& setup)
     {
@@ -238,7 +242,7 @@ private:
                 visibility && visibility->size() == std::size_t(scene::kConeDirectionCount)
                     ? visibility
                     : nullptr;
-            input.coneSky = mRun.lighting && mRun.sky != "lobes";
+            input.coneSky = wantsConeSky();
             return input;
         };
         // A technique's image must be the G-buffer's size.

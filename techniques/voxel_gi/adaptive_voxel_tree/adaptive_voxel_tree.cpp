@@ -32,9 +32,9 @@
 //    corners dropped), the comparison the talk makes.
 // Characters and the occlusion family's cone visibilities are not used for the indirect light
 // (the probes are static).
-// 4. the sky: the bake also stores, per probe and axis in the same payload form, the irradiance
-//    from the sky and the emissive surfaces straight (reference.h "direct" without the point
-//    lights), so walls and roofs beyond any screen-space radius shadow the sky: the sky transport
+// 4. the sky: when the lit frame takes its sky from the probes, the bake also stores, per probe
+//    and axis in the same payload form, the irradiance from the sky and the emissive surfaces
+//    straight (reference.h "direct" without the point lights), so walls and roofs beyond any screen-space radius shadow the sky: the sky transport
 //    of Quantum Break's probes. The lit frame takes it instead of the sky lobes (voxel_gi.h
 //    combineConeSky), times the cosine-weighted mean of the occlusion family's 16 visibilities
 //    when it gives them (the small-scale occlusion the probes' leaves are too coarse for).
@@ -202,13 +202,14 @@ public:
 
     plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& frame) override
     {
-        const std::string key = mGeometryKey + voxelgi::computeLightsKey(*frame.geometry);
+        const std::string key = mGeometryKey + voxelgi::computeLightsKey(*frame.geometry) +
+                                (frame.coneSky ? " with the sky" : "");
         if (!frame.force && key == mBakedKey)
             return plugin::VoxelGiStep::skipped("baked for this geometry and these lights");
         mBakedKey = key;
         if (!mTree)
             return plugin::VoxelGiStep::done("no probes to bake");
-        bake(*frame.geometry);
+        bake(*frame.geometry, frame.coneSky);
         return plugin::VoxelGiStep::done(
             "baked " + std::to_string(mTree->getElementCount()) + " probes x 6 axes x " +
             std::to_string(mBakeSamples) + " paths in " + std::to_string(mBakeSeconds) + " s");
@@ -222,7 +223,7 @@ public:
     std::string combineConeSky(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
         if (!mTree || mSkyPayload.empty())
-            return "no probes baked";
+            return "no sky baked into the probes";
         const bool cones = input.coneVisibility != nullptr &&
                            input.coneVisibility->size() == std::size_t(voxelgi::kConeCount);
         irradiance = evaluateAtPixels(*input.gbuffer, mSkyPayload, cones ? input.coneVisibility : nullptr);
@@ -271,7 +272,7 @@ private:
 
     // The six axis irradiances of every probe by the ground truth's estimator: one G-buffer
     // "pixel" per probe and axis, at the probe's centre with the axis as its normal.
-    void bake(const scene::RenderScene& geometry)
+    void bake(const scene::RenderScene& geometry, bool withSky)
     {
         const auto start = std::chrono::steady_clock::now();
         const std::vector<glm::ivec4> cells = mTree->listElementCells();
@@ -297,8 +298,15 @@ private:
         const reference::ReferenceSettings s = reference::makeFixedSampleSettings(
             reference::Quantity::Indirect, mBounces, mBakeSamples, 0xba4e0000ull);
         store(reference::computeReference(geometry, g, s).irradiance, probes, mPayload);
-        // The sky and the emitters straight: "direct" of the scene without its point lights
-        // (which the frame lights with their shadow maps).
+        // The sky and the emitters straight, when the frame takes its sky from the probes:
+        // "direct" of the scene without its point lights (which the frame lights with their
+        // shadow maps).
+        mSkyPayload.clear();
+        if (!withSky) {
+            mBakeSeconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            return;
+        }
         scene::RenderScene skyAndEmitters = geometry;
         skyAndEmitters.pointLights.clear();
         const reference::ReferenceSettings sky = reference::makeFixedSampleSettings(

@@ -332,7 +332,7 @@ public:
         mSky.cones.clear();
         mSkyWhyNot = mGatheredOnGpu ? "the Vulkan gather traces no cone sky yet (device: cpu does)" : "";
         voxelgi::ConeSkyOutput sky;
-        if (input.scene != nullptr)
+        if (input.coneSky && input.scene != nullptr)
             sky.skyPerCone = voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
         if (mCombinedOnGpu) {
             // The combine on Vulkan (cone_combine_gpu.h): the cones of the Vulkan gather stay on
