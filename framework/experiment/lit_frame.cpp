@@ -144,6 +144,20 @@ LitFrame::LitFrame(const RunConfig& run, DriverContext& context, pipeline::Frame
                           for (int k = 0; k < 3; ++k)
                               squares[k] += terms[k] * terms[k];
                       }
+                      {
+                          // The sky term's images, the technique's and the truth's (luminance).
+                          Image<glm::vec3> mine(g.emission.width, g.emission.height),
+                              truth(g.emission.width, g.emission.height);
+                          for (std::size_t i = 0; i < mine.pixels.size(); ++i) {
+                              mine.pixels[i] = glm::vec3(f.directSky.pixels[i]);
+                              truth.pixels[i] = glm::vec3(float(lum(tSky.pixels[i])));
+                          }
+                          const std::string dir =
+                              mContext.runDirectory() + "/frame" + std::to_string(ctx.frame());
+                          std::filesystem::create_directories(dir);
+                          writeExr(mine, dir + "/sky_term.exr");
+                          writeExr(truth, dir + "/truth_sky_term.exr");
+                      }
                       static const char* kTerms[4] = {"emission", "point_lights", "sky", "indirect"};
                       for (int k = 0; k < 4; ++k) {
                           const double scale = n > 0 ? 1.0 / double(n) : std::nan("");

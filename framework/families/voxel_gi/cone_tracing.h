@@ -59,11 +59,23 @@ std::array<double, kConeCount> computeIrradianceWeights(const ConeSet& cones, co
 //! leaves the structure unoccluded sees.
 std::array<glm::vec3, kConeCount> computeSkyPerCone(const scene::Sky& sky, const ConeSet& cones);
 
+//! The optical depth of a voxel of occupancy `alpha` across its own size, -ln(1 - alpha), the
+//! occupancy capped at 1 - 1e-4 (an opaque voxel lets 1e-4 through: kOpaqueOpticalDepth).
+inline float computeOpticalDepth(float alpha)
+{
+    return -std::log(1.0f - std::clamp(alpha, 0.0f, 0.9999f));
+}
+inline const float kOpaqueOpticalDepth = computeOpticalDepth(1.0f);
+
 //! One filtered sample of a structure at a cone's footprint.
 struct ConeSample {
     float alpha = 0.0f;                         //!< occupancy seen along the cone's direction
     std::array<glm::vec3, kFieldCount> light{}; //!< premultiplied by alpha
     double voxelSize = 1.0;                     //!< size of the voxels sampled (opacity correction)
+    //! The same voxels' optical depths (computeOpticalDepth of each voxel's occupancy seen along
+    //! the cone) with the same weights as alpha: what the sky's transmittance is marched with
+    //! (marchCone). 0 from a sampler that does not give it: its voxels do not hide the sky.
+    float depth = 0.0f;
 };
 
 struct ConeMarchSettings {
@@ -73,6 +85,14 @@ struct ConeMarchSettings {
     double maxOpacity = 0.99;   //!< stop when the accumulated occupancy reaches it
     double maxDistance = 1e30;  //!< world units (point-light shadow cones stop at the light)
     int maxSteps = 1024;
+    //! March the sky's own transmittance (ConeResult::skyTransmittance) in optical depth, from
+    //! skyStartDistance on, and on past the light's end until the sky is hidden too. Off: the
+    //! sky's transmittance is the light's.
+    bool sky = false;
+    //! How the sky's transmittance is marched: in optical depth (true; the leaks marchCone
+    //! describes are gone, a footprint partly on a surface weighs more) or, as the light, in
+    //! occupancy composited front to back (false).
+    bool skyOpticalDepth = true;
     //! World units along the cone from which its voxels shadow the sky (ConeResult::
     //! skyTransmittance); nearer occluders are left to the occlusion family's visibilities.
     double skyStartDistance = 0.0;
@@ -85,7 +105,8 @@ struct ConeMarchSettings {
 struct ConeResult {
     std::array<glm::vec3, kFieldCount> light{}; //!< radiance of each field seen along the cone
     double transmittance = 1.0;                 //!< 1 - accumulated occupancy
-    //! The same over the samples at or beyond ConeMarchSettings::skyStartDistance only.
+    //! What the voxels at or beyond ConeMarchSettings::skyStartDistance let through to the sky,
+    //! exp(-their optical depth) (ConeMarchSettings::sky; else transmittance).
     double skyTransmittance = 1.0;
     bool escaped = false;                       //!< left the structure (sees the sky)
     //! Left the structure, also after the light was done (marching on for the sky only).
@@ -98,13 +119,28 @@ struct ConeResult {
 //! structure. Opacity is corrected for the step length, a' = 1 - (1 - a)^(step / voxelSize), and
 //! the radiance composited with the same a' (Engel et al., Real-Time Volume Graphics; the
 //! step-length correction of shared/research/voxelgi.md section 8.1).
+//!
+//! The sky's transmittance (ConeMarchSettings::sky) is marched in optical depth instead:
+//! exp(-sum of ConeSample::depth * step / voxelSize). The occupancy of a trilinear sample is the
+//! tent-weighted mean of its voxels', and a march compositing it lets light through an opaque
+//! voxel: stepping half voxels past a one-voxel wall whose centre falls between two samples, the
+//! samples read it at 0.25, 0.75, 0.75, 0.25 and keep sqrt(0.75 * 0.25 * 0.25 * 0.75) = 19 % of
+//! the light; the 6-face blend (weights dir^2) does the same to a slab seen at 45 degrees (half
+//! its opaque face, half its thin side). Interpolated optical depth has neither leak: the tent
+//! weights of a lattice sum to one voxel per voxel size marched, so the march crosses each
+//! voxel's whole optical depth whatever the offset, and an opaque face stays opaque however little
+//! of it the blend weighs (Max, "Optical models for direct volume rendering", IEEE TVCG 1995:
+//! transmittance is the exponential of the integrated extinction, which is what a linear filter
+//! may interpolate). The light keeps the occupancy, as the GPU gathers composite it.
 template <class Sampler>
 ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm::dvec3& dir, int cone,
                      const ConeMarchSettings& s)
 {
     ConeResult r;
     double occupied = 0.0;
-    double skyTransmittance = 1.0;
+    double skyDepth = 0.0; // optical depth toward the sky (s.sky)
+    // The sky is hidden when its transmittance is as low as the light's limit.
+    const double skyHidden = -std::log(std::max(1e-12, 1.0 - s.maxOpacity));
     bool lightDone = false; // the occupancy reached maxOpacity: no more light
     double t = s.startDistance;
     ConeSample sample;
@@ -141,45 +177,41 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
                 occupied += (1.0 - occupied) * corrected;
                 lightDone = occupied >= s.maxOpacity;
             }
-            if (t >= s.skyStartDistance) {
+            if (s.sky && t >= s.skyStartDistance) {
                 // The sky through the part of the sample the surface the cone leaves does not
                 // fill. Voxels of size v hold the box average of the occupancy, and a trilinear
                 // sample averages them again: the solid half-space below a plane (the surface,
-                // voxelized solid) read h above it is the step filtered by the degree-1 B-spline
-                // of width 2v, b = (1 - h/v)^2 / 2 for 0 <= h <= v (1/2 on it, 0 a voxel above).
-                // What occludes the sky seen from the surface is the rest of the union,
-                // max(0, alpha - b) / (1 - b). This takes the surface's own occupancy out of
-                // the samples just above it; a wide cone at a low angle still reads its surface
-                // through coarse voxels (h/v tends to sin(elevation) / (2 tan(half-angle))), the
-                // part that skyStartDistance leaves out.
-                double skyCorrected = corrected;
+                // voxelized solid, opaque voxels) read h above it weighs the degree-1 B-spline
+                // of width 2v, b = (1 - h/v)^2 / 2 for 0 <= h <= v (1/2 on it, 0 a voxel above),
+                // so it adds b times an opaque voxel's optical depth to the sample's. What
+                // occludes the sky seen from the surface is the rest. This takes the surface's
+                // own occupancy out of the samples just above it; a wide cone at a low angle
+                // still reads its surface through coarse voxels (h/v tends to sin(elevation) /
+                // (2 tan(half-angle))), the part that skyStartDistance leaves out.
+                // In occupancy, the surface's part b of the union: max(0, alpha - b) / (1 - b).
+                double depth = s.skyOpticalDepth ? double(sample.depth) : 0.0;
+                double skyAlpha = stepAlpha;
                 if (s.skyPlaneNormal != glm::dvec3(0.0)) {
                     const double h = s.skyPlaneHeight + t * glm::dot(dir, s.skyPlaneNormal);
                     const double u = std::clamp(h / sample.voxelSize, -1.0, 1.0);
                     const double below = u >= 0.0 ? 0.5 * (1.0 - u) * (1.0 - u)
                                                   : 1.0 - 0.5 * (1.0 + u) * (1.0 + u);
-                    const double skyAlpha =
-                        below < 1.0 ? std::max(0.0, stepAlpha - below) / (1.0 - below) : 0.0;
-                    skyCorrected =
-                        skyAlpha > 0.0
-                            ? 1.0 - std::pow(1.0 - std::min(skyAlpha, 0.999999), exponent)
-                            : 0.0;
+                    depth = std::max(0.0, depth - below * double(kOpaqueOpticalDepth));
+                    skyAlpha = below < 1.0 ? std::max(0.0, stepAlpha - below) / (1.0 - below) : 0.0;
                 }
-                skyTransmittance *= 1.0 - skyCorrected;
+                if (!s.skyOpticalDepth)
+                    depth = -std::log(1.0 - std::min(skyAlpha, 0.999999));
+                skyDepth += depth * exponent;
             }
             // Done when the light is (the occupancy) and so is the sky: occluders nearer than
             // skyStartDistance do not end the cone's view of it.
-            if (lightDone && ((s.skyStartDistance <= s.startDistance &&
-                               s.skyPlaneNormal == glm::dvec3(0.0)) ||
-                              skyTransmittance <= 1.0 - s.maxOpacity))
+            if (lightDone && (!s.sky || skyDepth >= skyHidden))
                 break;
         }
         t += dt;
     }
     r.transmittance = 1.0 - occupied;
-    r.skyTransmittance = s.skyStartDistance <= s.startDistance && s.skyPlaneNormal == glm::dvec3(0.0)
-                             ? r.transmittance
-                             : skyTransmittance;
+    r.skyTransmittance = s.sky ? std::exp(-skyDepth) : r.transmittance;
     return r;
 }
 

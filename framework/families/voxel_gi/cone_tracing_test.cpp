@@ -77,6 +77,7 @@ struct UniformMedium {
             return false;
         out = ConeSample{};
         out.alpha = alpha;
+        out.depth = computeOpticalDepth(alpha);
         out.light[kDirect] = glm::vec3(alpha); // premultiplied radiance 1
         out.voxelSize = 1.0;
         return true;
@@ -130,6 +131,7 @@ struct Wall {
         out.voxelSize = 0.25;
         if (p.y >= wall && p.y <= wall + 1.0) {
             out.alpha = 1.0f;
+            out.depth = kOpaqueOpticalDepth;
             out.light[kEmission] = emission;
         }
         return true;
@@ -142,6 +144,7 @@ TEST(ConeTracing, TheSkyIsSeenPastTheVoxelsFromSkyStartOn)
     ConeMarchSettings s;
     s.tanHalfAngle = 0.0;
     s.stepScale = 0.5;
+    s.sky = true;
     // No occluder: the sky, whole.
     const ConeResult open = marchCone(Wall{20.0}, glm::dvec3(0.0), glm::dvec3(0, 1, 0), 0, s);
     EXPECT_TRUE(open.skyEscaped);
@@ -181,11 +184,14 @@ TEST(ConeTracing, TheSurfaceTheConeLeavesDoesNotHideItsSky)
             const double u = std::clamp(p.y / out.voxelSize, 0.0, 1.0);
             const double floor = 0.5 * (1.0 - u) * (1.0 - u);
             out.alpha = float(1.0 - (1.0 - floor) * (1.0 - extra));
+            // The floor's opaque voxels weigh `floor`; the rest is the other occupancy's.
+            out.depth = float(floor) * kOpaqueOpticalDepth + computeOpticalDepth(float(extra));
             return true;
         }
     };
     ConeMarchSettings s;
     s.tanHalfAngle = 0.0;
+    s.sky = true;
     s.skyPlaneNormal = glm::dvec3(0, 1, 0);
     s.skyPlaneHeight = 0.25;
     const glm::dvec3 along(1, 0, 0);
@@ -196,6 +202,44 @@ TEST(ConeTracing, TheSurfaceTheConeLeavesDoesNotHideItsSky)
     const ConeResult other = marchCone(Floor{0.1}, glm::dvec3(0, 0.25, 0), along, 0, s);
     // 0.1 more per voxel along 20 voxels: (1 - 0.1)^20 of the sky left.
     EXPECT_NEAR(other.skyTransmittance, std::pow(0.9, 20.0), 0.01);
+}
+
+// One opaque voxel (size 1, centre y = 3.5) in an empty lattice, sampled as the structures do:
+// occupancy and optical depth interpolated with the same tent weights along y.
+struct OpaqueVoxel {
+    bool sample(const glm::dvec3& p, double, int, const glm::dvec3&, ConeSample& out) const
+    {
+        if (p.y > 10.0)
+            return false;
+        out = ConeSample{};
+        out.voxelSize = 1.0;
+        const double w = std::max(0.0, 1.0 - std::abs(p.y - 3.5));
+        out.alpha = float(w);
+        out.depth = float(w) * kOpaqueOpticalDepth;
+        return true;
+    }
+};
+
+TEST(ConeTracing, TheSkyDoesNotLeakThroughAnOpaqueVoxelWhateverTheSamplesOffset)
+{
+    // Half-voxel steps whose samples fall at offsets 0, 1/8, 1/4, 3/8 from the voxel's centre: the
+    // light's occupancy lets up to sqrt(0.75 * 0.25 * 0.25 * 0.75) = 0.1875 through (offset 1/4,
+    // the samples read 0.25, 0.75, 0.75, 0.25: the leak cone_tracing.h describes); the sky's
+    // optical depth crosses the voxel's whole, exp(-kOpaqueOpticalDepth) = 1e-4, at every offset
+    // (the tent weights at half-voxel spacing sum to 2, times the step's half voxel).
+    ConeMarchSettings s;
+    s.tanHalfAngle = 0.0;
+    s.stepScale = 0.5;
+    s.maxOpacity = 0.999999;
+    s.sky = true;
+    double worstLight = 0.0;
+    for (const double offset : {0.0, 0.125, 0.25, 0.375}) {
+        const glm::dvec3 origin(0.0, offset, 0.0); // samples at y = offset + k/2
+        const ConeResult r = marchCone(OpaqueVoxel{}, origin, glm::dvec3(0, 1, 0), 0, s);
+        EXPECT_NEAR(r.skyTransmittance, 1e-4, 1e-6) << offset;
+        worstLight = std::max(worstLight, r.transmittance);
+    }
+    EXPECT_NEAR(worstLight, 0.1875, 1e-6);
 }
 
 } // namespace

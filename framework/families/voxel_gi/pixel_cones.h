@@ -61,10 +61,7 @@ double traceGBufferCones(const scene::GBuffer& gbuffer, const ConeSet& cones, co
             if (!prepare(gbuffer, x, y, s.origin, n, s.march))
                 continue; // no surface, or outside the structure: no indirect light
             s.march.tanHalfAngle = cones.tanHalfAngle;
-            if (skyOut == nullptr) { // no cone marches on for the sky alone
-                s.march.skyStartDistance = 0.0;
-                s.march.skyPlaneNormal = glm::dvec3(0.0);
-            }
+            s.march.sky = skyOut != nullptr; // else no cone marches on for the sky alone
             const auto w = computeIrradianceWeights(cones, n);
             for (int k = 0; k < kConeCount; ++k)
                 if (w[std::size_t(k)] != 0.0)

@@ -18,6 +18,7 @@ struct SparseConeParams {
     double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
     double skyStart = 8.0;    //!< leaves along a pixel cone from which its voxels shadow the sky
+    bool skyOpticalDepth = false; //!< sky_occlusion (declareSkyOcclusion)
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int traceStep = 4;        //!< pixels: one traced per trace_step^2 block, then upsampled
     //! The pixel gather's device: vulkan, cpu or auto (cone_combine_gpu.h shouldGatherOnGpu).
@@ -26,12 +27,19 @@ struct SparseConeParams {
     int innerLayers = 1;      //!< layers of solid leaves kept inside closed surfaces
 
     //! Declares resolution (described by `resolutionHelp`), voxel_size, supersampling, bounces,
-    //! cone_angle, start_offset, inject_offset, sky_start, step_scale, trace_step, device,
+    //! cone_angle, start_offset, inject_offset, sky_start, sky_occlusion, step_scale, trace_step, device,
     //! capsule_resolution and inner_layers.
-    static void declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault);
+    static void declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault,
+                        const char* skyOcclusionDefault);
     static SparseConeParams read(const config::ParamSet& p);
     void write(config::ParamSet& p) const;
 };
+
+//! The `sky_occlusion` parameter of every cone-traced technique: how its pixel cones march the
+//! sky's transmittance, `optical_depth` or `occupancy` (cone_tracing.h ConeMarchSettings::
+//! skyOpticalDepth), with the technique's default.
+void declareSkyOcclusion(config::ParamSchema& schema, const char* defaultValue);
+bool readSkyOpticalDepth(const config::ParamSet& p);
 
 //! The `device` and `capsule_resolution` parameters of every cone-traced technique (cascades,
 //! svo, adaptive_voxel_tree_cones): where the pixel gather runs and where the capsules are tested.

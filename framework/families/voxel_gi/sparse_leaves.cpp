@@ -247,7 +247,21 @@ void makeLeavesIsotropic(std::vector<SurfaceLeaf>& leaves, const std::string& wh
 
 namespace rtlab::voxelgi {
 
-void SparseConeParams::declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault)
+void declareSkyOcclusion(config::ParamSchema& schema, const char* defaultValue)
+{
+    schema.addEnum("sky_occlusion", defaultValue, {"optical_depth", "occupancy"},
+                   "how a pixel cone's voxels hide the sky: their optical depths interpolated and "
+                   "integrated (no leak through an opaque voxel between two samples; a footprint "
+                   "partly on a surface hides more) or their occupancy composited as the light's");
+}
+
+bool readSkyOpticalDepth(const config::ParamSet& p)
+{
+    return p.getString("sky_occlusion") == "optical_depth";
+}
+
+void SparseConeParams::declare(config::ParamSchema& schema, const char* resolutionHelp, int innerLayersDefault,
+                               const char* skyOcclusionDefault)
 {
     schema.addInt("resolution", 64, 8, 4096, "leaves", resolutionHelp);
     schema.addFloat("voxel_size", 0.0, 0.0, 1e6, "world units", "leaf size; 0 = fit the scene's box");
@@ -262,6 +276,7 @@ void SparseConeParams::declare(config::ParamSchema& schema, const char* resoluti
     schema.addFloat("sky_start", 8.0, 0.0, 64.0, "leaves",
                     "distance along a pixel cone from which its voxels shadow the sky (nearer "
                     "occluders, the pixel's own surface among them, are the occlusion family's)");
+    declareSkyOcclusion(schema, skyOcclusionDefault);
     schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
     schema.addInt("trace_step", 4, 1, 8, "pixels",
                   "trace one pixel per trace_step^2 block and upsample (depth- and normal-aware)");
@@ -303,6 +318,7 @@ SparseConeParams SparseConeParams::read(const config::ParamSet& p)
     s.startOffset = p.getFloat("start_offset");
     s.injectOffset = p.getFloat("inject_offset");
     s.skyStart = p.getFloat("sky_start");
+    s.skyOpticalDepth = readSkyOpticalDepth(p);
     s.stepScale = p.getFloat("step_scale");
     s.traceStep = int(p.getInt("trace_step"));
     s.device = p.getString("device");
@@ -321,6 +337,7 @@ void SparseConeParams::write(config::ParamSet& p) const
     p.set("start_offset", startOffset);
     p.set("inject_offset", injectOffset);
     p.set("sky_start", skyStart);
+    p.set("sky_occlusion", std::string(skyOpticalDepth ? "optical_depth" : "occupancy"));
     p.set("step_scale", stepScale);
     p.set("trace_step", std::int64_t(traceStep));
     p.set("device", device);

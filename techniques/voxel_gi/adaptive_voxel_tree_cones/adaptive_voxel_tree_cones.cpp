@@ -45,6 +45,7 @@
 // | cone_angle         | float | 29       | [5, 60]           | degrees (half-angle)       |
 // | start_offset       | float | 4        | [0, 8]            | leaves (pixel cones)       |
 // | sky_start          | float | 8        | [0, 64]           | leaves (the sky)           |
+// | sky_occlusion      | enum  | occupancy | optical_depth, occupancy | the sky's transmittance |
 // | inject_offset      | float | 4        | [0, 8]            | leaves (the leaves' cones) |
 // | step_scale         | float | 0.5      | [0.1, 2]          | of the voxel size sampled  |
 // | trace_step         | int   | 4        | [1, 8]            | pixels                     |
@@ -97,7 +98,8 @@ public:
     static config::ParamSchema declareParams()
     {
         config::ParamSchema schema;
-        voxelgi::SparseConeParams::declare(schema, "leaves along the longest side of the static scene's box", 4);
+        voxelgi::SparseConeParams::declare(schema, "leaves along the longest side of the static scene's box", 4,
+                                           "occupancy");
         schema.addInt("depth", 3, 1, 6, "", "tree levels below the dense root cells (4^depth leaves per root cell and axis)");
         schema.addEnum(
             "node_masks", "shared", {"shared", "inline"},
@@ -118,6 +120,7 @@ public:
         settings.startOffset = mParams.startOffset;
         settings.injectOffset = mParams.injectOffset;
         settings.skyStart = mParams.skyStart;
+        settings.skyOpticalDepth = mParams.skyOpticalDepth;
         settings.stepScale = mParams.stepScale;
         settings.innerLayers = mParams.innerLayers;
         mStructure.emplace(settings); // checks the settings

@@ -176,6 +176,7 @@ bool VoxelTreeCones::preparePixel(const scene::GBuffer& gbuffer, int x, int y, g
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * mLeafSize;
     march.skyStartDistance = mSettings.skyStart * mLeafSize;
+    march.skyOpticalDepth = mSettings.skyOpticalDepth;
     march.skyPlaneNormal = n;
     march.skyPlaneHeight = 0.5 * mSettings.startOffset * mLeafSize;
     origin = p + n * (0.5 * mSettings.startOffset * mLeafSize);

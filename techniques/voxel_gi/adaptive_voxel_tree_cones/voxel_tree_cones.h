@@ -38,6 +38,7 @@ struct TreeConeSettings {
     double startOffset = 4.0; //!< leaves: the pixel cones' start distance and origin offset along the normal
     double injectOffset = 4.0; //!< leaves: the same for the leaves' cones of light injection
     double skyStart = 8.0;    //!< leaves along a pixel cone from which its voxels shadow the sky
+    bool skyOpticalDepth = false; //!< cone_tracing.h ConeMarchSettings::skyOpticalDepth
     double stepScale = 0.5;   //!< march step / size of the voxels sampled
     int chunk = 32;           //!< leaves per side of the blocks voxelized independently
     int innerLayers = 1;      //!< layers of solid leaves inside closed surfaces (sparse_leaves.h)

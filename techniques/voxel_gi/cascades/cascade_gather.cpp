@@ -30,6 +30,7 @@ bool CascadeVolume::preparePixel(const scene::GBuffer& gbuffer, int x, int y, gl
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
     march.skyStartDistance = mSettings.skyStart * v;
+    march.skyOpticalDepth = mSettings.skyOpticalDepth;
     march.skyPlaneNormal = n;
     march.skyPlaneHeight = 0.5 * mSettings.startOffset * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);
@@ -247,7 +248,9 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
         march.tanHalfAngle = mCones.tanHalfAngle;
         march.stepScale = mSettings.stepScale;
         march.startDistance = mSettings.farStart * r.voxelSize;
-        march.skyStartDistance = mTraceSky ? mSettings.skyStart * r.voxelSize : 0.0;
+        march.sky = mTraceSky;
+        march.skyStartDistance = mSettings.skyStart * r.voxelSize;
+        march.skyOpticalDepth = mSettings.skyOpticalDepth;
         for (int c = 0; c < kConeCount; ++c) {
             const ConeResult far = marchCone(sampler, centre, mCones.directions[std::size_t(c)], c, march);
             const std::size_t at = std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c);
@@ -330,10 +333,7 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                 ConeMarchSettings march = s.march;
                 march.tanHalfAngle = mCones.tanHalfAngle;
                 march.maxDistance = split0;
-                if (skyOut == nullptr) { // no cone marches on for the sky alone
-                    march.skyStartDistance = 0.0;
-                    march.skyPlaneNormal = glm::dvec3(0.0);
-                }
+                march.sky = skyOut != nullptr; // else no cone marches on for the sky alone
                 const ConeResult a = marchCone(sampler, s.origin, dir, k, march);
                 glm::dvec3 la(a.light[kDirect]);
                 stepsPerRow[std::size_t(y)] += std::uint64_t(a.steps);

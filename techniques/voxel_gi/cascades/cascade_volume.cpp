@@ -613,6 +613,11 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
         if (combined) {
             const glm::vec4& v = coneRow[vox];
             out.alpha += fw * v.a;
+            // The optical depth per face, blended as the faces were (cone_tracing.h ConeSample).
+            for (int axis = 0; axis < 3; ++axis) {
+                const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
+                out.depth += fw * float(dir[axis] * dir[axis]) * computeOpticalDepth(level.alpha[f]);
+            }
             out.light[kDirect] += fw * glm::vec3(v);
             if (level.emits)
                 for (int axis = 0; axis < 3; ++axis) {
@@ -627,6 +632,7 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
                 continue;
             const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
             out.alpha += aw * level.alpha[f];
+            out.depth += aw * computeOpticalDepth(level.alpha[f]);
             if (gathered) {
                 out.light[kDirect] += aw * getGatheredLight(level, f);
                 if (level.emits)

@@ -39,6 +39,7 @@ struct CascadeSettings {
     //! Voxels (of the pixel's start level; of their own level for far cones) along a pixel cone
     //! from which its voxels shadow the sky (cone_tracing.h ConeMarchSettings::skyStartDistance).
     double skyStart = 4.0;
+    bool skyOpticalDepth = false; //!< cone_tracing.h ConeMarchSettings::skyOpticalDepth
     double stepScale = 0.5;
     bool precombine = true;
     //! Split near/far cones ("Split Cone Trace"): the pixel traces its cones up to farStart

@@ -79,6 +79,7 @@
 // | cone_angle     | float | 29                | [5, 60]                               | degrees (half-angle) |
 // | start_offset   | float | 1                 | [0, 4]                                | voxels |
 // | sky_start      | float | 4                 | [0, 64]                               | voxels of the pixel's start level |
+// | sky_occlusion  | enum  | occupancy         | optical_depth, occupancy              | the sky's transmittance |
 // | step_scale     | float | 0.5               | [0.1, 2]                              | of the voxel size sampled |
 // | precombine     | bool  | true              |                                       |        |
 // | solid          | bool  | true              |                                       |        |
@@ -158,6 +159,7 @@ public:
                         "distance along a pixel cone (voxels of its start level) from which its "
                         "voxels shadow the sky (nearer occluders, the pixel's own surface among "
                         "them, are the occlusion family's)");
+        voxelgi::declareSkyOcclusion(schema, "occupancy");
         schema.addFloat("step_scale", 0.5, 0.1, 2.0, "", "march step / size of the voxels sampled");
         schema.addBool("precombine", true,
                        "pre-combined direction buffers for the pixel cones (3x fewer lookups)");
@@ -205,6 +207,7 @@ public:
         mSettings.coneHalfAngleDegrees = p.getFloat("cone_angle");
         mSettings.startOffset = p.getFloat("start_offset");
         mSettings.skyStart = p.getFloat("sky_start");
+        mSettings.skyOpticalDepth = voxelgi::readSkyOpticalDepth(p);
         mSettings.stepScale = p.getFloat("step_scale");
         mSettings.precombine = p.getBool("precombine");
         mSettings.solid = p.getBool("solid");
@@ -237,6 +240,7 @@ public:
         p.set("cone_angle", mSettings.coneHalfAngleDegrees);
         p.set("start_offset", mSettings.startOffset);
         p.set("sky_start", mSettings.skyStart);
+        p.set("sky_occlusion", std::string(mSettings.skyOpticalDepth ? "optical_depth" : "occupancy"));
         p.set("step_scale", mSettings.stepScale);
         p.set("precombine", mSettings.precombine);
         p.set("solid", mSettings.solid);

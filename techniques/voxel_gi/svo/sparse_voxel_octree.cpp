@@ -328,6 +328,7 @@ void SparseVoxelOctree::sampleBrickLevel(int level, const glm::dvec3& p, const g
             const float w = aw * cornerWeight[corner];
             const glm::vec4& v = mGatheredBricks[brick + std::size_t(corner)];
             out.alpha += w * v.a;
+            out.depth += w * computeOpticalDepth(v.a);
             if constexpr (Gathered) {
                 out.light[kDirect] += w * glm::vec3(v);
             } else {
@@ -366,6 +367,7 @@ bool SparseVoxelOctree::preparePixel(const scene::GBuffer& gbuffer, int x, int y
     march.stepScale = mSettings.stepScale;
     march.startDistance = mSettings.startOffset * v;
     march.skyStartDistance = mSettings.skyStart * v;
+    march.skyOpticalDepth = mSettings.skyOpticalDepth;
     march.skyPlaneNormal = n;
     march.skyPlaneHeight = 0.5 * mSettings.startOffset * v;
     origin = p + n * (0.5 * mSettings.startOffset * v);

@@ -45,6 +45,7 @@
 // | cone_angle         | float | 29       | [5, 60]                 | degrees (half-angle)      |
 // | start_offset       | float | 4        | [0, 8]                  | leaves (pixel cones)      |
 // | sky_start          | float | 8        | [0, 64]                 | leaves (the sky)          |
+// | sky_occlusion      | enum  | occupancy | optical_depth, occupancy | the sky's transmittance |
 // | inject_offset      | float | 4        | [0, 8]                  | leaves (the leaves' cones) |
 // | step_scale         | float | 0.5      | [0.1, 2]                | of the voxel size sampled |
 // | trace_step         | int   | 4        | [1, 8]                  | pixels                    |
@@ -101,7 +102,8 @@ public:
     static config::ParamSchema declareParams()
     {
         config::ParamSchema schema;
-        voxelgi::SparseConeParams::declare(schema, "leaves along the cube's side (a power of two)", 1);
+        voxelgi::SparseConeParams::declare(schema, "leaves along the cube's side (a power of two)", 1,
+                                           "occupancy");
         schema.addEnum(
             "bricks", "none", {"none", "corner"},
             "none: one value per node and face, 8 descents per trilinear sample; corner: "
@@ -122,6 +124,7 @@ public:
         settings.startOffset = mParams.startOffset;
         settings.injectOffset = mParams.injectOffset;
         settings.skyStart = mParams.skyStart;
+        settings.skyOpticalDepth = mParams.skyOpticalDepth;
         settings.stepScale = mParams.stepScale;
         settings.innerLayers = mParams.innerLayers;
         settings.cornerBricks = p.getString("bricks") == "corner";
