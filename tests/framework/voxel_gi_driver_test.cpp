@@ -170,4 +170,48 @@ TEST(VoxelGiDriver, TheVulkanCombineGivesTheCppCombinesFrame)
     }
 }
 
+TEST(VoxelGiDriver, TheSplitCoversTheConesSky)
+{
+    // A lit frame whose sky comes through the cones, with the split: the sky's error against the
+    // truth's direct irradiance without point lights (sky.*), split into the voxels' (rays
+    // through them, split.sky_voxel_*) and the cones' (against those rays, split.sky_cone_*).
+    // The three RMSEs are norms of differences over the same pixels, so the whole is at most the
+    // sum of its halves (the triangle inequality); and the sky term's images are written.
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_voxel_gi_sky_split";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const auto& registry = plugin::builtinRegistry();
+    const auto e = experiment::parseExperiment(R"(base:
+  scene: cornell_box
+  resolution: [40, 30]
+  frames: 1
+  metrics: [error, split]
+  frame: {lighting: true, shadow_map_size: 16}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 8}
+  techniques:
+    occlusion: {technique: bentcone_ssdo}
+    voxel_gi: {technique: svo, params: {resolution: 16, trace_step: 2}}
+)",
+                                               (dir / "split.yaml").string(), registry);
+    const std::string out = (dir / "out").string();
+    experiment::runExperiment(e, registry, {.outputDirectory = out, .quiet = true, .queryVulkanForManifest = false});
+    const auto rows = experiment::loadResults(out);
+    ASSERT_EQ(rows.size(), 1u);
+    const auto& row = rows[0];
+    ASSERT_EQ(row.at("status"), "ok") << row.at("error");
+    EXPECT_EQ(row.at("frame.sky"), "cones");
+    const std::string& passes = row.at("passes");
+    EXPECT_NE(passes.find("voxel_sky_rays:run"), std::string::npos) << passes;
+    EXPECT_NE(passes.find("metric.sky_split:run"), std::string::npos) << passes;
+    const double whole = experiment::getNumber(row, "sky.rmse");
+    const double cone = experiment::getNumber(row, "split.sky_cone_rmse");
+    const double voxel = experiment::getNumber(row, "split.sky_voxel_rmse");
+    ASSERT_TRUE(std::isfinite(whole) && std::isfinite(cone) && std::isfinite(voxel));
+    EXPECT_GT(whole, 0.0);
+    EXPECT_LE(whole, (cone + voxel) * (1.0 + 1e-6));
+    EXPECT_TRUE(std::filesystem::exists(out + "/runs/" + row.at("run_id") + "/frame0/sky_term.exr"));
+    EXPECT_TRUE(std::filesystem::exists(out + "/runs/" + row.at("run_id") + "/frame0/truth_sky_term.exr"));
+}
+
 } // namespace

@@ -91,8 +91,8 @@ struct ConeMarchSettings {
     bool sky = false;
     //! How the sky's transmittance is marched: in optical depth (true; the leaks marchCone
     //! describes are gone, a footprint partly on a surface weighs more) or, as the light, in
-    //! occupancy composited front to back (false).
-    bool skyOpticalDepth = true;
+    //! occupancy composited front to back (false, every technique's default: `sky_occlusion`).
+    bool skyOpticalDepth = false;
     //! World units along the cone from which its voxels shadow the sky (ConeResult::
     //! skyTransmittance); nearer occluders are left to the occlusion family's visibilities.
     double skyStartDistance = 0.0;
@@ -120,8 +120,8 @@ struct ConeResult {
 //! the radiance composited with the same a' (Engel et al., Real-Time Volume Graphics; the
 //! step-length correction of shared/research/voxelgi.md section 8.1).
 //!
-//! The sky's transmittance (ConeMarchSettings::sky) is marched in optical depth instead:
-//! exp(-sum of ConeSample::depth * step / voxelSize). The occupancy of a trilinear sample is the
+//! The sky's transmittance (ConeMarchSettings::sky) may be marched in optical depth instead
+//! (ConeMarchSettings::skyOpticalDepth): exp(-sum of ConeSample::depth * step / voxelSize). The occupancy of a trilinear sample is the
 //! tent-weighted mean of its voxels', and a march compositing it lets light through an opaque
 //! voxel: stepping half voxels past a one-voxel wall whose centre falls between two samples, the
 //! samples read it at 0.25, 0.75, 0.75, 0.25 and keep sqrt(0.75 * 0.25 * 0.25 * 0.75) = 19 % of

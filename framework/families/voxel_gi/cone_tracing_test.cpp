@@ -202,6 +202,11 @@ TEST(ConeTracing, TheSurfaceTheConeLeavesDoesNotHideItsSky)
     const ConeResult other = marchCone(Floor{0.1}, glm::dvec3(0, 0.25, 0), along, 0, s);
     // 0.1 more per voxel along 20 voxels: (1 - 0.1)^20 of the sky left.
     EXPECT_NEAR(other.skyTransmittance, std::pow(0.9, 20.0), 0.01);
+    // The same in optical depth (the floor's opaque voxels weigh b, the rest -ln(0.9) a voxel).
+    s.skyOpticalDepth = true;
+    EXPECT_NEAR(marchCone(Floor{}, glm::dvec3(0, 0.25, 0), along, 0, s).skyTransmittance, 1.0, 1e-5);
+    EXPECT_NEAR(marchCone(Floor{0.1}, glm::dvec3(0, 0.25, 0), along, 0, s).skyTransmittance,
+                std::pow(0.9, 20.0), 0.01);
 }
 
 // One opaque voxel (size 1, centre y = 3.5) in an empty lattice, sampled as the structures do:
@@ -232,6 +237,7 @@ TEST(ConeTracing, TheSkyDoesNotLeakThroughAnOpaqueVoxelWhateverTheSamplesOffset)
     s.stepScale = 0.5;
     s.maxOpacity = 0.999999;
     s.sky = true;
+    s.skyOpticalDepth = true;
     double worstLight = 0.0;
     for (const double offset : {0.0, 0.125, 0.25, 0.375}) {
         const glm::dvec3 origin(0.0, offset, 0.0); // samples at y = offset + k/2

@@ -101,10 +101,12 @@ double traceGBufferCones(const scene::GBuffer& gbuffer, const ConeSet& cones, co
 
 //! Irradiance at every pixel from `rays` cosine-distributed rays (zero aperture) through the
 //! sampler's gathered light, E = pi * mean radiance. The directions are a stratified grid on the
-//! disk (Malley's method) turned per pixel by a hash, so the result is deterministic.
+//! disk (Malley's method) turned per pixel by a hash, so the result is deterministic. With `sky`,
+//! the irradiance from the sky and emitters instead: per ray what computeConeSkyRadiance gives a
+//! cone, the sky's radiance in the ray's own direction (the error split of the cones' sky).
 template <class Prepare, class Sampler>
 void traceGBufferRays(const scene::GBuffer& gbuffer, int rays, const Prepare& prepare,
-                      const Sampler& sampler, Image<glm::vec3>& out)
+                      const Sampler& sampler, Image<glm::vec3>& out, const scene::Sky* sky = nullptr)
 {
     out = Image<glm::vec3>(gbuffer.width, gbuffer.height, glm::vec3(0.0f));
     const int side = std::max(1, int(std::lround(std::sqrt(double(rays)))));
@@ -115,6 +117,7 @@ void traceGBufferRays(const scene::GBuffer& gbuffer, int rays, const Prepare& pr
             if (!prepare(gbuffer, x, y, origin, n, march))
                 continue;
             march.tanHalfAngle = 0.0; // rays
+            march.sky = sky != nullptr;
             const glm::dvec3 helper = std::abs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
             const glm::dvec3 t = glm::normalize(glm::cross(helper, n)), b = glm::cross(n, t);
             const double turn =
@@ -126,7 +129,9 @@ void traceGBufferRays(const scene::GBuffer& gbuffer, int rays, const Prepare& pr
                     const double r = std::sqrt(u1), phi = 2.0 * glm::pi<double>() * u2;
                     const glm::dvec3 d = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b +
                                                         std::sqrt(std::max(0.0, 1.0 - u1)) * n);
-                    sum += glm::dvec3(marchCone(sampler, origin, d, -1, march).light[kDirect]);
+                    const ConeResult ray = marchCone(sampler, origin, d, -1, march);
+                    sum += sky != nullptr ? glm::dvec3(computeConeSkyRadiance(ray, sky->radiance(d)))
+                                          : glm::dvec3(ray.light[kDirect]);
                 }
             out.at(x, y) =
                 glm::vec3(glm::max(glm::pi<double>() * sum / double(side * side), glm::dvec3(0.0)));

@@ -120,6 +120,16 @@ public:
         return true;
     }
 
+    bool traceVoxelSkyRays(const plugin::VoxelGiInput& input, int raysPerPixel, const scene::Sky& sky,
+                           Image<glm::vec3>& irradiance) override
+    {
+        irradiance = traceRaysReduced(*input.gbuffer, mParams.traceStep,
+                                      [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
+                                          mStructure->gatherRays(reduced, raysPerPixel, low, &sky);
+                                      });
+        return true;
+    }
+
     plugin::VoxelGiMemory memory() const override
     {
         if (!mBuilt)

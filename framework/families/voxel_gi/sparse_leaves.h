@@ -302,13 +302,15 @@ double traceSparsePixelCones(const S& structure, const scene::GBuffer& gbuffer, 
                              sky);
 }
 
-//! `rays` zero-aperture rays per pixel through a sparse structure S: pixel_cones.h traceGBufferRays.
+//! `rays` zero-aperture rays per pixel through a sparse structure S: pixel_cones.h traceGBufferRays
+//! (with `sky`: the sky and emitters they see).
 template <class S>
-void traceSparsePixelRays(const S& structure, const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out)
+void traceSparsePixelRays(const S& structure, const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                          const scene::Sky* sky = nullptr)
 {
     const auto prepare = [&](const scene::GBuffer& g, int x, int y, glm::dvec3& origin, glm::dvec3& n,
                              ConeMarchSettings& march) { return structure.preparePixel(g, x, y, origin, n, march); };
-    traceGBufferRays(gbuffer, rays, prepare, SparseGatheredSampler<S>{&structure}, out);
+    traceGBufferRays(gbuffer, rays, prepare, SparseGatheredSampler<S>{&structure}, out, sky);
 }
 
 } // namespace rtlab::voxelgi

@@ -120,6 +120,15 @@ public:
     {
         return false;
     }
+    //! The same split for the sky through the cones (combineConeSky): the irradiance from the sky
+    //! and emitters that the technique's voxels let through along `raysPerPixel` rays per pixel,
+    //! each seeing `sky` in its own direction, at the points of combineConeSky, without the
+    //! occlusion family's visibilities. False when the technique has no such path.
+    virtual bool traceVoxelSkyRays(const VoxelGiInput& input, int raysPerPixel, const scene::Sky& sky,
+                                   Image<glm::vec3>& irradiance)
+    {
+        return false;
+    }
     //! For the discontinuity metric: per pixel of input.gbuffer, the level of the structure its
     //! lookup starts at (cascades: the floor of the start level; a tree: the level of the
     //! interpolation), kNoLevel where there is none. Neighbouring pixels with different levels

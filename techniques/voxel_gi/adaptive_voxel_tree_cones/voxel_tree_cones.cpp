@@ -189,9 +189,10 @@ void VoxelTreeCones::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm:
     mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out, sky);
 }
 
-void VoxelTreeCones::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
+void VoxelTreeCones::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                                   const scene::Sky* sky) const
 {
-    traceSparsePixelRays(*this, gbuffer, rays, out);
+    traceSparsePixelRays(*this, gbuffer, rays, out, sky);
 }
 
 std::size_t VoxelTreeCones::getPayloadBytes() const

@@ -89,7 +89,9 @@ public:
     void gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out,
                      const ConeSkyOutput* sky = nullptr);
     //! Zero-aperture rays through the leaves (the error split of voxel_gi.h traceVoxelRays).
-    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
+    //! With `sky`: the sky and emitters the rays see (pixel_cones.h traceGBufferRays).
+    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                    const scene::Sky* sky = nullptr) const;
     bool preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin, glm::dvec3& n,
                       ConeMarchSettings& march) const;
 

@@ -99,14 +99,15 @@ void CascadeVolume::gatherCones(const scene::GBuffer& gbuffer, std::vector<glm::
     mCounters.pixelConesMs = millisecondsSince(start);
 }
 
-void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
+void CascadeVolume::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                               const scene::Sky* sky) const
 {
     const auto prepare = [this](const scene::GBuffer& g, int x, int y, glm::dvec3& origin,
                                 glm::dvec3& n, ConeMarchSettings& march) {
         return preparePixel(g, x, y, origin, n, march);
     };
     // Rays: the faces blended along each direction (no per-cone pre-combined buffer).
-    traceGBufferRays(gbuffer, rays, prepare, GatheredSampler{this, false}, out);
+    traceGBufferRays(gbuffer, rays, prepare, GatheredSampler{this, false}, out, sky);
 }
 
 int CascadeVolume::getFarDependency(int i) const

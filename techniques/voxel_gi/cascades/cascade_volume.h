@@ -145,7 +145,9 @@ public:
     //! The same light gathered along `rays` cosine-distributed rays per pixel (zero aperture:
     //! every sample at the finest level holding it), E = pi * mean radiance; the directions are
     //! a stratified grid turned per pixel, so the result is deterministic.
-    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
+    //! With `sky`: the sky and emitters the rays see (pixel_cones.h traceGBufferRays).
+    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                    const scene::Sky* sky = nullptr) const;
     //! Far cones to trace: (level, voxel) of each centre; out gets the 16 cones' radiance of
     //! each, [centre * 16 + cone] (on Vulkan: CascadeGatherGpu::traceFarCones).
     using FarConeTracer = std::function<void(const std::vector<std::pair<int, std::uint32_t>>& centres,

@@ -400,6 +400,16 @@ public:
         return true;
     }
 
+    bool traceVoxelSkyRays(const plugin::VoxelGiInput& input, int raysPerPixel, const scene::Sky& sky,
+                           Image<glm::vec3>& irradiance) override
+    {
+        irradiance = voxelgi::traceRaysReduced(*input.gbuffer, mTraceStep,
+                                               [&](const scene::GBuffer& reduced, Image<glm::vec3>& low) {
+                                                   mVolume->gatherRays(reduced, raysPerPixel, low, &sky);
+                                               });
+        return true;
+    }
+
     bool computeLookupLevels(const plugin::VoxelGiInput& input,
                              Image<std::uint8_t>& levels) override
     {

@@ -380,9 +380,10 @@ void SparseVoxelOctree::gatherCones(const scene::GBuffer& gbuffer, std::vector<g
     mMeanStepsPerCone = traceSparsePixelCones(*this, gbuffer, out, sky);
 }
 
-void SparseVoxelOctree::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const
+void SparseVoxelOctree::gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                                   const scene::Sky* sky) const
 {
-    traceSparsePixelRays(*this, gbuffer, rays, out);
+    traceSparsePixelRays(*this, gbuffer, rays, out, sky);
 }
 
 std::size_t SparseVoxelOctree::getPayloadBytes() const

@@ -160,7 +160,9 @@ public:
                      const ConeSkyOutput* sky = nullptr);
     //! The gathered light along `rays` cosine-distributed rays per pixel (zero aperture: the
     //! leaves), E = pi * mean radiance (the error split of voxel_gi.h traceVoxelRays).
-    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out) const;
+    //! With `sky`: the sky and emitters the rays see (pixel_cones.h traceGBufferRays).
+    void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
+                    const scene::Sky* sky = nullptr) const;
     //! Where a pixel's cones start; false without a surface or outside the cube.
     bool preparePixel(const scene::GBuffer& gbuffer, int x, int y, glm::dvec3& origin,
                       glm::dvec3& n, ConeMarchSettings& march) const;
