@@ -16,6 +16,7 @@
 #include "scene/scene_file.h"
 #include "scene/sdf_shapes.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -63,7 +64,8 @@ void reportSceneWarnings(const scene::Scene& scene)
 void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& records)
 {
     std::int64_t ran = 0, skipped = 0;
-    double frameCpu = 0.0, frameGpu = 0.0;
+    double frameCpu = 0.0, frameGpu = 0.0, frameHost = 0.0;
+    std::uint64_t frameUpload = 0, frameReadback = 0, frameSubmits = 0, frameWaits = 0;
     std::string framePasses;
     for (const auto& r : records) {
         (r.ran ? ran : skipped) += 1;
@@ -71,11 +73,24 @@ void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& r
             framePasses += (framePasses.empty() ? "" : ";") + r.name;
         if (!r.ran || !r.time)
             continue;
+        // What crossed the bus, and the host's own time: the CPU wall time less the waits on
+        // the device (gpu/bus_counters.h).
+        const double hostMs = std::max(0.0, r.time->cpuMs.median - r.waitMs);
         if (!r.measurement) {
             frameCpu += r.time->cpuMs.median;
             if (!r.time->gpuMs.empty())
                 frameGpu += r.time->gpuTotalMedianMs();
+            frameHost += hostMs;
+            frameUpload += r.uploadBytes;
+            frameReadback += r.readbackBytes;
+            frameSubmits += r.submits;
+            frameWaits += r.waits;
         }
+        row.set(r.name + ".host_ms", hostMs)
+            .set(r.name + ".upload_bytes", std::int64_t(r.uploadBytes))
+            .set(r.name + ".readback_bytes", std::int64_t(r.readbackBytes))
+            .set(r.name + ".submits", std::int64_t(r.submits))
+            .set(r.name + ".waits", std::int64_t(r.waits));
         if (r.timing == pipeline::PassTiming::Repeated) {
             addTimingColumns(row, r.name, *r.time);
         } else {
@@ -90,6 +105,11 @@ void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& r
     // The frame's own time: every pass that makes it (not the ground truths, metrics and files).
     row.set("frame.cpu_ms", frameCpu)
         .set("frame.gpu_ms", frameGpu)
+        .set("frame.host_ms", frameHost)
+        .set("frame.upload_bytes", std::int64_t(frameUpload))
+        .set("frame.readback_bytes", std::int64_t(frameReadback))
+        .set("frame.submits", std::int64_t(frameSubmits))
+        .set("frame.waits", std::int64_t(frameWaits))
         .set("frame_passes", framePasses);
 }
 

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <mutex>
 
+#include "gpu/bus_counters.h"
 #include "core/error.h"
 #include "gpu/vulkan_internal.h"
 
@@ -93,6 +94,7 @@ void invalidateMapped(DeviceState& device, const RawBuffer& raw)
 void uploadThroughStaging(DeviceState& device, const void* data, std::size_t size,
                           const std::function<void(VkCommandBuffer, VkBuffer)>& copy)
 {
+    countUpload(size);
     StagingBuffer staging(device, size, true);
     std::memcpy(staging.getRaw().mapped, data, size);
     flushMapped(device, staging.getRaw());
@@ -102,6 +104,7 @@ void uploadThroughStaging(DeviceState& device, const void* data, std::size_t siz
 void downloadThroughStaging(DeviceState& device, void* data, std::size_t size,
                             const std::function<void(VkCommandBuffer, VkBuffer)>& copy)
 {
+    countReadback(size);
     StagingBuffer staging(device, size, false);
     device.submitAndWait([&](VkCommandBuffer cmd) { copy(cmd, staging.getRaw().buffer); });
     invalidateMapped(device, staging.getRaw());
@@ -161,6 +164,7 @@ void Buffer::upload(const void* data, std::size_t size, std::size_t offset)
     if (state.direct) {
         std::memcpy(static_cast<std::byte*>(state.raw.mapped) + offset, data, size);
         detail::flushMapped(device, state.raw);
+        detail::countUpload(size);
         return;
     }
     detail::uploadThroughStaging(device, data, size, [&](VkCommandBuffer cmd, VkBuffer staging) {
@@ -179,6 +183,7 @@ void Buffer::download(void* data, std::size_t size, std::size_t offset) const
     if (state.direct) {
         detail::invalidateMapped(device, state.raw);
         std::memcpy(data, static_cast<const std::byte*>(state.raw.mapped) + offset, size);
+        detail::countReadback(size);
         return;
     }
     detail::downloadThroughStaging(device, data, size, [&](VkCommandBuffer cmd, VkBuffer staging) {

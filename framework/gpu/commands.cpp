@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "core/error.h"
+#include "gpu/bus_counters.h"
 #include "gpu/timestamps.h"
 #include "gpu/vulkan_internal.h"
 
@@ -436,8 +437,11 @@ RunResult Context::run(const std::function<void(CommandList&)>& record)
         submit.commandBufferCount = 1;
         submit.pCommandBuffers = &cb;
         detail::checkResult(vkQueueSubmit(mDevice->queue, 1, &submit, run.fence), "vkQueueSubmit");
+        detail::countSubmit();
+        const Clock::time_point waitStart = Clock::now();
         detail::checkResult(vkWaitForFences(mDevice->device, 1, &run.fence, VK_TRUE, UINT64_MAX),
                             "vkWaitForFences");
+        detail::countWait(elapsedMs(waitStart, Clock::now()));
     }
     result.cpuSubmitMs = elapsedMs(submitStart, Clock::now());
 

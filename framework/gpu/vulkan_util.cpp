@@ -3,9 +3,11 @@
 
 #include "gpu/vulkan_internal.h"
 
+#include <chrono>
 #include <limits>
 
 #include "core/error.h"
+#include "gpu/bus_counters.h"
 
 namespace rtlab::gpu::detail {
 
@@ -193,7 +195,10 @@ void DeviceState::submitAndWait(const std::function<void(VkCommandBuffer)>& reco
     submit.commandBufferCount = 1;
     submit.pCommandBuffers = &transferCommands;
     checkResult(vkQueueSubmit(queue, 1, &submit, transferFence), "vkQueueSubmit");
+    countSubmit();
+    const auto waitStart = std::chrono::steady_clock::now();
     checkResult(vkWaitForFences(device, 1, &transferFence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+    countWait(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - waitStart).count());
 }
 
 void DeviceState::setObjectName(VkObjectType type, std::uint64_t handle, const std::string& name)

@@ -1,5 +1,7 @@
 #include "pipeline/frame_graph.h"
 
+#include "gpu/bus_counters.h"
+
 #include "core/error.h"
 #include "core/strings.h"
 
@@ -364,11 +366,15 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
             if (options.culling && mPasses[i].reuse)
                 reused = mPasses[i].reuse(context);
             collect(); // GPU work submitted before this pass is not its own
+            const gpu::BusCounters busBefore = gpu::getBusCounters();
+            int calls = 1;
             if (!reused.empty()) {
                 outcome = PassOutcome::skipped(reused);
             } else if (mPasses[i].timing == PassTiming::Repeated) {
+                calls = 0;
                 const auto report =
                     metrics::measure(mPasses[i].timingOptions.value_or(options.timing), [&] {
+                        ++calls;
                         outcome = mCallbacks[i](context);
                         return collect();
                     });
@@ -380,6 +386,16 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
                                       std::chrono::steady_clock::now() - start)
                                       .count();
                 records[i].time = makeSingleReport(ms, collect());
+            }
+            {
+                // Per call of the pass (a repeated one is called warm-up + repeats times).
+                const gpu::BusCounters bus = gpu::getBusCounters() - busBefore;
+                const std::uint64_t n = std::uint64_t(std::max(1, calls));
+                records[i].uploadBytes = bus.uploadBytes / n;
+                records[i].readbackBytes = bus.readbackBytes / n;
+                records[i].submits = bus.submits / n;
+                records[i].waits = bus.waits / n;
+                records[i].waitMs = bus.waitMs / double(n);
             }
             if (!outcome.ran) {
                 records[i].ran = false;

@@ -39,6 +39,7 @@
 #include "metrics/timing.h"
 #include "scene/scene.h"
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -176,6 +177,14 @@ struct PassRecord {
     bool measurement = false;
     //! When it ran: the CPU wall time (and GPU pass times) the graph measured.
     std::optional<metrics::TimingReport> time;
+    //! When it ran: what crossed the bus per call of the pass (gpu/bus_counters.h): bytes
+    //! uploaded and read back, queue submissions, host waits on a fence and their wall time
+    //! (the pass's host time is its CPU wall time less that).
+    std::uint64_t uploadBytes = 0;
+    std::uint64_t readbackBytes = 0;
+    std::uint64_t submits = 0;
+    std::uint64_t waits = 0;
+    double waitMs = 0.0;
 };
 
 class FrameGraph;

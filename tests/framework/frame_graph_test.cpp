@@ -1,9 +1,15 @@
 // The frame graph's culling rules, on small graphs whose answer is known.
 
 #include "core/error.h"
+#include "experiment/results.h"
+#include "experiment/runner.h"
+#include "gpu/bus_counters.h"
 #include "pipeline/frame_graph.h"
 
 #include <algorithm>
+#include <cmath>
+#include <type_traits>
+#include <variant>
 
 #include <gtest/gtest.h>
 
@@ -304,6 +310,66 @@ TEST(FrameGraph, TimesEveryPassThatRunsAndOnlyThose)
     EXPECT_EQ(records[1].time->cpuMs.count, 3);
     EXPECT_FALSE(records[2].time.has_value()) << "a skipped pass has no time";
     EXPECT_GE(gpuDrains, 2 * 2);
+}
+
+TEST(FrameGraph, RecordsWhatEachPassSendsOverTheBusAndTheRowSumsTheFramesPasses)
+{
+    // Passes that stand in for GPU work by counting transfers where the gpu module does
+    // (gpu/bus_counters.h): each record carries its own, per call for a repeated pass; the row
+    // has them per pass and summed over the frame's passes (a measurement's left out), and each
+    // pass's host time, its CPU wall time less its waits on the device.
+    FrameGraph graph;
+    graph.addExternal("scene");
+    graph.addPass({.name = "upload", .reads = {"scene"}, .writes = {"x"}}, [] {
+        gpu::detail::countUpload(1000);
+        gpu::detail::countSubmit();
+        gpu::detail::countWait(0.0);
+        return PassOutcome{};
+    });
+    graph.addPass({.name = "repeated", .reads = {"x"}, .writes = {"y"}, .timing = PassTiming::Repeated},
+                  [] {
+                      gpu::detail::countReadback(64);
+                      return PassOutcome{};
+                  });
+    graph.addPass({.name = "measure", .reads = {"y"}, .writes = {"m"}, .measurement = true}, [] {
+        gpu::detail::countReadback(5000);
+        return PassOutcome{};
+    });
+    FrameOptions options;
+    options.outputs = {"y", "m"};
+    options.timing = {.warmup = 1, .repeats = 2};
+    const auto records = graph.execute(options);
+    const PassRecord& upload = find(records, "upload");
+    EXPECT_EQ(upload.uploadBytes, 1000u);
+    EXPECT_EQ(upload.readbackBytes, 0u);
+    EXPECT_EQ(upload.submits, 1u);
+    EXPECT_EQ(upload.waits, 1u);
+    EXPECT_EQ(find(records, "repeated").readbackBytes, 64u) << "per call, of 1 + 1 + 2 calls";
+    EXPECT_EQ(find(records, "measure").readbackBytes, 5000u);
+    experiment::ResultRow row;
+    experiment::writePassRecords(row, records);
+    const auto number = [&](const std::string& column) {
+        const experiment::Cell* c = row.find(column);
+        if (c == nullptr)
+            throw Error("no column " + column);
+        return std::visit([](const auto& v) -> double {
+            if constexpr (std::is_arithmetic_v<std::decay_t<decltype(v)>>)
+                return double(v);
+            else
+                return std::nan("");
+        }, *c);
+    };
+    EXPECT_EQ(number("upload.upload_bytes"), 1000.0);
+    EXPECT_EQ(number("upload.submits"), 1.0);
+    EXPECT_EQ(number("repeated.readback_bytes"), 64.0);
+    EXPECT_EQ(number("measure.readback_bytes"), 5000.0);
+    EXPECT_EQ(number("frame.upload_bytes"), 1000.0);
+    EXPECT_EQ(number("frame.readback_bytes"), 64.0) << "the measurement is not the frame's";
+    EXPECT_EQ(number("frame.submits"), 1.0);
+    EXPECT_EQ(number("frame.waits"), 1.0);
+    EXPECT_GE(number("upload.host_ms"), 0.0);
+    EXPECT_LE(number("upload.host_ms"), number("upload.cpu_ms"));
+    EXPECT_LE(number("frame.host_ms"), number("frame.cpu_ms") + 1e-9);
 }
 
 TEST(FrameGraph, ReleasedGpuResourcesServeTheNextWriterOfTheSameType)

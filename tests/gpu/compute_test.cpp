@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "gpu/bus_counters.h"
 #include "gpu/context.h"
 #include "gpu_test_support.h"
 
@@ -127,6 +128,50 @@ TEST_F(StagedComputeTest, HostVisibleBuffersSkipTheStagingBuffers)
 TEST_F(ComputeTest, HostVisibleBuffersWorkOnUnifiedMemory)
 {
     runSaxpyAndCheck(true);
+}
+
+// What crosses the bus is counted where it happens (gpu/bus_counters.h): the bytes of every
+// upload and read-back, mapped or staged, of buffers and images alike; one submission and one
+// host wait per run, and per staged transfer.
+void checkBusCounters(Context& context)
+{
+    Buffer buffer = context.createBuffer({.size = 4096, .name = "counted"});
+    Image image = context.createImage({.format = Format::R32Float, .width = 8, .height = 4, .name = "counted"});
+    const std::vector<float> texels(32, 1.5f);
+    const std::vector<std::uint8_t> bytes(1000, 7);
+    const bool staged = context.usesStagingUploads();
+    const BusCounters before = getBusCounters();
+    buffer.upload(bytes.data(), bytes.size(), 96);
+    image.uploadSpan<float>(texels);
+    std::vector<std::uint8_t> back(300);
+    buffer.download(back.data(), back.size(), 10);
+    EXPECT_EQ(image.downloadVector<float>(), texels);
+    const BusCounters transfers = getBusCounters() - before;
+    EXPECT_EQ(transfers.uploadBytes, 1000u + 32u * sizeof(float));
+    EXPECT_EQ(transfers.readbackBytes, 300u + 32u * sizeof(float));
+    // An image always goes through a staging buffer and a submission; a buffer only when its
+    // memory is not mapped.
+    const std::uint64_t submits = 2 + (staged ? 2 : 0);
+    EXPECT_EQ(transfers.submits, submits);
+    EXPECT_EQ(transfers.waits, submits);
+    EXPECT_GE(transfers.waitMs, 0.0);
+    const BusCounters beforeRun = getBusCounters();
+    context.run([&](CommandList& cmd) { cmd.fillBuffer(buffer, 0u); });
+    const BusCounters run = getBusCounters() - beforeRun;
+    EXPECT_EQ(run.submits, 1u);
+    EXPECT_EQ(run.waits, 1u);
+    EXPECT_EQ(run.uploadBytes, 0u);
+    EXPECT_EQ(run.readbackBytes, 0u);
+}
+
+TEST_F(ComputeTest, WhatCrossesTheBusIsCounted)
+{
+    checkBusCounters(getContext());
+}
+
+TEST_F(StagedComputeTest, WhatCrossesTheBusIsCountedThroughStagingBuffers)
+{
+    checkBusCounters(getContext());
 }
 
 TEST_F(StagedComputeTest, KeptStagingBuffersCarryEveryTransferWhateverItsSizeAndOrder)
