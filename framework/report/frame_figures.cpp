@@ -130,6 +130,36 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory,
         figures.captions.push_back(
             "Time of every pass that makes the frame, per frame, for " + technique + " on " +
             group.title + ". A pass that was skipped (reused work, nothing changed) is 0.");
+
+        // The same passes' traffic over the bus (gpu/bus_counters.h): per frame one bar of what
+        // went up and one of what came back, stacked by pass.
+        plot::StackedBarSpec bus;
+        bus.title = group.title + ": " + technique + ", bytes over the bus per pass";
+        bus.yLabel = "MiB per frame (up: uploaded, down: read back)";
+        bus.passes = passes;
+        double total = 0.0;
+        for (const auto& frame : run->frames)
+            for (const char* direction : {"upload", "readback"}) {
+                bus.bars.push_back("f" + getText(frame, "frame") +
+                                   (std::string(direction) == "upload" ? " up" : " down"));
+                std::vector<double> values;
+                for (const auto& p : passes) {
+                    const double v = experiment::getNumber(frame, p + "." + direction + "_bytes");
+                    values.push_back(std::isfinite(v) ? v / 1048576.0 : 0.0);
+                    total += values.back();
+                }
+                bus.values.push_back(values);
+            }
+        if (total > 0.0) {
+            const std::string busPath = plots + "/frame_bus_" + makeFileName(technique) + "_" + stem;
+            plot::writeStackedBars(bus, busPath);
+            figures.plots.push_back(busPath);
+            figures.captions.push_back(
+                "What crosses the bus between host and device in every pass that makes the frame, "
+                "per frame, for " + technique + " on " + group.title +
+                " (uploads and read-backs, staged or mapped; <pass>.upload_bytes, "
+                "<pass>.readback_bytes).");
+        }
     }
 
     // 2b. What the frame's light is made of (experiment/lit_frame.cpp metric.frame_terms): per
