@@ -282,14 +282,33 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory,
     // 4. Filmstrip: the truth and each technique's tonemapped frames (culling on), then each
     //    technique's |HDR error| per frame.
     plot::ImageGridSpec grid;
-    grid.title = group.title + ": lit frames (tonemapped) and |error| against Embree full";
+    grid.title = group.title + ": frames and |error|"; // the caption says the rest
     grid.encodeSrgb = false; // the PNGs are display values already
     grid.errorLabel = "mean |HDR error| over channels (radiance)";
     std::vector<std::vector<plot::GridCell>> imageRows, errorRows;
     std::vector<std::string> imageTitles, errorTitles;
     std::size_t frameCount = 0;
+    // Row titles without what every technique shares ("bentcone_ssdo+" in front of each voxel GI
+    // technique): they are drawn rotated beside one image's height.
+    std::string shared;
     for (const auto& [technique, runs] : byTechnique) {
-        const RunSummary* run = findFirstCulledRun(runs);
+        const std::string prefix = technique.substr(0, technique.rfind('+') + 1);
+        shared = shared.empty() || shared == prefix ? prefix : "-";
+    }
+    if (shared == "-")
+        shared.clear();
+    for (const auto& [technique, runs] : byTechnique) {
+        // The technique's first run with culling on, and among those one whose lit frame takes
+        // the technique's own sky where there is one (`frame: {sky: lobes}` is the frame's
+        // ablation, not the technique's frame).
+        const auto lobes = [](const RunSummary* r) {
+            const auto it = r->text.find("frame.sky");
+            return it != r->text.end() && it->second == "lobes";
+        };
+        const RunSummary* run = nullptr;
+        for (const RunSummary* r : runs)
+            if (!isCullingOff(*r) && (!run || (lobes(run) && !lobes(r))))
+                run = r;
         if (!run)
             continue;
         std::vector<plot::GridCell> images, errors, truths;
@@ -313,10 +332,11 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory,
             imageRows.push_back(truths);
             imageTitles.push_back("Embree full");
         }
+        const std::string title = technique.substr(shared.size());
         imageRows.push_back(images);
-        imageTitles.push_back(technique);
+        imageTitles.push_back(title);
         errorRows.push_back(errors);
-        errorTitles.push_back("|error| " + technique);
+        errorTitles.push_back("|error| " + title);
     }
     if (imageRows.size() > 1) {
         for (std::size_t k = 0; k < frameCount; ++k)
@@ -331,7 +351,10 @@ Figures writeLitFrameFigures(const Group& group, const std::string& directory,
         figures.captions.push_back(
             "Filmstrip of " + group.title +
             ": the Embree full radiance and each technique's lit frame (tonemapped), "
-            "then each technique's absolute HDR error, frame by frame.");
+            "then each technique's absolute HDR error, frame by frame" +
+            (shared.empty() ? std::string() : " (every row with " + shared.substr(0, shared.size() - 1) + ")") +
+            "; each technique's first run with culling on whose frame takes the technique's own "
+            "sky.");
     }
     return figures;
 }
