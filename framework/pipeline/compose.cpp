@@ -24,54 +24,6 @@ namespace {
 
 constexpr std::array<const char*, render::kCubeFaceCount> kFaceNames = {"+x", "-x", "+y",
                                                                         "-y", "+z", "-z"};
-// Changed triangles are grouped into the cells of a grid of this many cells per axis over the
-// scene's bounds, one box per cell: far apart changes (two characters, a dig) then do not make
-// one box that every face of every light sees.
-constexpr int kChangeGridSize = 8;
-
-// Triangles are ordered by hash, then by the bits of their box: a strict order even with NaN
-// or -0 coordinates, so that equal triangles (equal positions in the same order) are adjacent.
-std::array<std::uint32_t, 6> getBoxBits(const ShadowTriangle& t)
-{
-    return {std::bit_cast<std::uint32_t>(t.boxMin.x), std::bit_cast<std::uint32_t>(t.boxMin.y),
-            std::bit_cast<std::uint32_t>(t.boxMin.z), std::bit_cast<std::uint32_t>(t.boxMax.x),
-            std::bit_cast<std::uint32_t>(t.boxMax.y), std::bit_cast<std::uint32_t>(t.boxMax.z)};
-}
-
-bool isBefore(const ShadowTriangle& a, const ShadowTriangle& b)
-{
-    if (a.hash != b.hash)
-        return a.hash < b.hash;
-    return getBoxBits(a) < getBoxBits(b);
-}
-
-// The sorted triangles of `g`. The hash is of the position bits in index order: a triangle
-// whose corners are listed in another order rasterises with other roundings, so it counts as
-// changed.
-std::vector<ShadowTriangle> computeShadowTriangles(const scene::RenderScene& g)
-{
-    std::vector<ShadowTriangle> triangles(g.triangleCount());
-    for (std::size_t t = 0; t < triangles.size(); ++t) {
-        ShadowTriangle& out = triangles[t];
-        std::uint64_t h = 0xcbf29ce484222325ull; // FNV-1a over the nine 32-bit words
-        out.boxMin = glm::vec3(std::numeric_limits<float>::max());
-        out.boxMax = glm::vec3(std::numeric_limits<float>::lowest());
-        for (std::size_t k = 0; k < 3; ++k) {
-            const glm::vec3 p = g.positions[g.indices[3 * t + k]];
-            for (int c = 0; c < 3; ++c)
-                h = (h ^ std::bit_cast<std::uint32_t>(p[c])) * 0x100000001b3ull;
-            out.boxMin = glm::min(out.boxMin, p);
-            out.boxMax = glm::max(out.boxMax, p);
-        }
-        // splitmix64's finaliser spreads FNV's weak high bits, which lead the sort.
-        h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ull;
-        h = (h ^ (h >> 27)) * 0x94d049bb133111ebull;
-        out.hash = h ^ (h >> 31);
-    }
-    std::sort(triangles.begin(), triangles.end(), isBefore);
-    return triangles;
-}
-
 // The bounds of the positions, as render::ShadowPass computes them for its planes.
 std::pair<glm::vec3, glm::vec3> computeBounds(const std::vector<glm::vec3>& positions)
 {
@@ -85,43 +37,69 @@ std::pair<glm::vec3, glm::vec3> computeBounds(const std::vector<glm::vec3>& posi
     return {lo, hi};
 }
 
-// The triangles in one list and not the other (as multisets), as boxes: one per cell of the
-// change grid over [boundsMin, boundsMax] that holds the centre of one of them.
-struct ChangedTriangles {
-    std::vector<std::pair<glm::vec3, glm::vec3>> boxes;
+using Box = std::pair<glm::vec3, glm::vec3>;
+
+// The box a capsule's triangles lie in (scene.cpp appendCapsule: points on the capsule's
+// surface), grown by a little for the rounding of centre + radius * unit normal.
+Box getCapsuleBox(const scene::Capsule& c)
+{
+    const float r = c.radius * (1.0f + 1e-5f) + 1e-6f;
+    return {glm::min(c.a, c.b) - r, glm::max(c.a, c.b) + r};
+}
+
+bool isSameCapsule(const scene::Capsule& x, const scene::Capsule& y)
+{
+    return std::memcmp(&x, &y, sizeof(scene::Capsule)) == 0;
+}
+
+// Where the triangles may differ between the shadow maps' last rendering and this frame, from
+// what the scene says moved rather than from the triangles (nothing per triangle on the host):
+//  * each character capsule whose pose changed: its old and its new box;
+//  * each SDF edit that starts after `lastFrame` and by `frame`: its primitive's bounds grown by
+//    its blend radius (a soft edit changes nothing farther from its surface: the polynomial soft
+//    minimum equals the hard one there, scene/csg.h) and by 4 cells of its model's meshing grid
+//    (scene/sdf_mesher.cpp: a vertex moves with the field at the corners of its cell and at its
+//    Newton steps, within half a cell of it; its quads reach one cell further).
+// `bounded` is false when the geometry changed and neither explains it (a capsule more or
+// fewer, or nothing moved at all): then every face is redrawn.
+struct MovedBounds {
+    std::vector<Box> boxes;
+    bool bounded = true;
 };
 
-ChangedTriangles findChangedTriangles(const std::vector<ShadowTriangle>& before,
-                                      const std::vector<ShadowTriangle>& after, glm::vec3 boundsMin,
-                                      glm::vec3 boundsMax)
+MovedBounds findMovedBounds(const scene::Scene& scene, const std::vector<scene::Capsule>& before,
+                            const std::vector<scene::Capsule>& now, int lastFrame, int frame)
 {
-    constexpr int n = kChangeGridSize;
-    const glm::vec3 empty(std::numeric_limits<float>::max());
-    std::vector<std::pair<glm::vec3, glm::vec3>> cells(std::size_t(n * n * n), {empty, -empty});
-    const glm::vec3 extent = glm::max(boundsMax - boundsMin, glm::vec3(1e-30f));
-    ChangedTriangles changed;
-    auto add = [&](const ShadowTriangle& t) {
-        const glm::vec3 u = (0.5f * (t.boxMin + t.boxMax) - boundsMin) / extent * float(n);
-        const glm::ivec3 cell(glm::clamp(glm::floor(u), glm::vec3(0.0f), glm::vec3(float(n - 1))));
-        auto& box = cells[std::size_t((cell.z * n + cell.y) * n + cell.x)];
-        box.first = glm::min(box.first, t.boxMin);
-        box.second = glm::max(box.second, t.boxMax);
-    };
-    auto a = before.begin(), b = after.begin();
-    while (a != before.end() || b != after.end()) {
-        if (b == after.end() || (a != before.end() && isBefore(*a, *b)))
-            add(*a++);
-        else if (a == before.end() || isBefore(*b, *a))
-            add(*b++);
-        else {
-            ++a;
-            ++b;
+    MovedBounds moved;
+    if (before.size() != now.size()) {
+        moved.bounded = false;
+        return moved;
+    }
+    for (std::size_t i = 0; i < now.size(); ++i)
+        if (!isSameCapsule(before[i], now[i])) {
+            moved.boxes.push_back(getCapsuleBox(before[i]));
+            moved.boxes.push_back(getCapsuleBox(now[i]));
+        }
+    for (const scene::SdfModel& model : scene.sdfModels) {
+        const glm::dvec3 extent = model.boundsMax - model.boundsMin;
+        const double cell = std::max({extent.x, extent.y, extent.z}) / double(std::max(model.resolution, 1));
+        for (const scene::CsgEdit& edit : model.edits) {
+            if (edit.frame <= lastFrame || edit.frame > frame)
+                continue;
+            glm::dvec3 lo, hi;
+            edit.getBounds(lo, hi);
+            const double margin = std::max(edit.blend, 0.0) + 4.0 * cell;
+            // Outward to float, and never past the model's own box (nothing is meshed there).
+            lo = glm::max(lo - margin, model.boundsMin - 2.0 * cell);
+            hi = glm::min(hi + margin, model.boundsMax + 2.0 * cell);
+            if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z))
+                continue; // the edit lies outside its model's box
+            moved.boxes.push_back({glm::vec3(lo) - glm::abs(glm::vec3(lo)) * 1e-6f - 1e-6f,
+                                   glm::vec3(hi) + glm::abs(glm::vec3(hi)) * 1e-6f + 1e-6f});
         }
     }
-    for (const auto& box : cells)
-        if (box.first.x <= box.second.x)
-            changed.boxes.push_back(box);
-    return changed;
+    moved.bounded = !moved.boxes.empty();
+    return moved;
 }
 
 std::string describeFaces(std::uint8_t mask)
@@ -304,9 +282,11 @@ void Compose::addPasses(FrameGraph& graph)
     const auto indirectGpu = indirectIrradianceGpuSlot(mWidth, mHeight);
     const auto coneSkyGpu = coneSkyGpuSlot(mWidth, mHeight);
 
+    const auto capsulesRes = mStart.capsules();
     graph.addPass(
         {.name = "shadow_maps",
          .reads = {geometry, geometryKey},
+         .optionalReads = {capsulesRes},
          .writes = {shadowMaps, atlas},
          .needs = {scene::SceneFeature::PointLights},
          .persistent = {shadowMaps.name, atlas.name},
@@ -326,7 +306,7 @@ void Compose::addPasses(FrameGraph& graph)
                  mStats.shadowSkips = "every light: " + why;
                  return why;
              }},
-        [this, geometry, geometryKey, shadowMaps, atlas](PassContext& ctx) {
+        [this, geometry, geometryKey, capsulesRes, shadowMaps, atlas](PassContext& ctx) {
             const scene::RenderScene& g = ctx.read(geometry);
             if (!mShadows) {
                 mShadows = std::make_unique<render::ShadowPass>(
@@ -334,16 +314,22 @@ void Compose::addPasses(FrameGraph& graph)
                 mShadows->useAtlas(ctx.write(atlas));
             }
             const std::size_t lightCount = g.pointLights.size();
-            std::vector<ShadowTriangle> triangles = computeShadowTriangles(g);
             const auto [boundsMin, boundsMax] = computeBounds(g.positions);
+            std::vector<scene::Capsule> capsules;
+            if (const auto* posed = ctx.tryRead(capsulesRes))
+                for (const auto& c : *posed)
+                    capsules.push_back(c.capsule);
             // Every face of every light is drawn when the kept maps may not be what a full
             // rendering gives: the near and far planes follow the bounds.
-            const bool drawAll = !ctx.mayReuse() || mShadowFrame < 0 ||
-                                 lightCount != mShadowLightPositions.size() ||
-                                 boundsMin != mShadowBoundsMin || boundsMax != mShadowBoundsMax;
-            const ChangedTriangles changed =
-                drawAll ? ChangedTriangles{}
-                        : findChangedTriangles(mShadowTriangles, triangles, boundsMin, boundsMax);
+            bool drawAll = !ctx.mayReuse() || mShadowFrame < 0 ||
+                           lightCount != mShadowLightPositions.size() ||
+                           boundsMin != mShadowBoundsMin || boundsMax != mShadowBoundsMax;
+            MovedBounds changed;
+            if (!drawAll && ctx.read(geometryKey) != mShadowGeometryHash) {
+                changed = findMovedBounds(mStart.getScene(), mShadowCapsules, capsules, mShadowFrame,
+                                          ctx.frame());
+                drawAll = !changed.bounded;
+            }
             std::vector<std::uint8_t> masks(lightCount, 0);
             std::vector<std::string> skips;
             for (std::size_t i = 0; i < lightCount; ++i) {
@@ -357,16 +343,15 @@ void Compose::addPasses(FrameGraph& graph)
                     if (masks[i] == render::kAllCubeFaces)
                         break;
                 }
-                // The six pyramids cover space, so a light keeps every face only when no
-                // triangle changed (materials, normals or the triangles' order did).
+                // The six pyramids cover space, so a light keeps every face only when nothing
+                // moved (the geometry's hash is that of the last rendering).
                 if (masks[i] == 0)
-                    skips.push_back(
-                        "light " + std::to_string(i) +
-                        ": no triangle appeared or disappeared, the light did not move");
+                    skips.push_back("light " + std::to_string(i) +
+                                    ": no caster moved, the light did not move");
                 else if (masks[i] != render::kAllCubeFaces)
                     skips.push_back("light " + std::to_string(i) + " faces " +
                                     describeFaces(std::uint8_t(render::kAllCubeFaces & ~masks[i])) +
-                                    ": no triangle appeared or disappeared in their view");
+                                    ": no caster moved in their view");
             }
             std::string joined;
             for (const std::string& skip : skips)
@@ -384,7 +369,7 @@ void Compose::addPasses(FrameGraph& graph)
             mShadowLightPositions.clear();
             for (const auto& l : g.pointLights)
                 mShadowLightPositions.push_back(l.position);
-            mShadowTriangles = std::move(triangles);
+            mShadowCapsules = std::move(capsules);
             mShadowBoundsMin = boundsMin;
             mShadowBoundsMax = boundsMax;
             mShadowFrame = ctx.frame();

@@ -55,15 +55,6 @@ class Image;
 
 namespace rtlab::pipeline {
 
-//! A triangle of the geometry the shadow maps were rendered for (compose.cpp): a hash of its
-//! three positions, in order, and its box. Two frames' sorted lists of them give the triangles
-//! that appeared or disappeared in between.
-struct ShadowTriangle {
-    std::uint64_t hash = 0;
-    glm::vec3 boxMin{0.0f};
-    glm::vec3 boxMax{0.0f};
-};
-
 //! The lit frame on the CPU.
 struct LitFrame {
     Image<glm::vec3> hdr;    //!< linear radiance: emission + direct + indirect
@@ -180,7 +171,7 @@ private:
     // What the shadow maps were rendered for.
     std::string mShadowGeometryHash;
     std::vector<glm::vec3> mShadowLightPositions;
-    std::vector<ShadowTriangle> mShadowTriangles; //!< sorted (see compose.cpp)
+    std::vector<scene::Capsule> mShadowCapsules; //!< the characters' capsules, posed
     glm::vec3 mShadowBoundsMin{0.0f};
     glm::vec3 mShadowBoundsMax{0.0f};
     int mShadowFrame = -1;

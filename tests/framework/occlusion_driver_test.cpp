@@ -453,6 +453,69 @@ TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesAWalkerChangesAndTheFrameMatch
     }
 }
 
+TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesADigChangesAndTheFrameMatchesTheUnculledOne)
+{
+    // A rock dug at frame 1 in the Cornell box, two point lights, three frames. With culling the
+    // shadow pass bounds what changed by the dig's primitive (grown by its blend and the
+    // mesher's reach), not by comparing triangles, and redraws only the cube faces that see that
+    // box; at frame 2 nothing moved and it is skipped. The lit HDR frames must not differ by a bit
+    // from the unculled run, which redraws all 12 faces every frame.
+    const auto& registry = plugin::builtinRegistry();
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_dig";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "dig.yaml")
+        << "scene: dig\nbase: cornell_box\nframes: 3\n"
+           "sdf_models:\n  - name: rock\n    bounds: [[0.32, 0.0, 0.05], [0.52, 0.2, 0.25]]\n"
+           "    resolution: 48\n    edits:\n"
+           "      - {shape: rounded_box, op: add, center: [0.42, 0.08, 0.15], size: [0.08, 0.08, 0.08], "
+           "rounding: 0.02, material: white}\n"
+           "      - {shape: sphere, op: subtract, center: [0.47, 0.15, 0.10], size: 0.05, blend: 0.01, "
+           "frame: 1}\n"
+           "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n"
+           "  - {position: [0.1, 0.3, 0.45], intensity: [0.02, 0.03, 0.04]}\n";
+    auto run = [&](const std::string& culling) {
+        const auto e = experiment::parseExperiment(R"(base:
+  scene: dig.yaml
+  resolution: [32, 24]
+  frames: 3
+  camera_path: static
+  metrics: [error]
+  frame: {lighting: true, shadow_map_size: 32, culling: )" + culling + R"(}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 4}
+  techniques: {occlusion: {technique: gtao}}
+)",
+                                                   (dir / ("dig_" + culling + ".yaml")).string(), registry);
+        return runAndLoad(e, registry, (dir / ("out_" + culling)).string());
+    };
+    const auto culled = run("true");
+    const auto all = run("false");
+    ASSERT_EQ(culled.size(), 3u) << (culled.empty() ? "" : culled[0].at("error"));
+    ASSERT_EQ(all.size(), 3u) << (all.empty() ? "" : all[0].at("error"));
+    for (std::size_t i = 0; i < 3; ++i) {
+        ASSERT_EQ(culled[i].at("status"), "ok") << culled[i].at("error");
+        ASSERT_EQ(all[i].at("status"), "ok") << all[i].at("error");
+        EXPECT_EQ(all[i].at("frame.shadow_faces_rendered"), "12") << "frame " << i;
+        if (i == 1) {
+            const double faces = experiment::getNumber(culled[i], "frame.shadow_faces_rendered");
+            EXPECT_GT(faces, 0.0);
+            EXPECT_LT(faces, 12.0);
+            EXPECT_NE(culled[i].at("frame.shadow_skips").find("no caster moved in their view"),
+                      std::string::npos)
+                << culled[i].at("frame.shadow_skips");
+        }
+        if (i == 2)
+            EXPECT_NE(culled[i].at("passes").find("shadow_maps:skipped"), std::string::npos)
+                << culled[i].at("passes");
+        const Image<glm::vec3> a = experiment::readExrRgb(culled[i].at("image.lit_hdr"));
+        const Image<glm::vec3> b = experiment::readExrRgb(all[i].at("image.lit_hdr"));
+        ASSERT_EQ(a.pixels.size(), b.pixels.size());
+        EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
+            << "lit frame " << i;
+    }
+}
+
 TEST(OcclusionDriver, VulkanTechniquesReadTheGBufferOnTheGpuWithTheSameResult)
 {
     // gtao binds the view inputs made on the GPU (no upload of a CPU copy); the ablation
