@@ -3,8 +3,11 @@
 // their Vulkan objects and keep the device alive. Upload/download calls are synchronous: they
 // return when the data has arrived.
 
+#include "core/error.h"
+
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <span>
 #include <string>
@@ -89,6 +92,26 @@ private:
     explicit Buffer(std::unique_ptr<detail::BufferState> state);
     std::unique_ptr<detail::BufferState> mState;
 };
+
+//! Uploads to `buffer`, which holds `held`, the elements of `next` (as many as `held`) from the
+//! first to the last that differ from it, byte for byte: one upload of that span, or none.
+//! Returns the bytes uploaded. What a pass uses when a frame changes a part of its data (a
+//! character's vertices) and the rest stays.
+template <PlainData T>
+std::size_t uploadChangedSpan(Buffer& buffer, std::span<const T> held, std::span<const T> next)
+{
+    if (held.size() != next.size())
+        throw Error("uploadChangedSpan: " + std::to_string(next.size()) + " elements against " +
+                    std::to_string(held.size()) + " held");
+    std::size_t first = 0, last = next.size();
+    while (first < last && std::memcmp(&held[first], &next[first], sizeof(T)) == 0)
+        ++first;
+    while (last > first && std::memcmp(&held[last - 1], &next[last - 1], sizeof(T)) == 0)
+        --last;
+    if (first < last)
+        buffer.upload(next.data() + first, (last - first) * sizeof(T), first * sizeof(T));
+    return (last - first) * sizeof(T);
+}
 
 //! How an image will be bound.
 enum class ImageUsage : std::uint32_t {

@@ -321,6 +321,8 @@ void Compose::addPasses(FrameGraph& graph)
                     capsules.push_back(c.capsule);
             // Every face of every light is drawn when the kept maps may not be what a full
             // rendering gives: the near and far planes follow the bounds.
+            if (!ctx.mayReuse())
+                mShadows->forgetGeometry(); // without culling nothing is patched
             bool drawAll = !ctx.mayReuse() || mShadowFrame < 0 ||
                            lightCount != mShadowLightPositions.size() ||
                            boundsMin != mShadowBoundsMin || boundsMax != mShadowBoundsMax;

@@ -136,7 +136,8 @@ void FrameStart::addPasses(FrameGraph& graph)
                       if (!mGBufferPass)
                           mGBufferPass = std::make_unique<render::GBufferPass>(mGpu);
                       const scene::RenderScene& g = ctx.read(geometryRes);
-                      mGBufferPass->setScene(g);
+                      // Without culling nothing is patched: everything is uploaded again.
+                      mGBufferPass->setScene(g, ctx.mayReuse());
                       mUploadedHash = ctx.read(geometryKeyRes);
                       mUploadedFrame = ctx.frame();
                       ctx.write(gpuScene) = GpuScene{mUploadedHash, ctx.frame()};

@@ -97,6 +97,8 @@ struct GBufferPass::State {
     std::uint32_t indexCount = 0;
     std::size_t vertexCount = 0;
     bool hasScene = false;
+    //! What the buffers hold (setScene uploads only what changed from it).
+    GBufferGeometry uploaded;
     gpu::RenderTarget target;               //!< own target of draw(camera, width, height)
     const gpu::RenderTarget* last = nullptr; //!< the target of the last draw
     bool drawn = false;
@@ -117,10 +119,22 @@ GBufferPass::~GBufferPass() = default;
 GBufferPass::GBufferPass(GBufferPass&&) noexcept = default;
 GBufferPass& GBufferPass::operator=(GBufferPass&&) noexcept = default;
 
-void GBufferPass::setScene(const scene::RenderScene& scene)
+void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
 {
-    const GBufferGeometry geometry = buildGBufferGeometry(scene);
+    GBufferGeometry geometry = buildGBufferGeometry(scene);
     State& s = *mState;
+    // A scene of the same size as the one the buffers hold (a character moved, a light did):
+    // only the span of vertices and indices that differs goes over the bus.
+    if (patch && s.hasScene && !geometry.vertices.empty() && !geometry.indices.empty() &&
+        geometry.vertices.size() == s.uploaded.vertices.size() &&
+        geometry.indices.size() == s.uploaded.indices.size()) {
+        s.hasScene = false;
+        gpu::uploadChangedSpan<GBufferVertex>(s.vertices, s.uploaded.vertices, geometry.vertices);
+        gpu::uploadChangedSpan<std::uint32_t>(s.indices, s.uploaded.indices, geometry.indices);
+        s.uploaded = std::move(geometry);
+        s.hasScene = true;
+        return;
+    }
     s.hasScene = false;
     // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
     const std::size_t vertexCount = std::max<std::size_t>(geometry.vertices.size(), 1);
@@ -135,6 +149,7 @@ void GBufferPass::setScene(const scene::RenderScene& scene)
         s.indices.uploadSpan<std::uint32_t>(geometry.indices);
     s.indexCount = static_cast<std::uint32_t>(geometry.indices.size());
     s.vertexCount = geometry.vertices.size();
+    s.uploaded = std::move(geometry);
     s.hasScene = true;
 }
 

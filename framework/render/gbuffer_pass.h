@@ -68,8 +68,11 @@ public:
     GBufferPass& operator=(GBufferPass&&) noexcept;
 
     //! Validates and uploads `scene` (see render/gbuffer_geometry.h); replaces any earlier
-    //! scene. Throws rtlab::Error for an inconsistent scene.
-    void setScene(const scene::RenderScene& scene);
+    //! scene. A scene with as many vertices and indices as the last one (a character moved)
+    //! uploads only the span of them that differs (gpu/bus_counters.h counts it), unless
+    //! `patch` is false (new buffers, everything uploaded). Throws rtlab::Error for an
+    //! inconsistent scene.
+    void setScene(const scene::RenderScene& scene, bool patch = true);
     bool hasScene() const;
     //! Vertices uploaded for the scene (its vertices plus those split off for materials).
     std::size_t getVertexCount() const;

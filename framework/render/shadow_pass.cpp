@@ -202,18 +202,28 @@ struct ShadowPass::State {
         if (uploaded && scene.positions == uploadedPositions && scene.indices == uploadedIndices)
             return;
         validateRenderScene(scene);
+        // As many vertices and indices as the buffers hold (a character moved): only the span
+        // that differs goes over the bus; the planes follow the new bounds.
+        const bool sameSize = uploaded && !scene.positions.empty() && !scene.indices.empty() &&
+                              scene.positions.size() == uploadedPositions.size() &&
+                              scene.indices.size() == uploadedIndices.size();
         uploaded = false;
-        // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
-        const std::size_t vertexSlots = std::max<std::size_t>(scene.positions.size(), 1);
-        const std::size_t indexSlots = std::max<std::size_t>(scene.indices.size(), 3);
-        vertices = context->createBuffer(
-            {vertexSlots * sizeof(glm::vec3), "shadow vertices", /*vertexIndexUsage=*/true});
-        indices = context->createBuffer(
-            {indexSlots * sizeof(std::uint32_t), "shadow indices", /*vertexIndexUsage=*/true});
-        if (!scene.positions.empty())
-            vertices.uploadSpan<glm::vec3>(scene.positions);
-        if (!scene.indices.empty())
-            indices.uploadSpan<std::uint32_t>(scene.indices);
+        if (sameSize) {
+            gpu::uploadChangedSpan<glm::vec3>(vertices, uploadedPositions, scene.positions);
+            gpu::uploadChangedSpan<std::uint32_t>(indices, uploadedIndices, scene.indices);
+        } else {
+            // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
+            const std::size_t vertexSlots = std::max<std::size_t>(scene.positions.size(), 1);
+            const std::size_t indexSlots = std::max<std::size_t>(scene.indices.size(), 3);
+            vertices = context->createBuffer(
+                {vertexSlots * sizeof(glm::vec3), "shadow vertices", /*vertexIndexUsage=*/true});
+            indices = context->createBuffer(
+                {indexSlots * sizeof(std::uint32_t), "shadow indices", /*vertexIndexUsage=*/true});
+            if (!scene.positions.empty())
+                vertices.uploadSpan<glm::vec3>(scene.positions);
+            if (!scene.indices.empty())
+                indices.uploadSpan<std::uint32_t>(scene.indices);
+        }
         indexCount = static_cast<std::uint32_t>(scene.indices.size());
         uploadedPositions = scene.positions;
         uploadedIndices = scene.indices;
@@ -228,6 +238,13 @@ struct ShadowPass::State {
         uploaded = true;
     }
 };
+
+void ShadowPass::forgetGeometry()
+{
+    mState->uploaded = false;
+    mState->uploadedPositions.clear();
+    mState->uploadedIndices.clear();
+}
 
 ShadowPass::ShadowPass(gpu::Context& context, ShadowPassOptions options)
     : mState(std::make_unique<State>())

@@ -120,6 +120,9 @@ public:
     //! Compiles the shaders and creates the pipeline. Throws rtlab::Error for a bad option or
     //! when the device cannot draw.
     explicit ShadowPass(gpu::Context& context, ShadowPassOptions options = {});
+    //! The next rendering uploads the scene's geometry whole (by default a scene with as many
+    //! vertices and indices as the last uploads only the span that differs).
+    void forgetGeometry();
     ~ShadowPass();
     ShadowPass(ShadowPass&&) noexcept;
     ShadowPass& operator=(ShadowPass&&) noexcept;

@@ -164,6 +164,25 @@ void checkBusCounters(Context& context)
     EXPECT_EQ(run.readbackBytes, 0u);
 }
 
+TEST_F(ComputeTest, AChangedSpanUploadsOnlyFromTheFirstToTheLastChangedElement)
+{
+    std::vector<std::uint32_t> held(100);
+    for (std::uint32_t i = 0; i < 100; ++i)
+        held[i] = i * 7u;
+    Buffer buffer = getContext().createBuffer({.size = 100 * sizeof(std::uint32_t), .name = "patched"});
+    buffer.uploadSpan<std::uint32_t>(held);
+    std::vector<std::uint32_t> next = held;
+    next[10] = 1;
+    next[20] = 2;
+    const BusCounters before = getBusCounters();
+    EXPECT_EQ(uploadChangedSpan<std::uint32_t>(buffer, held, next), 11 * sizeof(std::uint32_t));
+    EXPECT_EQ((getBusCounters() - before).uploadBytes, 11 * sizeof(std::uint32_t));
+    EXPECT_EQ(buffer.downloadVector<std::uint32_t>(), next);
+    EXPECT_EQ(uploadChangedSpan<std::uint32_t>(buffer, next, next), 0u) << "nothing changed";
+    next.pop_back();
+    EXPECT_THROW(uploadChangedSpan<std::uint32_t>(buffer, held, next), Error);
+}
+
 TEST_F(ComputeTest, WhatCrossesTheBusIsCounted)
 {
     checkBusCounters(getContext());
