@@ -390,93 +390,20 @@ TEST(OcclusionDriver, TheLitFrameBindsTheTechniquesImagesWithoutARoundTripThroug
     EXPECT_EQ(0, std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)));
 }
 
-TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesAWalkerChangesAndTheFrameMatchesTheUnculledOne)
+// The three frames of the scene `sceneYaml` (two point lights in the Cornell box and something
+// that changes) lit with shadow maps, with culling on and off; every frame must be ok, the
+// unculled run redraws all 12 faces every frame, and the lit HDR frames must not differ by a bit.
+std::pair<std::vector<experiment::Row>, std::vector<experiment::Row>>
+runShadowFramesCulledAndNot(const std::string& name, const std::string& sceneYaml)
 {
-    // The Cornell box with two point lights and a small walking character, three frames. With
-    // culling the shadow pass redraws, after frame 0, only the cube faces that see the walker's
-    // old or new triangles and records the kept ones; without culling it redraws all 12 faces.
-    // The lit HDR frames must not differ by a bit.
     const auto& registry = plugin::builtinRegistry();
-    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_walker";
+    const auto dir = std::filesystem::temp_directory_path() / ("rtlab_occlusion_driver_" + name);
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
-    std::ofstream(dir / "walker.yaml")
-        << "scene: walker\nbase: cornell_box\nframes: 3\n"
-           "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n"
-           "  - {position: [0.1, 0.3, 0.45], intensity: [0.02, 0.03, 0.04]}\n"
-           "characters:\n  - name: walker\n"
-           "    capsules: [{a: [0, 0.03, 0], b: [0, 0.1, 0], radius: 0.03}]\n"
-           "    path: [{time: 0, position: [0.4, 0, 0.1]}, {time: 0.2, position: [0.45, 0, "
-           "0.2]}]\n";
-    auto run = [&](const std::string& culling) {
-        const auto e =
-            experiment::parseExperiment(R"(base:
-  scene: walker.yaml
-  resolution: [32, 24]
-  frames: 3
-  metrics: [error]
-  frame: {lighting: true, shadow_map_size: 32, culling: )" +
-                                            culling + R"(}
-  timing: {warmup: 0, repeats: 1}
-  reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 4}
-  techniques: {occlusion: {technique: gtao}}
-)",
-                                        (dir / ("walker_" + culling + ".yaml")).string(), registry);
-        return runAndLoad(e, registry, (dir / ("out_" + culling)).string());
-    };
-    const auto culled = run("true");
-    const auto all = run("false");
-    ASSERT_EQ(culled.size(), 3u) << (culled.empty() ? "" : culled[0].at("error"));
-    ASSERT_EQ(all.size(), 3u) << (all.empty() ? "" : all[0].at("error"));
-    for (std::size_t i = 0; i < 3; ++i) {
-        ASSERT_EQ(culled[i].at("status"), "ok") << culled[i].at("error");
-        ASSERT_EQ(all[i].at("status"), "ok") << all[i].at("error");
-        EXPECT_EQ(all[i].at("frame.shadow_faces_rendered"), "12") << "frame " << i;
-        EXPECT_EQ(all[i].at("frame.shadow_skips"), "") << "frame " << i;
-        if (i == 0) {
-            EXPECT_EQ(culled[i].at("frame.shadow_faces_rendered"), "12");
-        } else {
-            EXPECT_NE(culled[i].at("passes").find("shadow_maps:run"), std::string::npos)
-                << culled[i].at("passes");
-            const double faces = experiment::getNumber(culled[i], "frame.shadow_faces_rendered");
-            EXPECT_GT(faces, 0.0) << "frame " << i;
-            EXPECT_LT(faces, 12.0) << "frame " << i;
-            EXPECT_NE(culled[i].at("frame.shadow_skips").find("in their view"), std::string::npos)
-                << culled[i].at("frame.shadow_skips");
-        }
-        const Image<glm::vec3> a = experiment::readExrRgb(culled[i].at("image.lit_hdr"));
-        const Image<glm::vec3> b = experiment::readExrRgb(all[i].at("image.lit_hdr"));
-        ASSERT_EQ(a.pixels.size(), b.pixels.size());
-        EXPECT_EQ(
-            std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
-            << "lit frame " << i;
-    }
-}
-
-TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesADigChangesAndTheFrameMatchesTheUnculledOne)
-{
-    // A rock dug at frame 1 in the Cornell box, two point lights, three frames. With culling the
-    // shadow pass bounds what changed by the dig's primitive (grown by its blend and the
-    // mesher's reach), not by comparing triangles, and redraws only the cube faces that see that
-    // box; at frame 2 nothing moved and it is skipped. The lit HDR frames must not differ by a bit
-    // from the unculled run, which redraws all 12 faces every frame.
-    const auto& registry = plugin::builtinRegistry();
-    const auto dir = std::filesystem::temp_directory_path() / "rtlab_occlusion_driver_dig";
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    std::ofstream(dir / "dig.yaml")
-        << "scene: dig\nbase: cornell_box\nframes: 3\n"
-           "sdf_models:\n  - name: rock\n    bounds: [[0.32, 0.0, 0.05], [0.52, 0.2, 0.25]]\n"
-           "    resolution: 48\n    edits:\n"
-           "      - {shape: rounded_box, op: add, center: [0.42, 0.08, 0.15], size: [0.08, 0.08, 0.08], "
-           "rounding: 0.02, material: white}\n"
-           "      - {shape: sphere, op: subtract, center: [0.47, 0.15, 0.10], size: 0.05, blend: 0.01, "
-           "frame: 1}\n"
-           "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n"
-           "  - {position: [0.1, 0.3, 0.45], intensity: [0.02, 0.03, 0.04]}\n";
+    std::ofstream(dir / (name + ".yaml")) << sceneYaml;
     auto run = [&](const std::string& culling) {
         const auto e = experiment::parseExperiment(R"(base:
-  scene: dig.yaml
+  scene: )" + name + R"(.yaml
   resolution: [32, 24]
   frames: 3
   camera_path: static
@@ -486,34 +413,76 @@ TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesADigChangesAndTheFrameMatchesT
   reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 4}
   techniques: {occlusion: {technique: gtao}}
 )",
-                                                   (dir / ("dig_" + culling + ".yaml")).string(), registry);
+                                                   (dir / (name + "_" + culling + ".yaml")).string(), registry);
         return runAndLoad(e, registry, (dir / ("out_" + culling)).string());
     };
-    const auto culled = run("true");
-    const auto all = run("false");
-    ASSERT_EQ(culled.size(), 3u) << (culled.empty() ? "" : culled[0].at("error"));
-    ASSERT_EQ(all.size(), 3u) << (all.empty() ? "" : all[0].at("error"));
-    for (std::size_t i = 0; i < 3; ++i) {
-        ASSERT_EQ(culled[i].at("status"), "ok") << culled[i].at("error");
-        ASSERT_EQ(all[i].at("status"), "ok") << all[i].at("error");
+    auto culled = run("true");
+    auto all = run("false");
+    EXPECT_EQ(culled.size(), 3u) << (culled.empty() ? "" : culled[0].at("error"));
+    EXPECT_EQ(all.size(), 3u) << (all.empty() ? "" : all[0].at("error"));
+    for (std::size_t i = 0; i < std::min(culled.size(), all.size()); ++i) {
+        EXPECT_EQ(culled[i].at("status"), "ok") << culled[i].at("error");
+        EXPECT_EQ(all[i].at("status"), "ok") << all[i].at("error");
         EXPECT_EQ(all[i].at("frame.shadow_faces_rendered"), "12") << "frame " << i;
-        if (i == 1) {
-            const double faces = experiment::getNumber(culled[i], "frame.shadow_faces_rendered");
-            EXPECT_GT(faces, 0.0);
-            EXPECT_LT(faces, 12.0);
-            EXPECT_NE(culled[i].at("frame.shadow_skips").find("no caster moved in their view"),
-                      std::string::npos)
-                << culled[i].at("frame.shadow_skips");
-        }
-        if (i == 2)
-            EXPECT_NE(culled[i].at("passes").find("shadow_maps:skipped"), std::string::npos)
-                << culled[i].at("passes");
+        EXPECT_EQ(all[i].at("frame.shadow_skips"), "") << "frame " << i;
+        if (culled[i].at("status") != "ok" || all[i].at("status") != "ok")
+            continue;
         const Image<glm::vec3> a = experiment::readExrRgb(culled[i].at("image.lit_hdr"));
         const Image<glm::vec3> b = experiment::readExrRgb(all[i].at("image.lit_hdr"));
-        ASSERT_EQ(a.pixels.size(), b.pixels.size());
-        EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
-            << "lit frame " << i;
+        EXPECT_EQ(a.pixels.size(), b.pixels.size());
+        if (a.pixels.size() == b.pixels.size())
+            EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(glm::vec3)), 0)
+                << "lit frame " << i;
     }
+    return {std::move(culled), std::move(all)};
+}
+
+constexpr const char* kTwoLights =
+    "point_lights:\n  - {position: [0.28, 0.45, 0.2], intensity: [0.05, 0.05, 0.04]}\n"
+    "  - {position: [0.1, 0.3, 0.45], intensity: [0.02, 0.03, 0.04]}\n";
+
+TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesAWalkerChangesAndTheFrameMatchesTheUnculledOne)
+{
+    // A small walking character. With culling the shadow pass redraws, after frame 0, only the
+    // cube faces that see the walker's old or new capsule and records the kept ones.
+    const auto [culled, all] = runShadowFramesCulledAndNot(
+        "walker", std::string("scene: walker\nbase: cornell_box\nframes: 3\n") + kTwoLights +
+                      "characters:\n  - name: walker\n"
+                      "    capsules: [{a: [0, 0.03, 0], b: [0, 0.1, 0], radius: 0.03}]\n"
+                      "    path: [{time: 0, position: [0.4, 0, 0.1]}, {time: 0.2, position: [0.45, 0, "
+                      "0.2]}]\n");
+    ASSERT_EQ(culled.size(), 3u);
+    EXPECT_EQ(culled[0].at("frame.shadow_faces_rendered"), "12");
+    for (std::size_t i = 1; i < 3; ++i) {
+        EXPECT_NE(culled[i].at("passes").find("shadow_maps:run"), std::string::npos) << culled[i].at("passes");
+        const double faces = experiment::getNumber(culled[i], "frame.shadow_faces_rendered");
+        EXPECT_GT(faces, 0.0) << "frame " << i;
+        EXPECT_LT(faces, 12.0) << "frame " << i;
+        EXPECT_NE(culled[i].at("frame.shadow_skips").find("in their view"), std::string::npos)
+            << culled[i].at("frame.shadow_skips");
+    }
+}
+
+TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesADigChangesAndTheFrameMatchesTheUnculledOne)
+{
+    // A rock dug at frame 1. With culling the shadow pass bounds what changed by the dig's
+    // primitive (grown by its blend and the mesher's reach), not by comparing triangles, and
+    // redraws only the cube faces that see that box; at frame 2 nothing moved and it is skipped.
+    const auto [culled, all] = runShadowFramesCulledAndNot(
+        "dig", std::string("scene: dig\nbase: cornell_box\nframes: 3\n") + kTwoLights +
+                   "sdf_models:\n  - name: rock\n    bounds: [[0.32, 0.0, 0.05], [0.52, 0.2, 0.25]]\n"
+                   "    resolution: 48\n    edits:\n"
+                   "      - {shape: rounded_box, op: add, center: [0.42, 0.08, 0.15], size: [0.08, 0.08, 0.08], "
+                   "rounding: 0.02, material: white}\n"
+                   "      - {shape: sphere, op: subtract, center: [0.47, 0.15, 0.10], size: 0.05, blend: 0.01, "
+                   "frame: 1}\n");
+    ASSERT_EQ(culled.size(), 3u);
+    const double faces = experiment::getNumber(culled[1], "frame.shadow_faces_rendered");
+    EXPECT_GT(faces, 0.0);
+    EXPECT_LT(faces, 12.0);
+    EXPECT_NE(culled[1].at("frame.shadow_skips").find("no caster moved in their view"), std::string::npos)
+        << culled[1].at("frame.shadow_skips");
+    EXPECT_NE(culled[2].at("passes").find("shadow_maps:skipped"), std::string::npos) << culled[2].at("passes");
 }
 
 TEST(OcclusionDriver, VulkanTechniquesReadTheGBufferOnTheGpuWithTheSameResult)
