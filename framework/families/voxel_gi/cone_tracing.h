@@ -74,8 +74,20 @@ struct ConeSample {
     double voxelSize = 1.0;                     //!< size of the voxels sampled (opacity correction)
     //! The same voxels' optical depths (computeOpticalDepth of each voxel's occupancy seen along
     //! the cone) with the same weights as alpha: what the sky's transmittance is marched with
-    //! (marchCone). 0 from a sampler that does not give it: its voxels do not hide the sky.
+    //! (marchCone), given when `wantsDepth`. 0 from a sampler that does not give it: its voxels
+    //! do not hide the sky.
     float depth = 0.0f;
+    //! Set by marchCone before a sample whose optical depth it uses (a logarithm per voxel the
+    //! sample reads, which the light's march and the injection do without); kept by clear().
+    bool wantsDepth = false;
+
+    //! Back to an empty sample, keeping wantsDepth (what a sampler starts with).
+    void clear()
+    {
+        const bool keep = wantsDepth;
+        *this = ConeSample{};
+        wantsDepth = keep;
+    }
 };
 
 struct ConeMarchSettings {
@@ -149,6 +161,7 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
             break;
         const double diameter = 2.0 * t * s.tanHalfAngle;
         const glm::dvec3 p = origin + t * dir;
+        sample.wantsDepth = s.sky && s.skyOpticalDepth && t >= s.skyStartDistance;
         if (!sampler.sample(p, diameter, cone, dir, sample)) {
             r.escaped = !lightDone;
             r.skyEscaped = true;

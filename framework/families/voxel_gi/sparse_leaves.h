@@ -168,7 +168,8 @@ void sampleSparseLevel(const Find& find, const glm::dvec3& origin, double cellSi
             const std::size_t g = std::size_t(e) * kFaceCount + std::size_t(faceSeen[a]);
             const glm::vec4& v = payload.gathered[g];
             out.alpha += aw * v.a;
-            out.depth += aw * computeOpticalDepth(v.a);
+            if (out.wantsDepth)
+                out.depth += aw * computeOpticalDepth(v.a);
             if constexpr (Gathered) {
                 out.light[kDirect] += aw * glm::vec3(v);
                 // The emitters the pixels' cones meet (kept only when some leaf emits).

@@ -136,7 +136,7 @@ bool VoxelTreeCones::sampleAt(const glm::dvec3& p, double diameter, const glm::d
     const glm::dvec3 rel = (p - mOrigin) / mBoxSize;
     if (!(rel.x >= 0.0 && rel.y >= 0.0 && rel.z >= 0.0 && rel.x <= 1.0 && rel.y <= 1.0 && rel.z <= 1.0))
         return false;
-    out = ConeSample{};
+    out.clear();
     const int depth = mSettings.depth;
     // m = log4(d / leaf) levels above the leaves, linear between the two levels around it.
     const double m = std::min(double(depth), diameter > mLeafSize ? 0.5 * std::log2(diameter / mLeafSize) : 0.0);

@@ -614,7 +614,7 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
             const glm::vec4& v = coneRow[vox];
             out.alpha += fw * v.a;
             // The optical depth per face, blended as the faces were (cone_tracing.h ConeSample).
-            for (int axis = 0; axis < 3; ++axis) {
+            for (int axis = 0; axis < 3 && out.wantsDepth; ++axis) {
                 const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
                 out.depth += fw * float(dir[axis] * dir[axis]) * computeOpticalDepth(level.alpha[f]);
             }
@@ -632,7 +632,8 @@ void CascadeVolume::sampleLevel(const Level& level, const glm::dvec3& p, int con
                 continue;
             const std::size_t f = vox * kFaceCount + std::size_t(getFaceSeen(axis, dir[axis]));
             out.alpha += aw * level.alpha[f];
-            out.depth += aw * computeOpticalDepth(level.alpha[f]);
+            if (out.wantsDepth)
+                out.depth += aw * computeOpticalDepth(level.alpha[f]);
             if (gathered) {
                 out.light[kDirect] += aw * getGatheredLight(level, f);
                 if (level.emits)
@@ -652,7 +653,7 @@ bool CascadeVolume::sampleAt(const glm::dvec3& p, double diameter, int cone, con
     const double l = selectLevel(p, diameter, Gathered);
     if (l < 0.0)
         return false;
-    out = ConeSample{};
+    out.clear();
     const int l0 = int(std::floor(l));
     const float frac = float(l - l0);
     sampleLevel(mLevels[std::size_t(l0)], p, cone, dir, Gathered, 1.0f - frac, out);

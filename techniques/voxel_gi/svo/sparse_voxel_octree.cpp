@@ -278,7 +278,7 @@ bool SparseVoxelOctree::sampleAt(const glm::dvec3& p, double diameter, const glm
     const glm::dvec3 rel = (p - mOrigin) / mSide;
     if (!(rel.x >= 0.0 && rel.y >= 0.0 && rel.z >= 0.0 && rel.x <= 1.0 && rel.y <= 1.0 && rel.z <= 1.0))
         return false;
-    out = ConeSample{};
+    out.clear();
     const double leaf = getLeafSize();
     // The level whose voxels are as wide as the footprint (m levels above the leaves), and the
     // linear blend with the next coarser one (quadrilinear).
@@ -328,7 +328,8 @@ void SparseVoxelOctree::sampleBrickLevel(int level, const glm::dvec3& p, const g
             const float w = aw * cornerWeight[corner];
             const glm::vec4& v = mGatheredBricks[brick + std::size_t(corner)];
             out.alpha += w * v.a;
-            out.depth += w * computeOpticalDepth(v.a);
+            if (out.wantsDepth)
+                out.depth += w * computeOpticalDepth(v.a);
             if constexpr (Gathered) {
                 out.light[kDirect] += w * glm::vec3(v);
             } else {
