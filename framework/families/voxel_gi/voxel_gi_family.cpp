@@ -17,14 +17,14 @@
 //   voxel_rays, metric.indirect_split  the error split: the technique's voxels gathered along
 //                           rays (traceVoxelRays) against its cones and against the truth
 //   reference_cone_sky, voxel_sky_rays, metric.sky_split  the same for the cones' sky in a lit
-//                           frame that takes it (traceVoxelSkyRays; truth: Embree "direct"
-//                           without the point lights)
+//                           frame that takes it (cone_sky_split.h)
 //   metric.indirect_flicker the frame-to-frame change of the error along the camera path
 //                           (remember_indirect keeps the previous frame for it)
 //   images_indirect         technique, reference (and its standard error) and signed error as EXR
 // (names of their own, so that the family runs beside the occlusion family in one frame)
 
 #include "families/voxel_gi/voxel_gi.h"
+#include "families/voxel_gi/cone_sky_split.h"
 #include "families/voxel_gi/stress_cases.h"
 
 #include "core/error.h"
@@ -441,8 +441,15 @@ private:
                               .set("split.rays_per_pixel", std::int64_t(kSplitRays));
                           return pipeline::PassOutcome{};
                       });
-        if (wantsConeSky())
-            addConeSkySplit(graph, geometry, gbuffer, view, voxelLight, coneSky);
+        if (wantsConeSky()) {
+            voxelgi::addConeSkySplit(graph,
+                                     {.geometry = geometry, .gbuffer = gbuffer, .view = view,
+                                      .voxelLight = voxelLight, .coneSky = coneSky},
+                                     {.width = w, .height = h, .technique = mTechnique.get(),
+                                      .techniqueName = mTechniqueName, .reference = mSettings,
+                                      .raysPerPixel = kSplitRays, .row = &mRow});
+            mSkySplit = true;
+        }
         // Flicker along the camera path: the frame-to-frame change of the indirect light's
         // error at reprojected points (metrics/temporal_metrics.h), on luminance.
         const auto previous = graph.addExternal<PreviousIndirect>(
@@ -522,85 +529,6 @@ private:
                 if (m.name == "flicker")
                     setup.outputs.push_back("indirect_frame_memory");
             }
-    }
-
-    // The split of the cones' sky (metric split, in a lit frame that takes it): the technique's
-    // voxels along rays, each seeing the sky in its own direction (traceVoxelSkyRays), against
-    // the truth's direct irradiance without the point lights (split.sky_voxel_*: the voxels),
-    // and the cones' sky as the frame takes it, visibilities and capsules included, against
-    // those rays (split.sky_cone_*) and against the truth (sky.*).
-    template <class Geometry, class GBufferRes, class View, class Light, class Slot>
-    void addConeSkySplit(pipeline::FrameGraph& graph, const Geometry& geometry, const GBufferRes& gbuffer,
-                         const View& view, const Light& voxelLight, const Slot& coneSky)
-    {
-        const int w = mRun.width, h = mRun.height;
-        const pipeline::Resource<reference::ReferenceResult> skyTruth{
-            "ground_truth_cone_sky", pipeline::ResourceType::cpuImage("reference direct, no point lights", w, h)};
-        graph.addPass({.name = "reference_cone_sky",
-                       .reads = {geometry, gbuffer},
-                       .writes = {skyTruth},
-                       .measurement = true},
-                      [this, geometry, gbuffer, skyTruth](pipeline::PassContext& ctx) {
-                          scene::RenderScene g = ctx.read(geometry);
-                          g.pointLights.clear();
-                          reference::ReferenceSettings settings = mSettings;
-                          settings.quantity = reference::Quantity::Direct;
-                          reference::ReferenceResult& t = ctx.write(skyTruth);
-                          t = reference::computeReference(g, ctx.read(gbuffer), settings);
-                          mRow->set("reference_cone_sky.seconds", t.stats.seconds)
-                              .set("reference_cone_sky.from_cache", t.stats.fromCache);
-                          return pipeline::PassOutcome{};
-                      });
-        const pipeline::Resource<Image<glm::vec3>> skyRays{
-            "voxel_sky_rays", pipeline::ResourceType::cpuImage("vec3", w, h)};
-        graph.addPass({.name = "voxel_sky_rays",
-                       .reads = {voxelLight, gbuffer, geometry},
-                       .writes = {skyRays},
-                       .measurement = true},
-                      [this, gbuffer, geometry, skyRays](pipeline::PassContext& ctx) {
-                          plugin::VoxelGiInput input;
-                          input.gbuffer = &ctx.read(gbuffer);
-                          input.frameIndex = ctx.frame();
-                          input.coneSky = true;
-                          Image<glm::vec3>& out = ctx.write(skyRays);
-                          if (!mTechnique->traceVoxelSkyRays(input, kSplitRays, ctx.read(geometry).sky, out)) {
-                              out = Image<glm::vec3>();
-                              return pipeline::PassOutcome::skipped(
-                                  "technique '" + mTechniqueName + "' traces no voxel sky rays");
-                          }
-                          return pipeline::PassOutcome{};
-                      });
-        graph.addPass({.name = "metric.sky_split",
-                       .reads = {coneSky, skyRays, skyTruth, view},
-                       .writes = {"metric.sky_split"},
-                       .measurement = true},
-                      [this, coneSky, skyRays, skyTruth, view](pipeline::PassContext& ctx) {
-                          const Image<glm::vec3>& cones = ctx.read(coneSky);
-                          const Image<glm::vec3>& rays = ctx.read(skyRays);
-                          const Image<glm::vec3>& truth = ctx.read(skyTruth).irradiance;
-                          const auto& surface = ctx.read(view).surface;
-                          metrics::ImageErrorOptions o;
-                          o.range = metrics::DynamicRange::Hdr;
-                          o.withSsim = false;
-                          o.withFlip = false;
-                          const auto sized = [&](const Image<glm::vec3>& i) {
-                              return i.width == truth.width && i.height == truth.height;
-                          };
-                          const double nan = std::nan("");
-                          const auto put = [&](const std::string& name, const Image<glm::vec3>& a,
-                                               const Image<glm::vec3>& b) {
-                              const bool have = sized(a) && sized(b);
-                              const auto e = have ? metrics::computeImageErrors(a, b, o, surface)
-                                                  : metrics::ImageErrors{};
-                              mRow->set(name + "rmse", have ? e.rmse : nan)
-                                  .set(name + "mean_signed_error", have ? e.meanSignedError : nan);
-                          };
-                          put("sky.", cones, truth);
-                          put("split.sky_cone_", cones, rays);
-                          put("split.sky_voxel_", rays, truth);
-                          return pipeline::PassOutcome{};
-                      });
-        mSkySplit = true;
     }
 
     const experiment::RunConfig& mRun;
