@@ -141,19 +141,23 @@ void CsgEdit::getBounds(glm::dvec3& lo, glm::dvec3& hi) const
     hi = center + world;
 }
 
+double CsgEdit::applyTo(double d, const glm::dvec3& p) const
+{
+    const double s = evaluatePrimitive(p);
+    switch (op) {
+    case CsgOp::Add: return computeSmoothMin(d, s, blend);
+    case CsgOp::Subtract: return -computeSmoothMin(-d, s, blend);   // max(d, -s)
+    case CsgOp::Intersect: return -computeSmoothMin(-d, -s, blend); // max(d, s)
+    }
+    return d;
+}
+
 double SdfModel::evaluate(const glm::dvec3& p, int frame) const
 {
     double d = std::numeric_limits<double>::infinity();
-    for (const auto& e : edits) {
-        if (e.frame > frame)
-            continue;
-        const double s = e.evaluatePrimitive(p);
-        switch (e.op) {
-        case CsgOp::Add: d = computeSmoothMin(d, s, e.blend); break;
-        case CsgOp::Subtract: d = -computeSmoothMin(-d, s, e.blend); break;   // max(d, -s)
-        case CsgOp::Intersect: d = -computeSmoothMin(-d, -s, e.blend); break; // max(d, s)
-        }
-    }
+    for (const auto& e : edits)
+        if (e.frame <= frame)
+            d = e.applyTo(d, p);
     return d;
 }
 

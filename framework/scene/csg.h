@@ -47,6 +47,9 @@ struct CsgEdit {
     double evaluatePrimitive(const glm::dvec3& p) const;
     //! A bound on the primitive's extent: every point with distance <= 0 lies in this box.
     void getBounds(glm::dvec3& lo, glm::dvec3& hi) const;
+    //! The field after this edit at p, given the field d before it (SdfModel::evaluate folds
+    //! this over its edits in list order; the incremental mesher folds new edits the same way).
+    double applyTo(double d, const glm::dvec3& p) const;
 };
 
 //! Polynomial smooth minimum with blend radius k [Quilez 2013]: equal to min(a, b) when

@@ -5,6 +5,10 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
+#include <cstring>
+#include <bit>
+#include <climits>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -13,24 +17,617 @@ namespace rtlab::scene {
 
 namespace {
 
-constexpr std::uint32_t kNoVertex = std::numeric_limits<std::uint32_t>::max();
+constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+constexpr int kNotMeshed = INT_MIN;
+// Cells an edit's reach adds around its primitive (findEditReach: 2 sqrt(3) cells times a
+// Lipschitz constant up to 2).
+constexpr double kReachCells = 7.0;
 
-struct Grid {
-    glm::ivec3 samples;  // sample count per axis
-    glm::dvec3 origin;
-    double spacing;
-    std::vector<double> values;
+const int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
+                           {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+const int kEdge[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
+                          {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
 
-    std::size_t index(int x, int y, int z) const
-    {
-        return (std::size_t(z) * samples.y + y) * samples.x + x;
-    }
-    glm::dvec3 position(int x, int y, int z) const { return origin + spacing * glm::dvec3(x, y, z); }
-};
+void growBox(glm::dvec3& lo, glm::dvec3& hi, const glm::vec3& p)
+{
+    lo = glm::min(lo, glm::dvec3(p));
+    hi = glm::max(hi, glm::dvec3(p));
+}
+
+// Distance from p to the box [lo, hi] (0 inside): outside the box, a lower bound of the distance
+// of an exact primitive that lies in it.
+double getBoxDistance(const glm::dvec3& p, const glm::dvec3& lo, const glm::dvec3& hi)
+{
+    return glm::length(glm::max(glm::max(lo - p, p - hi), 0.0));
+}
 
 } // namespace
 
-SdfMesh meshSdfModel(const SdfModel& model, const SdfMeshOptions& options)
+double getSdfCellSize(const SdfModel& model, int resolution)
+{
+    const glm::dvec3 extent = model.boundsMax - model.boundsMin;
+    return std::max({extent.x, extent.y, extent.z}) / double(std::max(resolution, 1));
+}
+
+bool findEditReach(const SdfModel& model, const CsgEdit& edit, int resolution, glm::dvec3& lo,
+                   glm::dvec3& hi)
+{
+    if (edit.op == CsgOp::Intersect || edit.shape == CsgShape::Ellipsoid)
+        return false;
+    edit.getBounds(lo, hi);
+    // The Newton steps' gradient stencil (csg.cpp evaluateGradient) reaches a little farther.
+    const double stencil = 1e-5 * std::max(1.0, glm::length(model.boundsMax - model.boundsMin));
+    const double margin =
+        std::max(edit.blend, 0.0) + kReachCells * getSdfCellSize(model, resolution) + stencil;
+    lo -= margin;
+    hi += margin;
+    return true;
+}
+
+struct SdfMesher::State {
+    const SdfModel* model = nullptr;
+    SdfMeshOptions options;
+    glm::ivec3 cells{0};
+    glm::ivec3 samples{0};
+    glm::dvec3 origin{0.0};
+    double spacing = 0.0;
+    int meshedFrame = kNotMeshed;
+    std::vector<double> raw;     // the field at each sample
+    std::vector<double> values;  // the same, the padding shell pushed outside
+    std::vector<std::uint32_t> cellVertex;  // vertex of each cell, kNone when not crossed
+    std::vector<std::uint32_t> vertexCell;  // cell of each vertex
+    std::vector<std::uint32_t> edgeQuad;    // quad (triangles 2q, 2q + 1) of each grid edge
+    std::vector<std::uint32_t> quadEdge;    // edge of each quad
+    SdfMesh mesh;
+
+    // Scratch of the incremental update, kept between calls: fresh memory costs its first
+    // touch, which on a dig's few percent of the grid would cost more than the meshing. A cell,
+    // edge or vertex is marked in this update when its stamp equals `stamp`.
+    struct Quad {
+        std::uint32_t slot = kNone;
+        std::array<std::uint32_t, 6> indices{};
+        std::array<std::uint32_t, 2> materials{};
+    };
+    std::uint32_t stamp = 0;
+    std::vector<std::uint32_t> cellStamp, edgeStamp, vertexStamp;
+    std::vector<std::vector<std::uint32_t>> changedBySlice;
+    std::vector<std::uint32_t> dirtyCells;
+    std::vector<std::size_t> edges;
+    std::vector<Quad> before, after;
+    std::vector<glm::vec3> newPosition;
+    std::vector<std::uint8_t> crossed;
+
+    std::size_t sampleIndex(int x, int y, int z) const
+    {
+        return (std::size_t(z) * samples.y + y) * samples.x + x;
+    }
+    std::size_t cellIndex(int x, int y, int z) const
+    {
+        return (std::size_t(z) * cells.y + y) * cells.x + x;
+    }
+    glm::ivec3 cellCoords(std::size_t c) const
+    {
+        return {int(c % std::size_t(cells.x)), int((c / std::size_t(cells.x)) % std::size_t(cells.y)),
+                int(c / (std::size_t(cells.x) * std::size_t(cells.y)))};
+    }
+    // Edge along `axis` from sample p0 to p0 + e_axis.
+    std::size_t edgeIndex(int axis, const glm::ivec3& p0) const
+    {
+        return std::size_t(axis) * samples.x * samples.y * samples.z + sampleIndex(p0.x, p0.y, p0.z);
+    }
+    glm::dvec3 position(int x, int y, int z) const { return origin + spacing * glm::dvec3(x, y, z); }
+    bool isPadding(int x, int y, int z) const
+    {
+        return x == 0 || y == 0 || z == 0 || x == samples.x - 1 || y == samples.y - 1 ||
+               z == samples.z - 1;
+    }
+    // The padding shell is outside by construction: closed surfaces stay closed even when the
+    // model touches its bounds.
+    double padded(double v, int x, int y, int z) const
+    {
+        return isPadding(x, y, z) ? std::max(v, spacing * 0.5) : v;
+    }
+
+    // One vertex per crossed cell, at the mean of its edge crossings, then Newton-projected.
+    bool computeVertex(int x, int y, int z, int frame, glm::vec3& out) const
+    {
+        double v[8];
+        int inside = 0;
+        for (int c = 0; c < 8; ++c) {
+            v[c] = values[sampleIndex(x + kCorner[c][0], y + kCorner[c][1], z + kCorner[c][2])];
+            inside += v[c] < 0.0;
+        }
+        if (inside == 0 || inside == 8)
+            return false;
+        glm::dvec3 sum(0.0);
+        int crossings = 0;
+        for (const auto& e : kEdge) {
+            const double a = v[e[0]], b = v[e[1]];
+            if ((a < 0.0) == (b < 0.0))
+                continue;
+            const double t = a / (a - b);
+            const glm::dvec3 pa(kCorner[e[0]][0], kCorner[e[0]][1], kCorner[e[0]][2]);
+            const glm::dvec3 pb(kCorner[e[1]][0], kCorner[e[1]][1], kCorner[e[1]][2]);
+            sum += pa + t * (pb - pa);
+            ++crossings;
+        }
+        const glm::dvec3 cellMin = position(x, y, z);
+        glm::dvec3 p = cellMin + spacing * (sum / double(crossings));
+        // Newton steps on the field, kept within half a cell of the cell so that sharp features
+        // cannot pull vertices across their neighbours (which would fold the mesh); the surface
+        // may leave the cell's own box between two crossings.
+        const glm::dvec3 lo = cellMin - glm::dvec3(0.5 * spacing);
+        const glm::dvec3 hi = cellMin + glm::dvec3(1.5 * spacing);
+        for (int s = 0; s < options.projectionSteps; ++s) {
+            const double f = model->evaluate(p, frame);
+            if (!std::isfinite(f))
+                break;
+            p = glm::clamp(p - f * model->evaluateGradient(p, frame), lo, hi);
+        }
+        out = glm::vec3(p);
+        return true;
+    }
+
+    // One quad per crossed grid edge, between the four cells around it, wound counter-clockwise
+    // seen from outside: for an edge along axis a with u = a+1, v = a+2 (cyclic), the cells in
+    // the order (u-,v-), (u+,v-), (u+,v+), (u-,v+) are counter-clockwise seen from +a.
+    bool computeQuad(int axis, const glm::ivec3& p0, std::uint32_t tri[6]) const
+    {
+        const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+        glm::ivec3 p1 = p0;
+        p1[axis] += 1;
+        if (p1[axis] >= samples[axis] || p0[u] == 0 || p0[w] == 0 || p0[u] >= cells[u] ||
+            p0[w] >= cells[w])
+            return false;
+        const bool in0 = values[sampleIndex(p0.x, p0.y, p0.z)] < 0.0;
+        const bool in1 = values[sampleIndex(p1.x, p1.y, p1.z)] < 0.0;
+        if (in0 == in1)
+            return false;
+        std::uint32_t q[4];
+        const int du[4] = {-1, 0, 0, -1}, dw[4] = {-1, -1, 0, 0};
+        for (int k = 0; k < 4; ++k) {
+            glm::ivec3 c = p0;
+            c[u] += du[k];
+            c[w] += dw[k];
+            q[k] = cellVertex[cellIndex(c.x, c.y, c.z)];
+            if (q[k] == kNone)
+                return false;
+        }
+        if (!in0) // the surface faces -axis: reverse the winding
+            std::swap(q[1], q[3]);
+        const auto& positions = mesh.mesh.positions;
+        // Split along the shorter diagonal: fewer slivers.
+        const float d02 = glm::distance(positions[q[0]], positions[q[2]]);
+        const float d13 = glm::distance(positions[q[1]], positions[q[3]]);
+        const std::uint32_t split02[6] = {q[0], q[1], q[2], q[0], q[2], q[3]};
+        const std::uint32_t split13[6] = {q[0], q[1], q[3], q[1], q[2], q[3]};
+        std::copy_n(d02 <= d13 ? split02 : split13, 6, tri);
+        return true;
+    }
+
+    // The material at the triangle's centroid.
+    std::uint32_t computeMaterial(const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
+                                  int frame) const
+    {
+        return model->evaluateMaterial((glm::dvec3(a) + glm::dvec3(b) + glm::dvec3(c)) / 3.0, frame);
+    }
+
+    void meshAll(int frame);
+    // Folds `added` (edits after every applied one) into the grid and re-meshes what they
+    // touched; `reach` is each added edit's findEditReach box.
+    void meshIncrementally(int frame, const std::vector<const CsgEdit*>& added,
+                           const std::vector<std::pair<glm::dvec3, glm::dvec3>>& reach,
+                           SdfMeshChange& change);
+};
+
+void SdfMesher::State::meshAll(int frame)
+{
+    raw.resize(std::size_t(samples.x) * samples.y * samples.z);
+    values.resize(raw.size());
+    tbb::parallel_for(0, samples.z, [&](int z) {
+        for (int y = 0; y < samples.y; ++y)
+            for (int x = 0; x < samples.x; ++x) {
+                const std::size_t i = sampleIndex(x, y, z);
+                raw[i] = model->evaluate(position(x, y, z), frame);
+                values[i] = padded(raw[i], x, y, z);
+            }
+    });
+    auto& positions = mesh.mesh.positions;
+    positions.clear();
+    vertexCell.clear();
+    cellVertex.assign(std::size_t(cells.x) * cells.y * cells.z, kNone);
+    for (int z = 0; z < cells.z; ++z)
+        for (int y = 0; y < cells.y; ++y)
+            for (int x = 0; x < cells.x; ++x) {
+                glm::vec3 p;
+                if (!computeVertex(x, y, z, frame, p))
+                    continue;
+                const std::size_t c = cellIndex(x, y, z);
+                cellVertex[c] = std::uint32_t(positions.size());
+                vertexCell.push_back(std::uint32_t(c));
+                positions.push_back(p);
+            }
+
+    auto& indices = mesh.mesh.indices;
+    indices.clear();
+    quadEdge.clear();
+    edgeQuad.assign(3 * raw.size(), kNone);
+    for (int axis = 0; axis < 3; ++axis)
+        for (int z = 0; z < samples.z; ++z)
+            for (int y = 0; y < samples.y; ++y)
+                for (int x = 0; x < samples.x; ++x) {
+                    std::uint32_t tri[6];
+                    const glm::ivec3 p0(x, y, z);
+                    if (!computeQuad(axis, p0, tri))
+                        continue;
+                    const std::size_t e = edgeIndex(axis, p0);
+                    edgeQuad[e] = std::uint32_t(quadEdge.size());
+                    quadEdge.push_back(std::uint32_t(e));
+                    indices.insert(indices.end(), tri, tri + 6);
+                }
+
+    // The incremental update's marks, touched here once rather than on a dig frame.
+    cellStamp.assign(cellVertex.size(), 0u);
+    edgeStamp.assign(edgeQuad.size(), 0u);
+    vertexStamp.assign(positions.size(), 0u);
+
+    mesh.mesh.normals.resize(positions.size());
+    tbb::parallel_for(std::size_t(0), positions.size(), [&](std::size_t i) {
+        mesh.mesh.normals[i] = glm::vec3(model->evaluateGradient(glm::dvec3(positions[i]), frame));
+    });
+    mesh.triangleMaterial.resize(indices.size() / 3);
+    tbb::parallel_for(std::size_t(0), mesh.triangleMaterial.size(),
+                      [&](std::size_t t) {
+                          mesh.triangleMaterial[t] = computeMaterial(
+                              positions[indices[3 * t]], positions[indices[3 * t + 1]],
+                              positions[indices[3 * t + 2]], frame);
+                      });
+}
+
+void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgEdit*>& added,
+                                         const std::vector<std::pair<glm::dvec3, glm::dvec3>>& reach,
+                                         SdfMeshChange& change)
+{
+    auto& positions = mesh.mesh.positions;
+    auto& normals = mesh.mesh.normals;
+    auto& indices = mesh.mesh.indices;
+    auto& materials = mesh.triangleMaterial;
+    if (++stamp == 0) { // wrapped: every old mark must go
+        std::fill(cellStamp.begin(), cellStamp.end(), 0u);
+        std::fill(edgeStamp.begin(), edgeStamp.end(), 0u);
+        std::fill(vertexStamp.begin(), vertexStamp.end(), 0u);
+        stamp = 1;
+    }
+    cellStamp.resize(cellVertex.size(), 0u);
+    edgeStamp.resize(edgeQuad.size(), 0u);
+    dirtyCells.clear();
+    const auto markCell = [&](int x, int y, int z) {
+        if (x < 0 || y < 0 || z < 0 || x >= cells.x || y >= cells.y || z >= cells.z)
+            return;
+        const std::size_t c = cellIndex(x, y, z);
+        if (cellStamp[c] != stamp) {
+            cellStamp[c] = stamp;
+            dirtyCells.push_back(std::uint32_t(c));
+        }
+    };
+
+    // 1. The new edits folded into the samples: SdfModel::evaluate applies the edits in list
+    //    order and the new ones come after every applied one, so this is the value evaluating
+    //    them all gives, bit for bit. An edit changes a sample only where its primitive is
+    //    closer than the field's own value allows (csg.cpp: max(d, -s) = d when s >= -d, min(d, s)
+    //    = d when s >= d, beyond the blend radius); outside the primitive's box the distance to
+    //    the box bounds an exact primitive's distance from below, so farther samples skip it.
+    std::vector<glm::dvec3> boundsLo(added.size()), boundsHi(added.size());
+    for (std::size_t k = 0; k < added.size(); ++k)
+        added[k]->getBounds(boundsLo[k], boundsHi[k]);
+    changedBySlice.resize(std::size_t(samples.z));
+    tbb::parallel_for(0, samples.z, [&](int z) {
+        auto& changed = changedBySlice[std::size_t(z)];
+        changed.clear();
+        for (int y = 0; y < samples.y; ++y)
+            for (int x = 0; x < samples.x; ++x) {
+                const std::size_t i = sampleIndex(x, y, z);
+                const glm::dvec3 p = position(x, y, z);
+                double d = raw[i];
+                for (std::size_t k = 0; k < added.size(); ++k) {
+                    const CsgEdit& e = *added[k];
+                    const double threshold =
+                        (e.op == CsgOp::Add ? d : -d) + std::max(e.blend, 0.0);
+                    // Outside the box only (inside it the primitive's distance may be
+                    // negative); the slack covers the rounding of the primitive's evaluation.
+                    const double boxDistance = getBoxDistance(p, boundsLo[k], boundsHi[k]);
+                    if (boxDistance > 0.0 &&
+                        boxDistance > threshold + 1e-9 * (1.0 + std::abs(threshold)))
+                        continue;
+                    d = e.applyTo(d, p);
+                }
+                if (std::bit_cast<std::uint64_t>(d) == std::bit_cast<std::uint64_t>(raw[i]))
+                    continue;
+                raw[i] = d;
+                values[i] = padded(d, x, y, z);
+                changed.push_back(std::uint32_t(i));
+            }
+    });
+    // The cells around each changed sample (it is a corner of each).
+    for (const auto& slice : changedBySlice)
+        for (const std::uint32_t i : slice) {
+            ++change.samplesChanged;
+            const int x = int(i % std::uint32_t(samples.x));
+            const int y = int((i / std::uint32_t(samples.x)) % std::uint32_t(samples.y));
+            const int z = int(i / (std::uint32_t(samples.x) * std::uint32_t(samples.y)));
+            for (int dz = -1; dz <= 0; ++dz)
+                for (int dy = -1; dy <= 0; ++dy)
+                    for (int dx = -1; dx <= 0; ++dx)
+                        markCell(x + dx, y + dy, z + dz);
+        }
+    // 2. Cells whose vertex window (the cell grown by half a cell, where the Newton steps stay)
+    //    meets an edit's reach: their vertex may move although no corner changed.
+    for (const auto& [lo, hi] : reach) {
+        const glm::ivec3 begin =
+            glm::max(glm::ivec3(glm::floor((lo - origin) / spacing - 1.5)), glm::ivec3(0));
+        const glm::ivec3 end =
+            glm::min(glm::ivec3(glm::ceil((hi - origin) / spacing + 0.5)) + 1, cells);
+        for (int z = begin.z; z < end.z; ++z)
+            for (int y = begin.y; y < end.y; ++y)
+                for (int x = begin.x; x < end.x; ++x)
+                    markCell(x, y, z);
+    }
+    change.cellsMeshed = dirtyCells.size();
+
+    // The slots written, for the caller's patching.
+    std::size_t vLo = SIZE_MAX, vHi = 0, tLo = SIZE_MAX, tHi = 0;
+    const std::size_t vertexCountBefore = positions.size(), quadCountBefore = quadEdge.size();
+    const auto touchVertex = [&](std::size_t v) {
+        vLo = std::min(vLo, v);
+        vHi = std::max(vHi, v + 1);
+    };
+    const auto touchQuad = [&](std::size_t q) {
+        tLo = std::min(tLo, 2 * q);
+        tHi = std::max(tHi, 2 * q + 2);
+    };
+    const auto grow = [&](const glm::vec3& p) { growBox(change.changedMin, change.changedMax, p); };
+    // The 12 edges a cell borders: along each axis, the edges whose four cells include it.
+    const auto forEachCellEdge = [&](std::uint32_t cell, auto&& visit) {
+        const glm::ivec3 c = cellCoords(cell);
+        for (int axis = 0; axis < 3; ++axis) {
+            const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+            for (int a = 0; a < 2; ++a)
+                for (int b = 0; b < 2; ++b) {
+                    glm::ivec3 p0 = c;
+                    p0[u] += a;
+                    p0[w] += b;
+                    visit(axis, p0);
+                }
+        }
+    };
+
+    // 3. The quads on the dirty cells' edges, as they were: each edge once, in the order the
+    //    dirty cells first reach it, and only an edge that has a quad or whose ends now differ
+    //    in sign (no other edge can have one after).
+    edges.clear();
+    for (const std::uint32_t cell : dirtyCells)
+        forEachCellEdge(cell, [&](int axis, const glm::ivec3& p0) {
+            const std::size_t e = edgeIndex(axis, p0);
+            if (edgeStamp[e] == stamp)
+                return;
+            edgeStamp[e] = stamp;
+            glm::ivec3 p1 = p0;
+            p1[axis] += 1;
+            if (edgeQuad[e] != kNone ||
+                (p1[axis] < samples[axis] && (values[sampleIndex(p0.x, p0.y, p0.z)] < 0.0) !=
+                                                 (values[sampleIndex(p1.x, p1.y, p1.z)] < 0.0)))
+                edges.push_back(e);
+        });
+    before.resize(edges.size());
+    after.resize(edges.size());
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+        Quad& q = before[k];
+        q.slot = edgeQuad[edges[k]];
+        if (q.slot == kNone)
+            continue;
+        std::copy_n(indices.begin() + std::ptrdiff_t(6 * std::size_t(q.slot)), 6, q.indices.begin());
+        q.materials = {materials[2 * std::size_t(q.slot)], materials[2 * std::size_t(q.slot) + 1]};
+    }
+
+    // 4. The dirty cells' vertices, computed again (in parallel: each reads the field only); a
+    //    cell still crossed keeps its slot. A vertex that moves, leaves or arrives is stamped,
+    //    and its old and new positions go into the changed box.
+    newPosition.resize(dirtyCells.size());
+    crossed.assign(dirtyCells.size(), 0);
+    tbb::parallel_for(std::size_t(0), dirtyCells.size(), [&](std::size_t k) {
+        const glm::ivec3 c = cellCoords(dirtyCells[k]);
+        crossed[k] = computeVertex(c.x, c.y, c.z, frame, newPosition[k]) ? 1 : 0;
+    });
+    vertexStamp.resize(positions.size(), 0u);
+    std::vector<std::uint32_t> freeVertices, written;
+    std::size_t nextFreeVertex = 0;
+    bool changed = false;
+    for (std::size_t k = 0; k < dirtyCells.size(); ++k) {
+        const std::uint32_t cell = dirtyCells[k];
+        const std::uint32_t old = cellVertex[cell];
+        if (!crossed[k]) {
+            if (old != kNone) {
+                freeVertices.push_back(old);
+                vertexCell[old] = kNone;
+                vertexStamp[old] = stamp;
+                cellVertex[cell] = kNone;
+                grow(positions[old]);
+                changed = true;
+            }
+            continue;
+        }
+        std::uint32_t v = old;
+        if (v == kNone) {
+            if (nextFreeVertex < freeVertices.size()) {
+                v = freeVertices[nextFreeVertex++];
+            } else {
+                v = std::uint32_t(positions.size());
+                positions.emplace_back();
+                normals.emplace_back();
+                vertexCell.push_back(kNone);
+                vertexStamp.push_back(0u);
+            }
+        } else if (std::bit_cast<glm::uvec3>(positions[v]) ==
+                   std::bit_cast<glm::uvec3>(newPosition[k])) {
+            continue; // the same vertex: nothing to write
+        } else {
+            grow(positions[v]);
+        }
+        changed = true;
+        positions[v] = newPosition[k];
+        grow(positions[v]);
+        vertexCell[v] = cell;
+        vertexStamp[v] = stamp;
+        cellVertex[cell] = v;
+        written.push_back(v);
+        touchVertex(v);
+    }
+    freeVertices.erase(freeVertices.begin(), freeVertices.begin() + std::ptrdiff_t(nextFreeVertex));
+    tbb::parallel_for(std::size_t(0), written.size(), [&](std::size_t k) {
+        const std::uint32_t v = written[k];
+        normals[v] = glm::vec3(model->evaluateGradient(glm::dvec3(positions[v]), frame));
+    });
+
+    // 5. The quads on the same edges built again, with their materials (in parallel), then put
+    //    in place: a quad that is still there keeps its slot, a new one takes a freed slot or
+    //    goes at the end. A quad whose indices, materials and corners are unchanged is the same
+    //    quad; any other goes into the changed box (a corner that moved is already there with
+    //    its old position).
+    tbb::parallel_for(std::size_t(0), edges.size(), [&](std::size_t k) {
+        const std::size_t e = edges[k];
+        const int axis = int(e / raw.size());
+        const std::size_t s = e % raw.size();
+        const glm::ivec3 p0(int(s % std::size_t(samples.x)),
+                            int((s / std::size_t(samples.x)) % std::size_t(samples.y)),
+                            int(s / (std::size_t(samples.x) * std::size_t(samples.y))));
+        Quad& q = after[k];
+        q.slot = kNone;
+        if (!computeQuad(axis, p0, q.indices.data()))
+            return;
+        q.slot = 0; // built; the slot is chosen below
+        for (std::size_t t = 0; t < 2; ++t)
+            q.materials[t] = computeMaterial(positions[q.indices[3 * t]], positions[q.indices[3 * t + 1]],
+                                             positions[q.indices[3 * t + 2]], frame);
+    });
+    const auto moved = [&](const Quad& q) {
+        return std::any_of(q.indices.begin(), q.indices.end(),
+                           [&](std::uint32_t v) { return vertexStamp[v] == stamp; });
+    };
+    std::vector<std::uint32_t> freeQuads;
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+        const Quad& b = before[k];
+        const Quad& a = after[k];
+        if (b.slot == kNone && a.slot == kNone)
+            continue; // no quad before or after
+        if (b.slot != kNone && a.slot == kNone) {
+            freeQuads.push_back(b.slot);
+            edgeQuad[edges[k]] = kNone;
+            quadEdge[b.slot] = kNone;
+        }
+        if (b.slot != kNone && a.slot != kNone && b.indices == a.indices &&
+            b.materials == a.materials && !moved(a))
+            continue;
+        changed = true;
+        for (const Quad* q : {&b, &a})
+            if (q->slot != kNone)
+                for (const std::uint32_t v : q->indices)
+                    grow(positions[v]);
+    }
+    std::size_t nextFreeQuad = 0;
+    for (std::size_t k = 0; k < edges.size(); ++k) {
+        if (after[k].slot == kNone)
+            continue;
+        std::uint32_t q = before[k].slot;
+        if (q == kNone) {
+            if (nextFreeQuad < freeQuads.size()) {
+                q = freeQuads[nextFreeQuad++];
+            } else {
+                q = std::uint32_t(quadEdge.size());
+                quadEdge.push_back(kNone);
+                indices.resize(indices.size() + 6);
+                materials.resize(materials.size() + 2);
+            }
+        } else if (before[k].indices == after[k].indices &&
+                   before[k].materials == after[k].materials) {
+            continue; // the same bytes in the same slot
+        }
+        std::copy(after[k].indices.begin(), after[k].indices.end(),
+                  indices.begin() + std::ptrdiff_t(6 * std::size_t(q)));
+        materials[2 * std::size_t(q)] = after[k].materials[0];
+        materials[2 * std::size_t(q) + 1] = after[k].materials[1];
+        quadEdge[q] = std::uint32_t(edges[k]);
+        edgeQuad[edges[k]] = q;
+        touchQuad(q);
+    }
+    freeQuads.erase(freeQuads.begin(), freeQuads.begin() + std::ptrdiff_t(nextFreeQuad));
+
+    // 6. Compaction: the live slots past the new end fill the holes below it, so the arrays
+    //    hold no unused vertex and no degenerate triangle (what a full re-mesh would give).
+    if (!freeQuads.empty()) {
+        changed = true;
+        const std::size_t end = quadEdge.size() - freeQuads.size();
+        std::sort(freeQuads.begin(), freeQuads.end());
+        std::size_t hole = 0;
+        for (std::size_t q = end; q < quadEdge.size(); ++q) {
+            if (quadEdge[q] == kNone)
+                continue;
+            while (freeQuads[hole] >= end) // holes past the end vanish with it
+                ++hole;
+            const std::uint32_t h = freeQuads[hole++];
+            std::copy_n(indices.begin() + std::ptrdiff_t(6 * q), 6,
+                        indices.begin() + std::ptrdiff_t(6 * std::size_t(h)));
+            materials[2 * h] = materials[2 * q];
+            materials[2 * h + 1] = materials[2 * q + 1];
+            quadEdge[h] = quadEdge[q];
+            edgeQuad[quadEdge[h]] = h;
+            touchQuad(h);
+        }
+        quadEdge.resize(end);
+        indices.resize(6 * end);
+        materials.resize(2 * end);
+    }
+    if (!freeVertices.empty()) {
+        changed = true;
+        const std::size_t end = positions.size() - freeVertices.size();
+        std::sort(freeVertices.begin(), freeVertices.end());
+        std::size_t hole = 0;
+        for (std::size_t v = end; v < positions.size(); ++v) {
+            if (vertexCell[v] == kNone)
+                continue;
+            while (freeVertices[hole] >= end)
+                ++hole;
+            const std::uint32_t h = freeVertices[hole++];
+            positions[h] = positions[v];
+            normals[h] = normals[v];
+            vertexCell[h] = vertexCell[v];
+            cellVertex[vertexCell[h]] = h;
+            touchVertex(h);
+            // The quads that use the vertex are on its cell's edges.
+            forEachCellEdge(vertexCell[h], [&](int axis, const glm::ivec3& p0) {
+                const std::uint32_t q = edgeQuad[edgeIndex(axis, p0)];
+                if (q == kNone)
+                    return;
+                for (std::size_t k = 6 * std::size_t(q); k < 6 * std::size_t(q) + 6; ++k)
+                    if (indices[k] == v)
+                        indices[k] = h;
+                touchQuad(q);
+            });
+        }
+        positions.resize(end);
+        normals.resize(end);
+        vertexCell.resize(end);
+    }
+
+    change.changed = changed || positions.size() != vertexCountBefore ||
+                     quadEdge.size() != quadCountBefore;
+    change.vertexBegin = std::min(vLo, positions.size());
+    change.vertexEnd = std::max(std::min(vHi, positions.size()), change.vertexBegin);
+    change.triangleBegin = std::min(tLo, materials.size());
+    change.triangleEnd = std::max(std::min(tHi, materials.size()), change.triangleBegin);
+}
+
+SdfMesher::SdfMesher(const SdfModel& model, const SdfMeshOptions& options)
+    : mState(std::make_unique<State>())
 {
     if (options.resolution < 4 || options.resolution > 2048)
         throw std::invalid_argument("SDF mesh resolution must be in [4, 2048]");
@@ -38,128 +635,92 @@ SdfMesh meshSdfModel(const SdfModel& model, const SdfMeshOptions& options)
     const double longest = std::max({extent.x, extent.y, extent.z});
     if (!(longest > 0.0) || !std::isfinite(longest))
         throw std::invalid_argument("SDF model '" + model.name + "' has empty or non-finite bounds");
+    State& s = *mState;
+    s.model = &model;
+    s.options = options;
+    s.spacing = longest / options.resolution;
+    s.cells = glm::ivec3(glm::ceil(extent / s.spacing)) + 2; // one padding cell per side
+    s.samples = s.cells + 1;
+    s.origin = model.boundsMin - glm::dvec3(s.spacing);
+}
 
-    Grid g;
-    g.spacing = longest / options.resolution;
-    const glm::ivec3 cells = glm::ivec3(glm::ceil(extent / g.spacing)) + 2;  // one padding cell per side
-    g.samples = cells + 1;
-    g.origin = model.boundsMin - glm::dvec3(g.spacing);
-    g.values.resize(std::size_t(g.samples.x) * g.samples.y * g.samples.z);
-    tbb::parallel_for(0, g.samples.z, [&](int z) {
-        for (int y = 0; y < g.samples.y; ++y)
-            for (int x = 0; x < g.samples.x; ++x) {
-                double v = model.evaluate(g.position(x, y, z), options.frame);
-                // The padding shell is outside by construction: closed surfaces stay closed even
-                // when the model touches its bounds.
-                if (x == 0 || y == 0 || z == 0 || x == g.samples.x - 1 || y == g.samples.y - 1 ||
-                    z == g.samples.z - 1)
-                    v = std::max(v, g.spacing * 0.5);
-                g.values[g.index(x, y, z)] = v;
-            }
-    });
+SdfMesher::~SdfMesher() = default;
+SdfMesher::SdfMesher(SdfMesher&&) noexcept = default;
+SdfMesher& SdfMesher::operator=(SdfMesher&&) noexcept = default;
 
-    // One vertex per crossed cell, at the mean of its edge crossings, then Newton-projected.
-    auto cellIndex = [&](int x, int y, int z) { return (std::size_t(z) * cells.y + y) * cells.x + x; };
-    std::vector<std::uint32_t> cellVertex(std::size_t(cells.x) * cells.y * cells.z, kNoVertex);
-    SdfMesh out;
-    auto& positions = out.mesh.positions;
-    static const int kCorner[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0},
-                                      {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
-    static const int kEdge[12][2] = {{0, 1}, {2, 3}, {4, 5}, {6, 7}, {0, 2}, {1, 3},
-                                     {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6}, {3, 7}};
-    for (int z = 0; z < cells.z; ++z)
-        for (int y = 0; y < cells.y; ++y)
-            for (int x = 0; x < cells.x; ++x) {
-                double v[8];
-                int inside = 0;
-                for (int c = 0; c < 8; ++c) {
-                    v[c] = g.values[g.index(x + kCorner[c][0], y + kCorner[c][1], z + kCorner[c][2])];
-                    inside += v[c] < 0.0;
-                }
-                if (inside == 0 || inside == 8)
-                    continue;
-                glm::dvec3 sum(0.0);
-                int crossings = 0;
-                for (const auto& e : kEdge) {
-                    const double a = v[e[0]], b = v[e[1]];
-                    if ((a < 0.0) == (b < 0.0))
-                        continue;
-                    const double t = a / (a - b);
-                    const glm::dvec3 pa(kCorner[e[0]][0], kCorner[e[0]][1], kCorner[e[0]][2]);
-                    const glm::dvec3 pb(kCorner[e[1]][0], kCorner[e[1]][1], kCorner[e[1]][2]);
-                    sum += pa + t * (pb - pa);
-                    ++crossings;
-                }
-                const glm::dvec3 cellMin = g.position(x, y, z);
-                glm::dvec3 p = cellMin + g.spacing * (sum / double(crossings));
-                // Newton steps on the field, kept within half a cell of the cell so that sharp
-                // features cannot pull vertices across their neighbours (which would fold the
-                // mesh); the surface may leave the cell's own box between two crossings.
-                const glm::dvec3 lo = cellMin - glm::dvec3(0.5 * g.spacing);
-                const glm::dvec3 hi = cellMin + glm::dvec3(1.5 * g.spacing);
-                for (int s = 0; s < options.projectionSteps; ++s) {
-                    const double f = model.evaluate(p, options.frame);
-                    if (!std::isfinite(f))
-                        break;
-                    p = glm::clamp(p - f * model.evaluateGradient(p, options.frame), lo, hi);
-                }
-                cellVertex[cellIndex(x, y, z)] = std::uint32_t(positions.size());
-                positions.emplace_back(p);
-            }
+const SdfMesh& SdfMesher::getMesh() const { return mState->mesh; }
 
-    // One quad per crossed grid edge, between the four cells around it, wound counter-clockwise
-    // seen from outside: for an edge along axis a with u = a+1, v = a+2 (cyclic), the cells in
-    // the order (u-,v-), (u+,v-), (u+,v+), (u-,v+) are counter-clockwise seen from +a.
-    auto& indices = out.mesh.indices;
-    for (int axis = 0; axis < 3; ++axis) {
-        const int u = (axis + 1) % 3, w = (axis + 2) % 3;
-        for (int z = 0; z < g.samples.z; ++z)
-            for (int y = 0; y < g.samples.y; ++y)
-                for (int x = 0; x < g.samples.x; ++x) {
-                    glm::ivec3 p0(x, y, z), p1 = p0;
-                    p1[axis] += 1;
-                    if (p1[axis] >= g.samples[axis] || p0[u] == 0 || p0[w] == 0 ||
-                        p0[u] >= cells[u] || p0[w] >= cells[w])
-                        continue;
-                    const bool in0 = g.values[g.index(p0.x, p0.y, p0.z)] < 0.0;
-                    const bool in1 = g.values[g.index(p1.x, p1.y, p1.z)] < 0.0;
-                    if (in0 == in1)
-                        continue;
-                    std::uint32_t q[4];
-                    const int du[4] = {-1, 0, 0, -1}, dw[4] = {-1, -1, 0, 0};
-                    bool complete = true;
-                    for (int k = 0; k < 4; ++k) {
-                        glm::ivec3 c = p0;
-                        c[u] += du[k];
-                        c[w] += dw[k];
-                        q[k] = cellVertex[cellIndex(c.x, c.y, c.z)];
-                        complete = complete && q[k] != kNoVertex;
-                    }
-                    if (!complete)
-                        continue;
-                    if (!in0)  // the surface faces -axis: reverse the winding
-                        std::swap(q[1], q[3]);
-                    // Split along the shorter diagonal: fewer slivers.
-                    const float d02 = glm::distance(positions[q[0]], positions[q[2]]);
-                    const float d13 = glm::distance(positions[q[1]], positions[q[3]]);
-                    if (d02 <= d13)
-                        indices.insert(indices.end(), {q[0], q[1], q[2], q[0], q[2], q[3]});
-                    else
-                        indices.insert(indices.end(), {q[0], q[1], q[3], q[1], q[2], q[3]});
-                }
+int SdfMesher::getMeshedFrame() const { return mState->meshedFrame; }
+
+SdfMeshChange SdfMesher::update(int frame, bool full)
+{
+    State& s = *mState;
+    SdfMeshChange change;
+    change.cellCount = std::size_t(s.cells.x) * s.cells.y * s.cells.z;
+    const auto& edits = s.model->edits;
+    std::string why;
+    std::vector<const CsgEdit*> added;
+    std::vector<std::pair<glm::dvec3, glm::dvec3>> reach;
+    if (s.meshedFrame == kNotMeshed) {
+        why = "first meshing";
+    } else if (full) {
+        why = "asked for in full";
+    } else {
+        std::ptrdiff_t lastApplied = -1;
+        for (std::size_t i = 0; i < edits.size(); ++i)
+            if (edits[i].frame <= s.meshedFrame)
+                lastApplied = std::ptrdiff_t(i);
+        for (std::size_t i = 0; i < edits.size() && why.empty(); ++i) {
+            const bool was = edits[i].frame <= s.meshedFrame, now = edits[i].frame <= frame;
+            if (was && !now)
+                why = "edit " + std::to_string(i) + " (frame " + std::to_string(edits[i].frame) +
+                      ") is not applied at frame " + std::to_string(frame);
+            else if (!was && now && std::ptrdiff_t(i) < lastApplied)
+                why = "edit " + std::to_string(i) + " (frame " + std::to_string(edits[i].frame) +
+                      ") comes before an applied edit in the list";
+            else if (!was && now)
+                added.push_back(&edits[i]);
+        }
+        for (std::size_t k = 0; k < added.size() && why.empty(); ++k) {
+            glm::dvec3 lo, hi;
+            if (!findEditReach(*s.model, *added[k], s.options.resolution, lo, hi))
+                why = std::string("edit ") + std::to_string(added[k] - edits.data()) + " (" +
+                      toString(added[k]->shape) + " " + toString(added[k]->op) +
+                      ") has no bounded reach";
+            reach.emplace_back(lo, hi);
+        }
     }
+    if (!why.empty()) {
+        s.meshAll(frame);
+        s.meshedFrame = frame;
+        change.changed = change.full = true;
+        change.cellsMeshed = change.cellCount;
+        change.samplesChanged = s.raw.size();
+        change.what = "meshed in full (" + why + ")";
+        for (const glm::vec3& p : s.mesh.mesh.positions)
+            growBox(change.changedMin, change.changedMax, p);
+        change.vertexEnd = s.mesh.mesh.positions.size();
+        change.triangleEnd = s.mesh.triangleMaterial.size();
+        return change;
+    }
+    s.meshedFrame = frame;
+    if (added.empty()) {
+        change.what = "no new edit";
+        return change;
+    }
+    s.meshIncrementally(frame, added, reach, change);
+    change.what = "re-meshed " + std::to_string(change.cellsMeshed) + " of " +
+                  std::to_string(change.cellCount) + " cells for " + std::to_string(added.size()) +
+                  " new edit" + (added.size() == 1 ? "" : "s") +
+                  (change.changed ? "" : " (the mesh did not change)");
+    return change;
+}
 
-    out.mesh.normals.resize(positions.size());
-    tbb::parallel_for(std::size_t(0), positions.size(), [&](std::size_t i) {
-        out.mesh.normals[i] = glm::vec3(model.evaluateGradient(glm::dvec3(positions[i]), options.frame));
-    });
-    out.triangleMaterial.resize(indices.size() / 3);
-    tbb::parallel_for(std::size_t(0), out.triangleMaterial.size(), [&](std::size_t t) {
-        const glm::dvec3 c = (glm::dvec3(positions[indices[3 * t]]) + glm::dvec3(positions[indices[3 * t + 1]]) +
-                              glm::dvec3(positions[indices[3 * t + 2]])) / 3.0;
-        out.triangleMaterial[t] = model.evaluateMaterial(c, options.frame);
-    });
-    return out;
+SdfMesh meshSdfModel(const SdfModel& model, const SdfMeshOptions& options)
+{
+    SdfMesher mesher(model, options);
+    mesher.update(options.frame);
+    return mesher.getMesh();
 }
 
 } // namespace rtlab::scene
