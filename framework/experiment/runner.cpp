@@ -275,6 +275,10 @@ std::vector<ResultRow> executeRun(const RunConfig& run, DriverContext& context,
         const auto records = graph.execute(options);
         row.set("frame.gpu_images_created", std::int64_t(graph.lastGpuAllocations()))
             .set("frame.gpu_images_reused", std::int64_t(graph.lastGpuReuses()));
+        if (start && start->getStats().remeshFrame == frame)
+            row.set("frame.sdf_remesh", start->getStats().remesh)
+                .set("frame.sdf_cells_meshed", start->getStats().cellsMeshed)
+                .set("frame.sdf_cells", start->getStats().cells);
         for (const auto& family : familyRuns)
             family->endFrame(frame, records, row);
         if (litFrame)

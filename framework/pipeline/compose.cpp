@@ -55,20 +55,17 @@ bool isSameCapsule(const scene::Capsule& x, const scene::Capsule& y)
 // Where the triangles may differ between the shadow maps' last rendering and this frame, from
 // what the scene says moved rather than from the triangles (nothing per triangle on the host):
 //  * each character capsule whose pose changed: its old and its new box;
-//  * each SDF edit that starts after `lastFrame` and by `frame`: its primitive's bounds grown by
-//    its blend radius (a soft edit changes nothing farther from its surface: the polynomial soft
-//    minimum equals the hard one there, scene/csg.h) and by 4 cells of its model's meshing grid
-//    (scene/sdf_mesher.cpp: a vertex moves with the field at the corners of its cell and at its
-//    Newton steps, within half a cell of it; its quads reach one cell further).
+//  * the SDF triangles the digs re-meshed since `lastFrame` (FrameStart::findSdfChangeSince:
+//    the box of the triangles a re-mesh removed or added).
 // `bounded` is false when the geometry changed and neither explains it (a capsule more or
-// fewer, or nothing moved at all): then every face is redrawn.
+// fewer, a full re-mesh, or nothing moved at all): then every face is redrawn.
 struct MovedBounds {
     std::vector<Box> boxes;
     bool bounded = true;
 };
 
-MovedBounds findMovedBounds(const scene::Scene& scene, const std::vector<scene::Capsule>& before,
-                            const std::vector<scene::Capsule>& now, int lastFrame, int frame)
+MovedBounds findMovedBounds(const FrameStart& start, const std::vector<scene::Capsule>& before,
+                            const std::vector<scene::Capsule>& now, int lastFrame)
 {
     MovedBounds moved;
     if (before.size() != now.size()) {
@@ -80,23 +77,16 @@ MovedBounds findMovedBounds(const scene::Scene& scene, const std::vector<scene::
             moved.boxes.push_back(getCapsuleBox(before[i]));
             moved.boxes.push_back(getCapsuleBox(now[i]));
         }
-    for (const scene::SdfModel& model : scene.sdfModels) {
-        const glm::dvec3 extent = model.boundsMax - model.boundsMin;
-        const double cell = std::max({extent.x, extent.y, extent.z}) / double(std::max(model.resolution, 1));
-        for (const scene::CsgEdit& edit : model.edits) {
-            if (edit.frame <= lastFrame || edit.frame > frame)
-                continue;
-            glm::dvec3 lo, hi;
-            edit.getBounds(lo, hi);
-            const double margin = std::max(edit.blend, 0.0) + 4.0 * cell;
-            // Outward to float, and never past the model's own box (nothing is meshed there).
-            lo = glm::max(lo - margin, model.boundsMin - 2.0 * cell);
-            hi = glm::min(hi + margin, model.boundsMax + 2.0 * cell);
-            if (!(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z))
-                continue; // the edit lies outside its model's box
+    if (!start.getScene().sdfModels.empty()) {
+        glm::dvec3 lo, hi;
+        if (!start.findSdfChangeSince(lastFrame, lo, hi)) {
+            moved.bounded = false;
+            return moved;
+        }
+        // Outward to float: the triangles' corners are floats inside the box.
+        if (lo.x <= hi.x)
             moved.boxes.push_back({glm::vec3(lo) - glm::abs(glm::vec3(lo)) * 1e-6f - 1e-6f,
                                    glm::vec3(hi) + glm::abs(glm::vec3(hi)) * 1e-6f + 1e-6f});
-        }
     }
     moved.bounded = !moved.boxes.empty();
     return moved;
@@ -328,8 +318,7 @@ void Compose::addPasses(FrameGraph& graph)
                            boundsMin != mShadowBoundsMin || boundsMax != mShadowBoundsMax;
             MovedBounds changed;
             if (!drawAll && ctx.read(geometryKey) != mShadowGeometryHash) {
-                changed = findMovedBounds(mStart.getScene(), mShadowCapsules, capsules, mShadowFrame,
-                                          ctx.frame());
+                changed = findMovedBounds(mStart, mShadowCapsules, capsules, mShadowFrame);
                 drawAll = !changed.bounded;
             }
             std::vector<std::uint8_t> masks(lightCount, 0);

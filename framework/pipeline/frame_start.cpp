@@ -63,6 +63,23 @@ Resource<gpu::RenderTarget> FrameStart::gbufferTarget() const
             }};
 }
 
+bool FrameStart::findSdfChangeSince(int since, glm::dvec3& lo, glm::dvec3& hi) const
+{
+    lo = glm::dvec3(1e300);
+    hi = glm::dvec3(-1e300);
+    if (mSdfChanges.empty() || since < mSdfChanges.front().frame)
+        return false; // before the first meshing
+    for (const SdfChange& c : mSdfChanges) {
+        if (c.frame <= since)
+            continue;
+        if (!c.bounded)
+            return false;
+        lo = glm::min(lo, c.lo);
+        hi = glm::max(hi, c.hi);
+    }
+    return true;
+}
+
 void FrameStart::addPasses(FrameGraph& graph)
 {
     const auto sceneRes =
@@ -90,7 +107,31 @@ void FrameStart::addPasses(FrameGraph& graph)
                            return std::string();
                        }},
                   [this, sdfMeshes](PassContext& ctx) {
-                      ctx.write(sdfMeshes) = mScene.meshSdfModels(ctx.frame());
+                      // A dig re-meshes only what it touched (scene/sdf_mesher.h); without
+                      // culling every model is meshed in full, as before the meshers kept
+                      // their grids (the ablation).
+                      if (mMeshers.empty())
+                          for (const scene::SdfModel& model : mScene.sdfModels)
+                              mMeshers.emplace_back(model, scene::SdfMeshOptions{.resolution = model.resolution});
+                      auto& meshes = ctx.write(sdfMeshes);
+                      meshes.resize(mMeshers.size());
+                      mStats = FrameStartStats{.remeshFrame = ctx.frame()};
+                      SdfChange logged{.frame = ctx.frame(), .bounded = true};
+                      for (std::size_t k = 0; k < mMeshers.size(); ++k) {
+                          const scene::SdfMeshChange change =
+                              mMeshers[k].update(ctx.frame(), !ctx.mayReuse());
+                          if (change.changed || meshes[k].mesh.positions.empty())
+                              meshes[k] = mMeshers[k].getMesh();
+                          logged.bounded = logged.bounded && !change.full;
+                          logged.lo = glm::min(logged.lo, change.changedMin);
+                          logged.hi = glm::max(logged.hi, change.changedMax);
+                          mStats.remesh += (mStats.remesh.empty() ? "" : "; ") +
+                                           mScene.sdfModels[k].name + ": " + change.what;
+                          mStats.cellsMeshed += std::int64_t(change.cellsMeshed);
+                          mStats.cells += std::int64_t(change.cellCount);
+                      }
+                      if (!logged.bounded || logged.lo.x <= logged.hi.x)
+                          mSdfChanges.push_back(logged);
                       mMeshedEditKey = mScene.getEditStateKey(ctx.frame());
                       mMeshedFrame = ctx.frame();
                       return PassOutcome{};

@@ -5,7 +5,8 @@
 //
 //   sdf_remesh         the scene's SDF models as triangles (needs sdf_models; reused while no
 //                      edit starts: the Dreams-style edit list,
-//                      shared/seeds/001_5c6096db92814698.txt)
+//                      shared/seeds/001_5c6096db92814698.txt); a dig re-meshes only the cells
+//                      it touched (scene::SdfMesher; in full with culling off, the ablation)
 //   character_pose     the characters' capsules at this frame (needs characters)
 //   assemble_geometry  the frame's triangles, lights and sky (scene::RenderScene)
 //   scene_upload       to the GPU (reused while the geometry is unchanged)
@@ -80,6 +81,14 @@ struct FrameStartOptions {
     int height = 180;
 };
 
+//! What the frame start's passes did in the last frame they ran (columns of the row).
+struct FrameStartStats {
+    int remeshFrame = -1;        //!< the frame sdf_remesh last ran in
+    std::string remesh;          //!< per SDF model, what SdfMesher::update did
+    std::int64_t cellsMeshed = 0; //!< cells whose vertex was computed, all models
+    std::int64_t cells = 0;       //!< cells of the models' grids
+};
+
 class FrameStart {
 public:
     //! Names of the resources the frame start writes.
@@ -103,6 +112,12 @@ public:
     const scene::FeatureSet& getFeatures() const { return mFeatures; }
     gpu::Context& getGpu() const { return mGpu; }
     const FrameStartOptions& getOptions() const { return mOptions; }
+    const FrameStartStats& getStats() const { return mStats; }
+    //! The box holding every SDF triangle that a re-mesh after frame `since` removed or added
+    //! (lo > hi when none did). False when that is not known: `since` is before the first
+    //! meshing, or a re-mesh since then was a full one. What a pass that keeps its own copy of
+    //! the geometry uses instead of comparing triangles.
+    bool findSdfChangeSince(int since, glm::dvec3& lo, glm::dvec3& hi) const;
 
     // Typed handles of the resources, for the families' passes.
     Resource<scene::Scene> scene() const { return {kScene, ResourceType::value("scene")}; }
@@ -162,6 +177,14 @@ private:
     std::unique_ptr<render::GBufferPass> mGBufferPass;
     std::unique_ptr<render::ViewInputsPass> mViewInputsPass;
     // What is reused between frames.
+    std::vector<scene::SdfMesher> mMeshers; //!< one per SDF model, each keeps its grid
+    struct SdfChange {
+        int frame = 0;
+        bool bounded = false; //!< false: meshed in full
+        glm::dvec3 lo{1e300}, hi{-1e300};
+    };
+    std::vector<SdfChange> mSdfChanges; //!< one per re-mesh that changed a mesh, oldest first
+    FrameStartStats mStats;
     std::uint64_t mMeshedEditKey = 0;
     int mMeshedFrame = -1;
     std::string mUploadedHash;

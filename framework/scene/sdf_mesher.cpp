@@ -561,61 +561,72 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
     }
     freeQuads.erase(freeQuads.begin(), freeQuads.begin() + std::ptrdiff_t(nextFreeQuad));
 
-    // 6. Compaction: the live slots past the new end fill the holes below it, so the arrays
-    //    hold no unused vertex and no degenerate triangle (what a full re-mesh would give).
-    if (!freeQuads.empty()) {
-        changed = true;
-        const std::size_t end = quadEdge.size() - freeQuads.size();
-        std::sort(freeQuads.begin(), freeQuads.end());
-        std::size_t hole = 0;
-        for (std::size_t q = end; q < quadEdge.size(); ++q) {
-            if (quadEdge[q] == kNone)
-                continue;
-            while (freeQuads[hole] >= end) // holes past the end vanish with it
-                ++hole;
-            const std::uint32_t h = freeQuads[hole++];
-            std::copy_n(indices.begin() + std::ptrdiff_t(6 * q), 6,
-                        indices.begin() + std::ptrdiff_t(6 * std::size_t(h)));
-            materials[2 * h] = materials[2 * q];
-            materials[2 * h + 1] = materials[2 * q + 1];
-            quadEdge[h] = quadEdge[q];
-            edgeQuad[quadEdge[h]] = h;
-            touchQuad(h);
+    // 6. The arrays back in the order a full meshing gives (vertices by cell, quads by edge,
+    //    as meshAll visits them), the freed slots dropped: the patched mesh is then the full
+    //    re-mesh byte for byte, not only up to order (rasterising the same triangles in another
+    //    order rounds some interpolated values differently, so the frame would not be bitwise
+    //    the unculled one). Only the dirty slots broke the order, so each array is a sorted run
+    //    with a few entries out of place; the rebuild is a copy with a remap of the indices.
+    {
+        if (!freeQuads.empty())
+            changed = true;
+        std::vector<std::uint32_t> quads;
+        quads.reserve(quadEdge.size());
+        for (std::uint32_t q = 0; q < quadEdge.size(); ++q)
+            if (quadEdge[q] != kNone)
+                quads.push_back(q);
+        const auto byEdge = [&](std::uint32_t x, std::uint32_t y) { return quadEdge[x] < quadEdge[y]; };
+        if (!std::is_sorted(quads.begin(), quads.end(), byEdge) || quads.size() != quadEdge.size()) {
+            std::sort(quads.begin(), quads.end(), byEdge);
+            std::vector<std::uint32_t> sortedIndices(6 * quads.size()), sortedMaterials(2 * quads.size()),
+                sortedEdges(quads.size());
+            for (std::size_t k = 0; k < quads.size(); ++k) {
+                const std::uint32_t q = quads[k];
+                std::copy_n(indices.begin() + std::ptrdiff_t(6 * std::size_t(q)), 6,
+                            sortedIndices.begin() + std::ptrdiff_t(6 * k));
+                sortedMaterials[2 * k] = materials[2 * std::size_t(q)];
+                sortedMaterials[2 * k + 1] = materials[2 * std::size_t(q) + 1];
+                sortedEdges[k] = quadEdge[q];
+                edgeQuad[quadEdge[q]] = std::uint32_t(k);
+                if (q != k)
+                    touchQuad(k);
+            }
+            indices = std::move(sortedIndices);
+            materials = std::move(sortedMaterials);
+            quadEdge = std::move(sortedEdges);
         }
-        quadEdge.resize(end);
-        indices.resize(6 * end);
-        materials.resize(2 * end);
-    }
-    if (!freeVertices.empty()) {
-        changed = true;
-        const std::size_t end = positions.size() - freeVertices.size();
-        std::sort(freeVertices.begin(), freeVertices.end());
-        std::size_t hole = 0;
-        for (std::size_t v = end; v < positions.size(); ++v) {
-            if (vertexCell[v] == kNone)
-                continue;
-            while (freeVertices[hole] >= end)
-                ++hole;
-            const std::uint32_t h = freeVertices[hole++];
-            positions[h] = positions[v];
-            normals[h] = normals[v];
-            vertexCell[h] = vertexCell[v];
-            cellVertex[vertexCell[h]] = h;
-            touchVertex(h);
-            // The quads that use the vertex are on its cell's edges.
-            forEachCellEdge(vertexCell[h], [&](int axis, const glm::ivec3& p0) {
-                const std::uint32_t q = edgeQuad[edgeIndex(axis, p0)];
-                if (q == kNone)
-                    return;
-                for (std::size_t k = 6 * std::size_t(q); k < 6 * std::size_t(q) + 6; ++k)
-                    if (indices[k] == v)
-                        indices[k] = h;
-                touchQuad(q);
-            });
+        std::vector<std::uint32_t> order;
+        order.reserve(positions.size());
+        for (std::uint32_t v = 0; v < positions.size(); ++v)
+            if (vertexCell[v] != kNone)
+                order.push_back(v);
+        const auto byCell = [&](std::uint32_t x, std::uint32_t y) { return vertexCell[x] < vertexCell[y]; };
+        if (!std::is_sorted(order.begin(), order.end(), byCell) || order.size() != positions.size()) {
+            std::sort(order.begin(), order.end(), byCell);
+            std::vector<std::uint32_t> remap(positions.size(), kNone);
+            std::vector<glm::vec3> sortedPositions(order.size()), sortedNormals(order.size());
+            std::vector<std::uint32_t> sortedCells(order.size());
+            for (std::size_t k = 0; k < order.size(); ++k) {
+                const std::uint32_t v = order[k];
+                remap[v] = std::uint32_t(k);
+                sortedPositions[k] = positions[v];
+                sortedNormals[k] = normals[v];
+                sortedCells[k] = vertexCell[v];
+                cellVertex[vertexCell[v]] = std::uint32_t(k);
+                if (v != k)
+                    touchVertex(k);
+            }
+            positions = std::move(sortedPositions);
+            normals = std::move(sortedNormals);
+            vertexCell = std::move(sortedCells);
+            for (std::size_t k = 0; k < indices.size(); ++k) {
+                const std::uint32_t i = remap[indices[k]];
+                if (i != indices[k]) {
+                    indices[k] = i;
+                    touchQuad(k / 6);
+                }
+            }
         }
-        positions.resize(end);
-        normals.resize(end);
-        vertexCell.resize(end);
     }
 
     change.changed = changed || positions.size() != vertexCountBefore ||

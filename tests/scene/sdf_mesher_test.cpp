@@ -1,6 +1,7 @@
 // The incremental SDF mesher: a dig re-meshes only the cells it touched, and the mesh it patches
-// has the same triangles (positions, winding, material) and vertex normals as meshing the whole
-// grid again, bit for bit, up to order.
+// is the mesh of meshing the whole grid again, bit for bit: the same triangles (positions,
+// winding, material) and vertex normals (checked as sets, which says what differs when it
+// fails), in the same order.
 
 #include "scene/procedural.h"
 #include "scene/sdf_mesher.h"
@@ -67,6 +68,14 @@ void expectSameMesh(const SdfMesh& patched, const SdfMesh& full, const std::stri
     EXPECT_EQ(patched.mesh.positions.size(), full.mesh.positions.size()) << where;
     EXPECT_TRUE(getTriangles(patched) == getTriangles(full)) << where << ": the triangles differ";
     EXPECT_TRUE(getVertices(patched) == getVertices(full)) << where << ": the vertices differ";
+    // And in the same order, byte for byte: the frame drawn from it is the full re-mesh's.
+    EXPECT_TRUE(patched.mesh.indices == full.mesh.indices) << where << ": the indices differ";
+    EXPECT_EQ(std::memcmp(patched.mesh.positions.data(), full.mesh.positions.data(),
+                          std::min(patched.mesh.positions.size(), full.mesh.positions.size()) *
+                              sizeof(glm::vec3)),
+              0)
+        << where << ": the positions' order differs";
+    EXPECT_TRUE(patched.triangleMaterial == full.triangleMaterial) << where << ": the materials differ";
 }
 
 CsgEdit makeEdit(CsgShape shape, CsgOp op, glm::dvec3 center, glm::dvec3 size, double blend,

@@ -50,6 +50,13 @@ struct VoxelGiDefinition {
 struct VoxelGiFrame {
     const scene::RenderScene* geometry = nullptr; //!< triangles, lights, sky
     std::string geometryKey;                      //!< changes exactly when `geometry` changes
+    //! When `changeKnown`: `geometry` differs from the geometry of key `changedFromKey` only by
+    //! triangles inside [changedMin, changedMax] (lo > hi: by none), the region the digs
+    //! re-meshed (pipeline::FrameStart::findSdfChangeSince). A technique that tracks what
+    //! changed uses it instead of comparing the triangles.
+    bool changeKnown = false;
+    std::string changedFromKey;
+    glm::dvec3 changedMin{1e300}, changedMax{-1e300};
     glm::dvec3 cameraPosition{0.0};
     int frameIndex = 0;
     bool force = false; //!< do the whole step even where nothing changed (culling off)

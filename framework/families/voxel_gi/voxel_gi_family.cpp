@@ -136,6 +136,10 @@ private:
         plugin::VoxelGiFrame f;
         f.geometry = &geometry;
         f.geometryKey = mGeometryKey;
+        f.changeKnown = mChangeKnown;
+        f.changedFromKey = mChangedFromKey;
+        f.changedMin = mChangedMin;
+        f.changedMax = mChangedMax;
         f.cameraPosition = glm::dvec3(mScene->getCameraAt(ctx.frame()).position);
         f.frameIndex = ctx.frame();
         f.force = !ctx.mayReuse();
@@ -152,6 +156,7 @@ private:
         pipeline::FrameGraph& graph = setup.graph;
         pipeline::FrameStart& start = *setup.frameStart;
         mScene = &start.getScene();
+        mStart = &start;
         mGraph = &graph;
         const int w = mRun.width, h = mRun.height;
         const auto sceneRes = start.scene();
@@ -191,6 +196,11 @@ private:
                 const auto* meshes = ctx.tryRead(sdfMeshes);
                 scene::RenderScene& g = ctx.write(staticGeometry);
                 g = mScene->assembleRenderScene(meshes ? *meshes : kNone, {}, ctx.frame());
+                // The static triangles change only where the digs re-meshed (characters are not
+                // voxelized): what changed since this pass last assembled them.
+                mChangeKnown = mGeometryFrame >= 0 && ctx.mayReuse() &&
+                               mStart->findSdfChangeSince(mGeometryFrame, mChangedMin, mChangedMax);
+                mChangedFromKey = mGeometryKey;
                 mGeometryKey = g.computeContentHash();
                 mGeometryEditKey = mScene->getEditStateKey(ctx.frame());
                 mGeometryFrame = ctx.frame();
@@ -540,7 +550,11 @@ private:
     plugin::VoxelGiDefinition mDefinition;
     reference::ReferenceSettings mSettings;
     const scene::Scene* mScene = nullptr;
+    const pipeline::FrameStart* mStart = nullptr;
     std::string mGeometryKey;
+    bool mChangeKnown = false; //!< VoxelGiFrame::changeKnown and the fields below
+    std::string mChangedFromKey;
+    glm::dvec3 mChangedMin{1e300}, mChangedMax{-1e300};
     std::uint64_t mGeometryEditKey = 0;
     int mGeometryFrame = -1;
     experiment::ResultRow* mRow = nullptr;

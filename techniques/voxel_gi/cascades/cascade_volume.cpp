@@ -93,7 +93,7 @@ void CascadeVolume::trackGeometryChange(const scene::RenderScene& geometry,
         keys[t] = {std::stoull(digest.substr(0, 16), nullptr, 16), lo, hi};
     }
     std::sort(keys.begin(), keys.end());
-    if (!mTrianglesKey.empty()) {
+    if (!mTrianglesKey.empty() && !mTrianglesStale) {
         // The symmetric difference of the two sorted triangle sets: what a dig (or any edit)
         // added or removed. Triangles kept unchanged by the re-mesh do not count.
         glm::dvec3 lo(1e300), hi(-1e300);
@@ -119,6 +119,24 @@ void CascadeVolume::trackGeometryChange(const scene::RenderScene& geometry,
     }
     mTriangles = std::move(keys);
     mTrianglesKey = geometryKey;
+    mTrianglesStale = false;
+}
+
+bool CascadeVolume::noteGeometryChange(const std::string& fromKey, const std::string& toKey,
+                                       const glm::dvec3& lo, const glm::dvec3& hi)
+{
+    if (mTrianglesKey.empty() || fromKey != mTrianglesKey)
+        return false;
+    if (toKey == mTrianglesKey)
+        return true;
+    for (Level& level : mLevels) {
+        level.changedMin = glm::min(level.changedMin, lo);
+        level.changedMax = glm::max(level.changedMax, hi);
+    }
+    mTriangles.clear();
+    mTrianglesKey = toKey;
+    mTrianglesStale = true;
+    return true;
 }
 
 std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
@@ -154,15 +172,17 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         level.region = region;
         level.centre = region.origin + 0.5 * double(region.resolution) * region.voxelSize;
         const int R = region.resolution;
-        const bool onlyScrolled = old.voxelized && geometryKey == old.geometryKey && !force &&
-                                  shift != glm::ivec3(0) && glm::all(glm::lessThan(glm::abs(shift), glm::ivec3(R)));
-        // Only the geometry changed: the box of voxels the changed triangles touch, one voxel
-        // wider (a voxel's solid fill and coverage depend on the rays through its column).
+        // What changed is known when the geometry is the same, or when the triangles that
+        // changed are (trackGeometryChange's box): then the old voxels are kept (shifted when
+        // the level scrolled) and only the new slabs and the changed box are voxelized.
+        const bool geometryChanged = geometryKey != old.geometryKey;
+        const bool changeKnown = !geometryChanged || old.changedMin.x <= old.changedMax.x;
+        const bool incremental = old.voxelized && !force && changeKnown &&
+                                 glm::all(glm::lessThan(glm::abs(shift), glm::ivec3(R)));
+        // The box of voxels the changed triangles touch, one voxel wider (a voxel's solid fill
+        // and coverage depend on the rays through its column), in the new region.
         glm::ivec3 dugBegin(0), dugEnd(0);
-        const bool onlyEdited = old.voxelized && !force && shift == glm::ivec3(0) &&
-                                geometryKey != old.geometryKey &&
-                                old.changedMin.x <= old.changedMax.x;
-        if (onlyEdited) {
+        if (incremental && geometryChanged) {
             dugBegin = glm::clamp(
                 glm::ivec3(glm::floor((old.changedMin - region.origin) / region.voxelSize)) - 1,
                 glm::ivec3(0), glm::ivec3(R));
@@ -170,7 +190,8 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 glm::ivec3(glm::floor((old.changedMax - region.origin) / region.voxelSize)) + 2,
                 dugBegin, glm::ivec3(R));
         }
-        if (onlyEdited && old.region == region && glm::any(glm::lessThanEqual(dugEnd, dugBegin))) {
+        const bool dugInside = glm::all(glm::lessThan(dugBegin, dugEnd));
+        if (incremental && geometryChanged && shift == glm::ivec3(0) && !dugInside) {
             // The change lies outside the level: its voxels, and so its light, are what they were.
             // The level is kept as it is (no new voxel stamp: the light injection and the finer
             // levels that read it have nothing to redo).
@@ -184,25 +205,10 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 ": the change lies outside the level, nothing re-voxelized (voxels and light kept)";
             continue;
         }
-        if (onlyEdited) {
-            // "Voxelize ... any geometry that has just appeared or been changed" (the dug region).
-            level.grid = shiftVoxelGrid(old.grid, region, glm::ivec3(0));
-            const glm::ivec3 extent = dugEnd - dugBegin;
-            const std::size_t boxVoxels =
-                std::size_t(extent.x) * std::size_t(extent.y) * std::size_t(extent.z);
-            if (boxVoxels > 0) {
-                VoxelizeOptions options{.supersampling = mSettings.supersampling,
-                                        .solid = mSettings.solid};
-                options.boxBegin = dugBegin;
-                options.boxEnd = dugEnd;
-                pasteVoxelBox(voxelizeRegion(region, options), dugBegin, dugEnd, level.grid);
-            }
-            finalizeVoxelGrid(level.grid); // the list of surface voxels, which the copy lacks
-            why += ": re-voxelized the changed region (" + std::to_string(boxVoxels) + " of " +
-                   std::to_string(region.getVoxelCount()) + " voxels)";
-        } else if (onlyScrolled) {
+        if (incremental) {
             // Keep the voxels the old region shares with the new one and voxelize only the new
-            // slabs ("Voxelize if Cascade level has moved": the geometry at the edges).
+            // slabs ("Voxelize if Cascade level has moved": the geometry at the edges) and
+            // "any geometry that has just appeared or been changed" (the dug region).
             level.grid = shiftVoxelGrid(old.grid, region, shift);
             std::size_t slabVoxels = 0;
             for (int a = 0; a < 3; ++a) {
@@ -214,11 +220,32 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 options.boxEnd[a] = shift[a] > 0 ? R : -shift[a];
                 const VoxelGrid slab = voxelizeRegion(region, options);
                 pasteVoxelBox(slab, options.boxBegin, options.boxEnd, level.grid);
-                slabVoxels += std::size_t(std::abs(shift[a])) * std::size_t(R) * std::size_t(R);
             }
-            finalizeVoxelGrid(level.grid);
-            why += ", voxelized the new slabs (" + std::to_string(slabVoxels) + " of " +
-                   std::to_string(region.getVoxelCount()) + " voxels)";
+            // The slabs' union: every voxel outside the box the old region shares.
+            const glm::ivec3 kept = glm::ivec3(R) - glm::abs(shift);
+            slabVoxels = region.getVoxelCount() -
+                         std::size_t(kept.x) * std::size_t(kept.y) * std::size_t(kept.z);
+            std::size_t boxVoxels = 0;
+            if (dugInside) {
+                VoxelizeOptions options{.supersampling = mSettings.supersampling,
+                                        .solid = mSettings.solid};
+                options.boxBegin = dugBegin;
+                options.boxEnd = dugEnd;
+                pasteVoxelBox(voxelizeRegion(region, options), dugBegin, dugEnd, level.grid);
+                const glm::ivec3 extent = dugEnd - dugBegin;
+                boxVoxels = std::size_t(extent.x) * std::size_t(extent.y) * std::size_t(extent.z);
+            }
+            finalizeVoxelGrid(level.grid); // the list of surface voxels, which the copy lacks
+            const std::string total = std::to_string(region.getVoxelCount());
+            if (shift != glm::ivec3(0))
+                why += ", voxelized the new slabs (" + std::to_string(slabVoxels) + " of " + total +
+                       " voxels)";
+            if (geometryChanged && dugInside)
+                why += std::string(shift != glm::ivec3(0) ? " and" : ":") +
+                       " re-voxelized the changed region (" + std::to_string(boxVoxels) + " of " +
+                       total + " voxels)";
+            else if (geometryChanged)
+                why += " (the geometry's change lies outside the level)";
         } else {
             level.grid = voxelizeRegion(region, {.supersampling = mSettings.supersampling,
                                                  .solid = mSettings.solid});

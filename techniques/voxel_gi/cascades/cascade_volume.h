@@ -121,6 +121,12 @@ public:
     //! Re-voxelizes the due levels whose region or geometry changed (all when `force`), with
     //! `voxelizer` when given, else voxelizeTriangles. Returns a description of what it did (""
     //! when nothing).
+    //! Tells the volume that the geometry of key `toKey` differs from that of `fromKey` only by
+    //! triangles inside [lo, hi] (lo > hi: none), so that the next voxelize() of `toKey` need not
+    //! compare the triangles to find it. Ignored (false) unless `fromKey` is the geometry the
+    //! volume saw last.
+    bool noteGeometryChange(const std::string& fromKey, const std::string& toKey,
+                            const glm::dvec3& lo, const glm::dvec3& hi);
     std::string voxelize(const scene::RenderScene& geometry, const std::string& geometryKey,
                          const glm::dvec3& camera, int frame, bool force, const Voxelizer& voxelizer = {});
     //! The irradiance per face of the surface voxels of a level (in the order of its
@@ -276,6 +282,9 @@ private:
     };
     std::vector<TriangleKey> mTriangles; //!< of the last geometry seen, sorted by hash
     std::string mTrianglesKey;
+    //! mTriangles is not that of mTrianglesKey (a noted change replaced the comparison): the
+    //! next comparison has nothing to compare with.
+    bool mTrianglesStale = false;
     std::uint64_t mStamp = 0;
     std::uint64_t mRevision = 0; //!< Level::lightRevision's counter
     std::string mLightsKey;

@@ -290,6 +290,10 @@ public:
                         const voxelgi::VoxelizeOptions& options) {
                 return mVoxelizer.voxelize(*frame.gpu, geometry, region, options);
             };
+        // A dig's re-meshed region, when the frame knows it: no triangle comparison.
+        if (frame.changeKnown)
+            mVolume->noteGeometryChange(frame.changedFromKey, frame.geometryKey, frame.changedMin,
+                                        frame.changedMax);
         const std::string what = mVolume->voxelize(*frame.geometry, frame.geometryKey, frame.cameraPosition,
                                                    frame.frameIndex, frame.force, onGpu);
         if (what.empty())

@@ -247,6 +247,47 @@ TEST(Cascades, AnEditReVoxelizesOnlyTheChangedRegionAndEqualsAFullVoxelization)
     expectSameVoxels(edited, fresh);
 }
 
+// The frame knows what a dig re-meshed (FrameStart::findSdfChangeSince): the volume takes that box
+// instead of comparing the triangles, and its voxels equal a fresh voxelization. A note about
+// another geometry than the one it saw last is refused (it then compares, as before).
+TEST(Cascades, AKnownChangeBoxReplacesTheTriangleComparison)
+{
+    const scene::RenderScene before = makeRoomWithBox(-0.2f), after = makeRoomWithBox(-0.14f);
+    const std::string keyBefore = before.computeContentHash(), keyAfter = after.computeContentHash();
+    CascadeSettings settings = furnaceSettings();
+    settings.resolution = 16;
+    settings.voxelSize = 1.0 / 16.0;
+    CascadeVolume noted(settings), fresh(settings);
+    noted.voxelize(before, keyBefore, glm::dvec3(0.0), 0, false);
+    EXPECT_FALSE(noted.noteGeometryChange("another geometry", keyAfter, glm::dvec3(0.0), glm::dvec3(0.0)));
+    // The box's old and new place (makeRoomWithBox: x to x + 0.13).
+    const glm::dvec3 lo(-0.2f, -0.4f, -0.2f), hi(-0.14f + 0.13f, -0.27f, -0.05f);
+    EXPECT_TRUE(noted.noteGeometryChange(keyBefore, keyAfter, lo, hi));
+    const std::string what = noted.voxelize(after, keyAfter, glm::dvec3(0.0), 1, false);
+    EXPECT_NE(what.find("re-voxelized the changed region"), std::string::npos) << what;
+    fresh.voxelize(after, keyAfter, glm::dvec3(0.0), 0, false);
+    expectSameVoxels(noted, fresh);
+}
+
+// A dig frame with a moving camera: the level scrolled and the geometry changed in one step.
+// Only the new slabs and the changed box are voxelized, and the voxels equal a fresh
+// voxelization of the edited scene at the new position.
+TEST(Cascades, AScrollAndAnEditInOneFrameVoxelizeTheSlabsAndTheChangedRegionOnly)
+{
+    const scene::RenderScene before = makeRoomWithBox(-0.2f), after = makeRoomWithBox(-0.14f);
+    CascadeSettings settings = furnaceSettings();
+    settings.resolution = 16;
+    settings.voxelSize = 1.0 / 16.0;
+    CascadeVolume edited(settings), fresh(settings);
+    const glm::dvec3 a(0.0), b(2.0 / 16.0 + 0.01, 0.0, -1.0 / 16.0);
+    edited.voxelize(before, before.computeContentHash(), a, 0, false);
+    const std::string what = edited.voxelize(after, after.computeContentHash(), b, 1, false);
+    EXPECT_NE(what.find("voxelized the new slabs"), std::string::npos) << what;
+    EXPECT_NE(what.find("and re-voxelized the changed region"), std::string::npos) << what;
+    fresh.voxelize(after, after.computeContentHash(), b, 0, false);
+    expectSameVoxels(edited, fresh);
+}
+
 // An edit outside a level (a box moved 1.5 m out, beyond level 0's 1 m but inside level 1's 2 m)
 // leaves that level's voxels and light as they were: when it comes due it is neither
 // re-voxelized nor re-lit, while level 1 re-voxelizes the change and is re-lit.
