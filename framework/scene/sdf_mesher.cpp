@@ -41,6 +41,34 @@ double getBoxDistance(const glm::dvec3& p, const glm::dvec3& lo, const glm::dvec
     return glm::length(glm::max(glm::max(lo - p, p - hi), 0.0));
 }
 
+// The live slots (key != kNone) in the order of their keys, when every slot outside `written`
+// already is in that order (the slots an update did not write kept their place in the order a
+// full meshing gives): the others sorted, then merged in. Linear but for the sort of `written`.
+template <class Less>
+std::vector<std::uint32_t> mergeInOrder(const std::vector<std::uint32_t>& key,
+                                        std::vector<std::uint32_t> written, Less less)
+{
+    std::vector<std::uint8_t> isWritten(key.size(), 0);
+    std::erase_if(written, [&](std::uint32_t slot) {
+        const bool drop = key[slot] == kNone || isWritten[slot];
+        isWritten[slot] = 1;
+        return drop;
+    });
+    std::sort(written.begin(), written.end(), less);
+    std::vector<std::uint32_t> out;
+    out.reserve(key.size());
+    std::size_t j = 0;
+    for (std::uint32_t slot = 0; slot < key.size(); ++slot) {
+        if (key[slot] == kNone || isWritten[slot])
+            continue;
+        while (j < written.size() && less(written[j], slot))
+            out.push_back(written[j++]);
+        out.push_back(slot);
+    }
+    out.insert(out.end(), written.begin() + std::ptrdiff_t(j), written.end());
+    return out;
+}
+
 } // namespace
 
 double getSdfCellSize(const SdfModel& model, int resolution)
@@ -534,6 +562,7 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
                     grow(positions[v]);
     }
     std::size_t nextFreeQuad = 0;
+    std::vector<std::uint32_t> writtenQuads;
     for (std::size_t k = 0; k < edges.size(); ++k) {
         if (after[k].slot == kNone)
             continue;
@@ -557,6 +586,7 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
         materials[2 * std::size_t(q) + 1] = after[k].materials[1];
         quadEdge[q] = std::uint32_t(edges[k]);
         edgeQuad[edges[k]] = q;
+        writtenQuads.push_back(q);
         touchQuad(q);
     }
     freeQuads.erase(freeQuads.begin(), freeQuads.begin() + std::ptrdiff_t(nextFreeQuad));
@@ -570,14 +600,9 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
     {
         if (!freeQuads.empty())
             changed = true;
-        std::vector<std::uint32_t> quads;
-        quads.reserve(quadEdge.size());
-        for (std::uint32_t q = 0; q < quadEdge.size(); ++q)
-            if (quadEdge[q] != kNone)
-                quads.push_back(q);
         const auto byEdge = [&](std::uint32_t x, std::uint32_t y) { return quadEdge[x] < quadEdge[y]; };
-        if (!std::is_sorted(quads.begin(), quads.end(), byEdge) || quads.size() != quadEdge.size()) {
-            std::sort(quads.begin(), quads.end(), byEdge);
+        const std::vector<std::uint32_t> quads = mergeInOrder(quadEdge, writtenQuads, byEdge);
+        if (!std::is_sorted(quads.begin(), quads.end()) || quads.size() != quadEdge.size()) {
             std::vector<std::uint32_t> sortedIndices(6 * quads.size()), sortedMaterials(2 * quads.size()),
                 sortedEdges(quads.size());
             for (std::size_t k = 0; k < quads.size(); ++k) {
@@ -595,14 +620,9 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
             materials = std::move(sortedMaterials);
             quadEdge = std::move(sortedEdges);
         }
-        std::vector<std::uint32_t> order;
-        order.reserve(positions.size());
-        for (std::uint32_t v = 0; v < positions.size(); ++v)
-            if (vertexCell[v] != kNone)
-                order.push_back(v);
         const auto byCell = [&](std::uint32_t x, std::uint32_t y) { return vertexCell[x] < vertexCell[y]; };
-        if (!std::is_sorted(order.begin(), order.end(), byCell) || order.size() != positions.size()) {
-            std::sort(order.begin(), order.end(), byCell);
+        const std::vector<std::uint32_t> order = mergeInOrder(vertexCell, written, byCell);
+        if (!std::is_sorted(order.begin(), order.end()) || order.size() != positions.size()) {
             std::vector<std::uint32_t> remap(positions.size(), kNone);
             std::vector<glm::vec3> sortedPositions(order.size()), sortedNormals(order.size());
             std::vector<std::uint32_t> sortedCells(order.size());

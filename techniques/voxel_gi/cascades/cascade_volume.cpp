@@ -150,6 +150,8 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
         mFirstFrame = frame;
     trackGeometryChange(geometry, geometryKey);
     mCounters.levelsVoxelized = 0;
+    mCounters.changedVoxels = 0;
+    mCounters.changedMs = 0.0;
     std::string what;
     for (const int i : getDueLevels(frame)) {
         Level& level = mLevels[std::size_t(i)];
@@ -227,6 +229,7 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                          std::size_t(kept.x) * std::size_t(kept.y) * std::size_t(kept.z);
             std::size_t boxVoxels = 0;
             if (dugInside) {
+                const auto begin = std::chrono::steady_clock::now();
                 VoxelizeOptions options{.supersampling = mSettings.supersampling,
                                         .solid = mSettings.solid};
                 options.boxBegin = dugBegin;
@@ -234,6 +237,10 @@ std::string CascadeVolume::voxelize(const scene::RenderScene& geometry,
                 pasteVoxelBox(voxelizeRegion(region, options), dugBegin, dugEnd, level.grid);
                 const glm::ivec3 extent = dugEnd - dugBegin;
                 boxVoxels = std::size_t(extent.x) * std::size_t(extent.y) * std::size_t(extent.z);
+                mCounters.changedVoxels += boxVoxels;
+                mCounters.changedMs += std::chrono::duration<double, std::milli>(
+                                           std::chrono::steady_clock::now() - begin)
+                                           .count();
             }
             finalizeVoxelGrid(level.grid); // the list of surface voxels, which the copy lacks
             const std::string total = std::to_string(region.getVoxelCount());

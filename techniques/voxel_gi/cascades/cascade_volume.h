@@ -207,6 +207,10 @@ public:
     //! Counts of the last calls, for the row.
     struct Counters {
         int levelsVoxelized = 0;
+        //! Of the last voxelize(): the voxels of the changed (dug) boxes it voxelized again, and
+        //! the wall time of those calls (the voxelizer's, with the paste into the level).
+        std::size_t changedVoxels = 0;
+        double changedMs = 0.0;
         int levelsLit = 0;
         std::size_t surfaceVoxelsLit = 0;
         double meanStepsPerCone = 0.0;

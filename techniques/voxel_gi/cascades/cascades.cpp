@@ -442,6 +442,8 @@ public:
         std::vector<std::pair<std::string, double>> counters = {
             {"voxel_size", mVolume->getSettings().voxelSize},
             {"levels_voxelized", double(c.levelsVoxelized)},
+            {"voxelize_changed_voxels", double(c.changedVoxels)},
+            {"voxelize_changed_ms", c.changedMs},
             {"levels_lit", double(c.levelsLit)},
             {"surface_voxels", double(surface)},
             {"steps_per_cone", mGatheredOnGpu ? std::nan("") : c.meanStepsPerCone}};
