@@ -93,24 +93,35 @@ private:
     std::unique_ptr<detail::BufferState> mState;
 };
 
-//! Uploads to `buffer`, which holds `held`, the elements of `next` (as many as `held`) from the
-//! first to the last that differ from it, byte for byte: one upload of that span, or none.
-//! Returns the bytes uploaded. What a pass uses when a frame changes a part of its data (a
-//! character's vertices) and the rest stays.
+//! Uploads to `buffer`, which holds `held`, what of `next` differs from it, byte for byte: one
+//! upload of the span from the first element that differs to the last (when the two are as
+//! long) or to the end of `next` (when the length changed: the elements after a change shifted),
+//! or none. `buffer` must have room for `next` (a pass that patches gives its buffers a margin,
+//! getPatchCapacity). Returns the bytes uploaded. What a pass uses when a frame changes a part of
+//! its data (a character's vertices, a dug model's mesh) and the rest stays.
 template <PlainData T>
 std::size_t uploadChangedSpan(Buffer& buffer, std::span<const T> held, std::span<const T> next)
 {
-    if (held.size() != next.size())
-        throw Error("uploadChangedSpan: " + std::to_string(next.size()) + " elements against " +
-                    std::to_string(held.size()) + " held");
+    if (next.size_bytes() > buffer.getSize())
+        throw Error("uploadChangedSpan: " + std::to_string(next.size()) + " elements do not fit a buffer of " +
+                    std::to_string(buffer.getSize()) + " bytes");
+    const std::size_t common = std::min(held.size(), next.size());
     std::size_t first = 0, last = next.size();
-    while (first < last && std::memcmp(&held[first], &next[first], sizeof(T)) == 0)
+    while (first < common && std::memcmp(&held[first], &next[first], sizeof(T)) == 0)
         ++first;
-    while (last > first && std::memcmp(&held[last - 1], &next[last - 1], sizeof(T)) == 0)
-        --last;
+    if (held.size() == next.size())
+        while (last > first && std::memcmp(&held[last - 1], &next[last - 1], sizeof(T)) == 0)
+            --last;
     if (first < last)
         buffer.upload(next.data() + first, (last - first) * sizeof(T), first * sizeof(T));
     return (last - first) * sizeof(T);
+}
+
+//! Elements to allocate for `count` in a buffer that uploadChangedSpan patches: a quarter more, so
+//! that a mesh that grows a little (a dig) is patched, not allocated and uploaded again.
+inline std::size_t getPatchCapacity(std::size_t count)
+{
+    return count + count / 4 + 64;
 }
 
 //! How an image will be bound.

@@ -123,22 +123,27 @@ void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
 {
     GBufferGeometry geometry = buildGBufferGeometry(scene);
     State& s = *mState;
-    // A scene of the same size as the one the buffers hold (a character moved, a light did):
-    // only the span of vertices and indices that differs goes over the bus.
+    // A scene that fits the buffers (a character moved, a light did, a dig changed a model's
+    // mesh by a little): only the span of vertices and indices that differs goes over the bus.
     if (patch && s.hasScene && !geometry.vertices.empty() && !geometry.indices.empty() &&
-        geometry.vertices.size() == s.uploaded.vertices.size() &&
-        geometry.indices.size() == s.uploaded.indices.size()) {
+        geometry.vertices.size() * sizeof(GBufferVertex) <= s.vertices.getSize() &&
+        geometry.indices.size() * sizeof(std::uint32_t) <= s.indices.getSize()) {
         s.hasScene = false;
         gpu::uploadChangedSpan<GBufferVertex>(s.vertices, s.uploaded.vertices, geometry.vertices);
         gpu::uploadChangedSpan<std::uint32_t>(s.indices, s.uploaded.indices, geometry.indices);
+        s.indexCount = static_cast<std::uint32_t>(geometry.indices.size());
+        s.vertexCount = geometry.vertices.size();
         s.uploaded = std::move(geometry);
         s.hasScene = true;
         return;
     }
     s.hasScene = false;
-    // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
-    const std::size_t vertexCount = std::max<std::size_t>(geometry.vertices.size(), 1);
-    const std::size_t indexCount = std::max<std::size_t>(geometry.indices.size(), 3);
+    // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle. With room to
+    // be patched when the scene grows a little; without patching, the exact size (the ablation
+    // allocates and uploads as before).
+    const auto room = [patch](std::size_t n) { return patch ? gpu::getPatchCapacity(n) : n; };
+    const std::size_t vertexCount = room(std::max<std::size_t>(geometry.vertices.size(), 1));
+    const std::size_t indexCount = room(std::max<std::size_t>(geometry.indices.size(), 3));
     gpu::BufferDesc vertexDesc{vertexCount * sizeof(GBufferVertex), "gbuffer vertices", true};
     gpu::BufferDesc indexDesc{indexCount * sizeof(std::uint32_t), "gbuffer indices", true};
     s.vertices = s.context->createBuffer(vertexDesc);

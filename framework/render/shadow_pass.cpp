@@ -202,19 +202,23 @@ struct ShadowPass::State {
         if (uploaded && scene.positions == uploadedPositions && scene.indices == uploadedIndices)
             return;
         validateRenderScene(scene);
-        // As many vertices and indices as the buffers hold (a character moved): only the span
-        // that differs goes over the bus; the planes follow the new bounds.
-        const bool sameSize = uploaded && !scene.positions.empty() && !scene.indices.empty() &&
-                              scene.positions.size() == uploadedPositions.size() &&
-                              scene.indices.size() == uploadedIndices.size();
+        // Vertices and indices that fit the buffers (a character moved, a dig changed a mesh by
+        // a little): only the span that differs goes over the bus; the planes follow the new
+        // bounds.
+        const bool fits = uploaded && !scene.positions.empty() && !scene.indices.empty() &&
+                          scene.positions.size() * sizeof(glm::vec3) <= vertices.getSize() &&
+                          scene.indices.size() * sizeof(std::uint32_t) <= indices.getSize();
         uploaded = false;
-        if (sameSize) {
+        if (fits) {
             gpu::uploadChangedSpan<glm::vec3>(vertices, uploadedPositions, scene.positions);
             gpu::uploadChangedSpan<std::uint32_t>(indices, uploadedIndices, scene.indices);
         } else {
             // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
-            const std::size_t vertexSlots = std::max<std::size_t>(scene.positions.size(), 1);
-            const std::size_t indexSlots = std::max<std::size_t>(scene.indices.size(), 3);
+            // With room to be patched when the scene grows a little (gpu::getPatchCapacity).
+            const std::size_t vertexSlots =
+                gpu::getPatchCapacity(std::max<std::size_t>(scene.positions.size(), 1));
+            const std::size_t indexSlots =
+                gpu::getPatchCapacity(std::max<std::size_t>(scene.indices.size(), 3));
             vertices = context->createBuffer(
                 {vertexSlots * sizeof(glm::vec3), "shadow vertices", /*vertexIndexUsage=*/true});
             indices = context->createBuffer(

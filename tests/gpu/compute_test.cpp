@@ -169,7 +169,8 @@ TEST_F(ComputeTest, AChangedSpanUploadsOnlyFromTheFirstToTheLastChangedElement)
     std::vector<std::uint32_t> held(100);
     for (std::uint32_t i = 0; i < 100; ++i)
         held[i] = i * 7u;
-    Buffer buffer = getContext().createBuffer({.size = 100 * sizeof(std::uint32_t), .name = "patched"});
+    // Room for 110 elements (a patched buffer has a margin, getPatchCapacity).
+    Buffer buffer = getContext().createBuffer({.size = 110 * sizeof(std::uint32_t), .name = "patched"});
     buffer.uploadSpan<std::uint32_t>(held);
     std::vector<std::uint32_t> next = held;
     next[10] = 1;
@@ -177,10 +178,20 @@ TEST_F(ComputeTest, AChangedSpanUploadsOnlyFromTheFirstToTheLastChangedElement)
     const BusCounters before = getBusCounters();
     EXPECT_EQ(uploadChangedSpan<std::uint32_t>(buffer, held, next), 11 * sizeof(std::uint32_t));
     EXPECT_EQ((getBusCounters() - before).uploadBytes, 11 * sizeof(std::uint32_t));
-    EXPECT_EQ(buffer.downloadVector<std::uint32_t>(), next);
+    EXPECT_EQ(buffer.downloadVector<std::uint32_t>(100), next);
     EXPECT_EQ(uploadChangedSpan<std::uint32_t>(buffer, next, next), 0u) << "nothing changed";
-    next.pop_back();
-    EXPECT_THROW(uploadChangedSpan<std::uint32_t>(buffer, held, next), Error);
+    // A different length (a dig changed a mesh): from the first difference to the new end.
+    std::vector<std::uint32_t> longer = next;
+    longer.insert(longer.begin() + 90, {5u, 6u, 7u});
+    EXPECT_EQ(uploadChangedSpan<std::uint32_t>(buffer, next, longer), 13 * sizeof(std::uint32_t));
+    EXPECT_EQ(buffer.downloadVector<std::uint32_t>(103), longer);
+    std::vector<std::uint32_t> shorter(longer.begin(), longer.begin() + 95);
+    shorter[94] = 9u;
+    EXPECT_EQ(uploadChangedSpan<std::uint32_t>(buffer, longer, shorter), 1 * sizeof(std::uint32_t));
+    EXPECT_EQ(buffer.downloadVector<std::uint32_t>(95), shorter);
+    // More than the buffer holds: a clear error, nothing uploaded.
+    EXPECT_THROW(uploadChangedSpan<std::uint32_t>(buffer, shorter, std::vector<std::uint32_t>(111, 0u)),
+                 Error);
 }
 
 TEST_F(ComputeTest, WhatCrossesTheBusIsCounted)
