@@ -402,17 +402,7 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
     }
     change.cellsMeshed = dirtyCells.size();
 
-    // The slots written, for the caller's patching.
-    std::size_t vLo = SIZE_MAX, vHi = 0, tLo = SIZE_MAX, tHi = 0;
     const std::size_t vertexCountBefore = positions.size(), quadCountBefore = quadEdge.size();
-    const auto touchVertex = [&](std::size_t v) {
-        vLo = std::min(vLo, v);
-        vHi = std::max(vHi, v + 1);
-    };
-    const auto touchQuad = [&](std::size_t q) {
-        tLo = std::min(tLo, 2 * q);
-        tHi = std::max(tHi, 2 * q + 2);
-    };
     const auto grow = [&](const glm::vec3& p) { growBox(change.changedMin, change.changedMax, p); };
     // The 12 edges a cell borders: along each axis, the edges whose four cells include it.
     const auto forEachCellEdge = [&](std::uint32_t cell, auto&& visit) {
@@ -508,7 +498,6 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
         vertexStamp[v] = stamp;
         cellVertex[cell] = v;
         written.push_back(v);
-        touchVertex(v);
     }
     freeVertices.erase(freeVertices.begin(), freeVertices.begin() + std::ptrdiff_t(nextFreeVertex));
     tbb::parallel_for(std::size_t(0), written.size(), [&](std::size_t k) {
@@ -587,7 +576,6 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
         quadEdge[q] = std::uint32_t(edges[k]);
         edgeQuad[edges[k]] = q;
         writtenQuads.push_back(q);
-        touchQuad(q);
     }
     freeQuads.erase(freeQuads.begin(), freeQuads.begin() + std::ptrdiff_t(nextFreeQuad));
 
@@ -613,8 +601,6 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
                 sortedMaterials[2 * k + 1] = materials[2 * std::size_t(q) + 1];
                 sortedEdges[k] = quadEdge[q];
                 edgeQuad[quadEdge[q]] = std::uint32_t(k);
-                if (q != k)
-                    touchQuad(k);
             }
             indices = std::move(sortedIndices);
             materials = std::move(sortedMaterials);
@@ -633,28 +619,17 @@ void SdfMesher::State::meshIncrementally(int frame, const std::vector<const CsgE
                 sortedNormals[k] = normals[v];
                 sortedCells[k] = vertexCell[v];
                 cellVertex[vertexCell[v]] = std::uint32_t(k);
-                if (v != k)
-                    touchVertex(k);
             }
             positions = std::move(sortedPositions);
             normals = std::move(sortedNormals);
             vertexCell = std::move(sortedCells);
-            for (std::size_t k = 0; k < indices.size(); ++k) {
-                const std::uint32_t i = remap[indices[k]];
-                if (i != indices[k]) {
-                    indices[k] = i;
-                    touchQuad(k / 6);
-                }
-            }
+            for (std::uint32_t& i : indices)
+                i = remap[i];
         }
     }
 
     change.changed = changed || positions.size() != vertexCountBefore ||
                      quadEdge.size() != quadCountBefore;
-    change.vertexBegin = std::min(vLo, positions.size());
-    change.vertexEnd = std::max(std::min(vHi, positions.size()), change.vertexBegin);
-    change.triangleBegin = std::min(tLo, materials.size());
-    change.triangleEnd = std::max(std::min(tHi, materials.size()), change.triangleBegin);
 }
 
 SdfMesher::SdfMesher(const SdfModel& model, const SdfMeshOptions& options)
@@ -730,8 +705,6 @@ SdfMeshChange SdfMesher::update(int frame, bool full)
         change.what = "meshed in full (" + why + ")";
         for (const glm::vec3& p : s.mesh.mesh.positions)
             growBox(change.changedMin, change.changedMax, p);
-        change.vertexEnd = s.mesh.mesh.positions.size();
-        change.triangleEnd = s.mesh.triangleMaterial.size();
         return change;
     }
     s.meshedFrame = frame;

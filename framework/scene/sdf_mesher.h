@@ -65,9 +65,6 @@ struct SdfMeshChange {
     std::size_t samplesChanged = 0; //!< grid samples whose value the new edits changed
     //! Box holding every triangle removed or added (empty, lo > hi, when none was).
     glm::dvec3 changedMin{1e300}, changedMax{-1e300};
-    //! Vertex and triangle index ranges [begin, end) of the mesh's arrays that were written
-    //! (the arrays may also have grown or shrunk; everything outside these kept its value).
-    std::size_t vertexBegin = 0, vertexEnd = 0, triangleBegin = 0, triangleEnd = 0;
 };
 
 //! Meshes one SDF model and keeps its grid, so that later frames re-mesh only what their edits
