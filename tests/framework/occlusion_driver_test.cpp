@@ -485,6 +485,31 @@ TEST(OcclusionDriver, ShadowMapsRedrawOnlyTheFacesADigChangesAndTheFrameMatchesT
     EXPECT_NE(culled[2].at("passes").find("shadow_maps:skipped"), std::string::npos) << culled[2].at("passes");
 }
 
+TEST(OcclusionDriver, ADigOutsideTheModelOrOfNoSizeIsRecordedAndChangesNothing)
+{
+    // A dig far outside the rock's box at frame 1 and a dig of radius 0 in the air at frame 2:
+    // the re-mesh runs, records that the mesh did not change, and nothing downstream redraws;
+    // the frames equal the unculled ones bit for bit (the helper checks).
+    const auto [culled, all] = runShadowFramesCulledAndNot(
+        "dig_nothing", std::string("scene: dig_nothing\nbase: cornell_box\nframes: 3\n") + kTwoLights +
+                           "sdf_models:\n  - name: rock\n    bounds: [[0.32, 0.0, 0.05], [0.52, 0.2, 0.25]]\n"
+                           "    resolution: 32\n    edits:\n"
+                           "      - {shape: sphere, op: add, center: [0.42, 0.08, 0.15], size: 0.07, material: white}\n"
+                           "      - {shape: sphere, op: subtract, center: [5.0, 5.0, 5.0], size: 0.05, frame: 1}\n"
+                           "      - {shape: sphere, op: subtract, center: [0.45, 0.19, 0.2], size: 0.0, frame: 2}\n");
+    ASSERT_EQ(culled.size(), 3u);
+    for (std::size_t i = 1; i < 3; ++i) {
+        EXPECT_NE(culled[i].at("frame.sdf_remesh").find("the mesh did not change"), std::string::npos)
+            << "frame " << i << ": " << culled[i].at("frame.sdf_remesh");
+        EXPECT_NE(culled[i].at("passes").find("scene_upload:skipped"), std::string::npos)
+            << culled[i].at("passes");
+        EXPECT_NE(culled[i].at("passes").find("shadow_maps:skipped"), std::string::npos)
+            << culled[i].at("passes");
+        EXPECT_NE(all[i].at("frame.sdf_remesh").find("meshed in full"), std::string::npos)
+            << all[i].at("frame.sdf_remesh");
+    }
+}
+
 TEST(OcclusionDriver, VulkanTechniquesReadTheGBufferOnTheGpuWithTheSameResult)
 {
     // gtao binds the view inputs made on the GPU (no upload of a CPU copy); the ablation
