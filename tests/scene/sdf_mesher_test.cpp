@@ -81,15 +81,8 @@ void expectSameMesh(const SdfMesh& patched, const SdfMesh& full, const std::stri
 CsgEdit makeEdit(CsgShape shape, CsgOp op, glm::dvec3 center, glm::dvec3 size, double blend,
                  int frame, std::uint32_t material = 0)
 {
-    CsgEdit e;
-    e.shape = shape;
-    e.op = op;
-    e.center = center;
-    e.size = size;
-    e.blend = blend;
-    e.frame = frame;
-    e.material = material;
-    return e;
+    return {.shape = shape, .op = op, .center = center, .size = size, .blend = blend,
+            .material = material, .frame = frame};
 }
 
 SdfModel makeGround()
