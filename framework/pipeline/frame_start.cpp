@@ -51,6 +51,18 @@ Resource<gpu::Image> FrameStart::viewNormalGpu() const
                                 mOptions.height);
 }
 
+Resource<gpu::Image> FrameStart::positionDepthGpu() const
+{
+    return makeGpuImageResource(mGpu, "gbuffer_position_depth_gpu", gpu::Format::RGBA32Float,
+                                mOptions.width, mOptions.height);
+}
+
+Resource<gpu::Image> FrameStart::worldNormalGpu() const
+{
+    return makeGpuImageResource(mGpu, "gbuffer_normal_gpu", gpu::Format::RGBA32Float,
+                                mOptions.width, mOptions.height);
+}
+
 Resource<gpu::RenderTarget> FrameStart::gbufferTarget() const
 {
     gpu::Context* ctx = &mGpu;
@@ -258,14 +270,18 @@ void FrameStart::addPasses(FrameGraph& graph)
     const auto viewGpuRes = viewInputsGpu();
     const auto depthGpu = viewDepthGpu();
     const auto normalGpu = viewNormalGpu();
+    const auto positionGpu = positionDepthGpu();
+    const auto worldGpu = worldNormalGpu();
     graph.addPass({.name = "view_inputs_gpu",
                    .reads = {gbufferRes},
-                   .writes = {viewGpuRes, depthGpu, normalGpu}},
-                  [this, gbufferRes, viewGpuRes, depthGpu, normalGpu](PassContext& ctx) {
+                   .writes = {viewGpuRes, depthGpu, normalGpu, positionGpu, worldGpu}},
+                  [this, gbufferRes, viewGpuRes, depthGpu, normalGpu, positionGpu,
+                   worldGpu](PassContext& ctx) {
                       const GpuGBuffer& g = ctx.read(gbufferRes);
                       if (!mViewInputsPass)
                           mViewInputsPass = std::make_unique<render::ViewInputsPass>(mGpu);
-                      mViewInputsPass->run(*g.target, g.view, ctx.write(depthGpu),
+                      mViewInputsPass->run(*g.target, g.view, ctx.write(positionGpu),
+                                           ctx.write(worldGpu), ctx.write(depthGpu),
                                            ctx.write(normalGpu));
                       ctx.write(viewGpuRes) = GpuViewInputs{g.view, g.projection};
                       return PassOutcome{};

@@ -15,7 +15,8 @@
 //                      geometry, size and jitter are unchanged)
 //   gbuffer_readback   the attachments copied to the CPU, only when a pass that runs reads them
 //   view_inputs        view-space normals and the surface mask (CPU), for CPU-side readers
-//   view_inputs_gpu    linear depth and view-space normals on the GPU, for Vulkan techniques
+//   view_inputs_gpu    linear depth and view-space normals on the GPU, for Vulkan techniques,
+//                      and the world position + depth and normal attachments as storage images
 //                      (the G-buffer stays on the GPU: no read-back unless a CPU reader runs)
 //
 // The passes are added once per run; FrameStart keeps what they reuse between frames.
@@ -168,6 +169,12 @@ public:
     //! graph (pipeline/gpu_resources.h): Vulkan techniques bind them.
     Resource<gpu::Image> viewDepthGpu() const;
     Resource<gpu::Image> viewNormalGpu() const;
+    //! The G-buffer's world-space attachments as storage images (RGBA32Float; written by
+    //! view_inputs_gpu): position with the linear depth in w (inf where there is no surface),
+    //! and the shading normal. Vulkan techniques that work in world space bind them (voxel GI's
+    //! resident gather: families/voxel_gi/voxel_gi.h VoxelGiGpuGBuffer).
+    Resource<gpu::Image> positionDepthGpu() const;
+    Resource<gpu::Image> worldNormalGpu() const;
 
 private:
     const scene::Scene& mScene;

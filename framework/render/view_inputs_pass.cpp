@@ -1,6 +1,7 @@
 #include "render/view_inputs_pass.h"
 
 #include "core/error.h"
+#include "gpu/format.h"
 #include "gpu/shader_compiler.h"
 #include "render/gbuffer_pass.h"
 
@@ -21,8 +22,6 @@ constexpr std::uint32_t kGroupSize = 8;
 struct ViewInputsPass::State {
     gpu::Context* context = nullptr;
     gpu::ComputePipeline pipeline;
-    gpu::Image positionDepth, normal; // copies of the attachments (storage-bindable)
-    std::uint32_t width = 0, height = 0;
 };
 
 ViewInputsPass::ViewInputsPass(gpu::Context& context) : mState(std::make_unique<State>())
@@ -45,37 +44,33 @@ ViewInputsPass::ViewInputsPass(gpu::Context& context) : mState(std::make_unique<
 ViewInputsPass::~ViewInputsPass() = default;
 
 gpu::RunResult ViewInputsPass::run(const gpu::RenderTarget& gbuffer, const glm::mat4& view,
+                                   const gpu::Image& positionDepth, const gpu::Image& worldNormal,
                                    const gpu::Image& depth, const gpu::Image& normal)
 {
     State& s = *mState;
     const std::uint32_t w = gbuffer.getDesc().width, h = gbuffer.getDesc().height;
-    const gpu::ImageDesc& d = depth.getDesc();
-    const gpu::ImageDesc& n = normal.getDesc();
-    if (d.width != w || d.height != h || n.width != w || n.height != h ||
-        d.format != gpu::Format::R32Float || n.format != gpu::Format::RGBA32Float)
-        throw Error("view inputs: expected an R32Float depth and an RGBA32Float normal image of " +
-                    std::to_string(w) + "x" + std::to_string(h) + ", found '" + d.name + "' and '" +
-                    n.name + "'");
-    if (w != s.width || h != s.height || !s.positionDepth.isValid()) {
-        auto make = [&](const char* name) {
-            return s.context->createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float,
-                                           w, h, 1, gpu::ImageUsage::StorageAndSampled, name});
-        };
-        s.positionDepth = make("view_inputs.position_depth");
-        s.normal = make("view_inputs.world_normal");
-        s.width = w;
-        s.height = h;
-    }
+    const auto check = [&](const gpu::Image& image, gpu::Format format, const char* what) {
+        const gpu::ImageDesc& d = image.getDesc();
+        if (d.width != w || d.height != h || d.format != format)
+            throw Error(std::string("view inputs: expected ") + what + " of " + std::to_string(w) +
+                        "x" + std::to_string(h) + ", found '" + d.name + "' (" +
+                        std::to_string(d.width) + "x" + std::to_string(d.height) + ", " +
+                        std::string(gpu::getFormatName(d.format)) + ")");
+    };
+    check(positionDepth, gpu::Format::RGBA32Float, "an RGBA32Float position + depth image");
+    check(worldNormal, gpu::Format::RGBA32Float, "an RGBA32Float world normal image");
+    check(depth, gpu::Format::R32Float, "an R32Float depth image");
+    check(normal, gpu::Format::RGBA32Float, "an RGBA32Float normal image");
     Push push;
     push.view = view;
     push.size[0] = w;
     push.size[1] = h;
     return s.context->run([&](gpu::CommandList& cmd) {
-        gpu::copyAttachmentToImage(cmd, gbuffer, 0, s.positionDepth, 0, "view_inputs copy");
-        gpu::copyAttachmentToImage(cmd, gbuffer, 1, s.normal, 0, "view_inputs copy");
+        gpu::copyAttachmentToImage(cmd, gbuffer, 0, positionDepth, 0, "view_inputs copy");
+        gpu::copyAttachmentToImage(cmd, gbuffer, 1, worldNormal, 0, "view_inputs copy");
         cmd.dispatch(s.pipeline,
-                     {gpu::Binding::storageImage(0, s.positionDepth),
-                      gpu::Binding::storageImage(1, s.normal), gpu::Binding::storageImage(2, depth),
+                     {gpu::Binding::storageImage(0, positionDepth),
+                      gpu::Binding::storageImage(1, worldNormal), gpu::Binding::storageImage(2, depth),
                       gpu::Binding::storageImage(3, normal)},
                      gpu::PushConstants(push),
                      gpu::GroupCount{gpu::computeGroupCount(w, kGroupSize),

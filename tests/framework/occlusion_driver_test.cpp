@@ -319,13 +319,15 @@ TEST(OcclusionDriver, ComposesTheLitFrameAndMeasuresItAgainstTheFullRadiance)
     }
     EXPECT_EQ(rows[0].at("frame.shadow_maps_rendered"), "1");
     // The graph's GPU resources: the G-buffer's render target and the shadow atlas (made in
-    // frame 0, kept across frames) and five images (view depth and normals, HDR, direct,
-    // tonemapped): four of them made in frame 0 (the HDR image takes the view normals' RGBA32F
-    // image once the occlusion pass, their last reader, has run), all five reused in frame 1.
-    EXPECT_EQ(rows[0].at("frame.gpu_images_created"), "6");
-    EXPECT_EQ(rows[0].at("frame.gpu_images_reused"), "1");
+    // frame 0, kept across frames) and seven images (view depth and normals, the world position
+    // + depth and normal copies, HDR, direct, tonemapped): five of them made in frame 0 (the
+    // world copies, which no pass of this run reads, go back to the pool once view_inputs_gpu
+    // has written them, and the HDR and direct images take two RGBA32F images from it), all
+    // seven reused in frame 1.
+    EXPECT_EQ(rows[0].at("frame.gpu_images_created"), "7");
+    EXPECT_EQ(rows[0].at("frame.gpu_images_reused"), "2");
     EXPECT_EQ(rows[1].at("frame.gpu_images_created"), "0");
-    EXPECT_EQ(rows[1].at("frame.gpu_images_reused"), "5");
+    EXPECT_EQ(rows[1].at("frame.gpu_images_reused"), "7");
     EXPECT_NE(rows[1].at("passes").find(
                   "shadow_maps:skipped(no light and no shadow caster moved since frame 0)"),
               std::string::npos)

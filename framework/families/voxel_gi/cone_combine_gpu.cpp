@@ -2,6 +2,8 @@
 
 #include "core/error.h"
 #include "families/voxel_gi/cone_tracing.h"
+#include "families/voxel_gi/voxel_gi.h"
+#include "gpu/format.h"
 #include "gpu/shader_compiler.h"
 
 #include <glm/geometric.hpp>
@@ -28,6 +30,18 @@ static_assert(sizeof(CombineConstants) == 64, "must match cone_combine.comp");
 
 constexpr std::uint32_t kBindings = 9;
 
+CombineConstants makeConstants(int w, int h, glm::ivec2 low, int factor, int capsules, bool visibility,
+                               double coneHalfAngle, const glm::dvec3& anchor)
+{
+    CombineConstants c;
+    c.size = {w, h, low.x, low.y};
+    c.flags = {factor, capsules, visibility ? 1 : 0, 0};
+    c.angle = {float(coneHalfAngle), float(std::cos(coneHalfAngle)), float(std::sin(coneHalfAngle)),
+               float(2.0 * std::pow(std::sin(0.5 * coneHalfAngle), 2))};
+    c.anchor = glm::vec4(glm::vec3(anchor), 0.0f);
+    return c;
+}
+
 } // namespace
 
 std::filesystem::path ConeCombineGpu::getShaderDir()
@@ -44,14 +58,14 @@ gpu::Buffer& ConeCombineGpu::reserve(gpu::Buffer& buffer, std::size_t bytes, con
     return buffer;
 }
 
-void ConeCombineGpu::prepare(gpu::Context& context)
+void ConeCombineGpu::prepare(gpu::Context& context, bool resident)
 {
-    if (mContext == &context && mPipeline.isValid())
+    if (mContext != &context || !mPipeline.isValid()) {
+        *this = ConeCombineGpu();
+        mContext = &context;
+    }
+    if (mPipeline.isValid() && (!resident || mResidentPipeline.isValid()))
         return;
-    *this = ConeCombineGpu();
-    mContext = &context;
-    gpu::ComputePipelineDesc desc;
-    desc.name = kDispatchLabel;
     // The directions as GLSL constants, to 9 significant digits (float round trip).
     std::string constants;
     for (const glm::dvec3& d : scene::getConeDirections()) {
@@ -60,14 +74,60 @@ void ConeCombineGpu::prepare(gpu::Context& context)
                       float(d.x), float(d.y), float(d.z));
         constants += text;
     }
-    desc.spirv =
-        gpu::ShaderCompiler()
-            .compileFile(getShaderDir() / "cone_combine.comp", {{"CONE_DIRECTIONS", constants}})
-            .spirv;
-    for (std::uint32_t b = 0; b < kBindings; ++b)
-        desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
-    desc.pushConstantSize = sizeof(CombineConstants);
-    mPipeline = context.createPipeline(desc);
+    if (!mPipeline.isValid()) {
+        gpu::ComputePipelineDesc desc;
+        desc.name = kDispatchLabel;
+        desc.spirv = gpu::ShaderCompiler()
+                         .compileFile(getShaderDir() / "cone_combine.comp", {{"CONE_DIRECTIONS", constants}})
+                         .spirv;
+        for (std::uint32_t b = 0; b < kBindings; ++b)
+            desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
+        desc.pushConstantSize = sizeof(CombineConstants);
+        mPipeline = context.createPipeline(desc);
+    }
+    if (resident && !mResidentPipeline.isValid()) {
+        gpu::ComputePipelineDesc desc;
+        desc.name = kDispatchLabel;
+        desc.spirv = gpu::ShaderCompiler()
+                         .compileFile(getShaderDir() / "cone_combine.comp",
+                                      {{"CONE_DIRECTIONS", constants}, {"GBUFFER_IMAGES", "1"}})
+                         .spirv;
+        desc.bindings = {{0, gpu::BindingType::StorageBuffer}, {1, gpu::BindingType::StorageBuffer},
+                         {2, gpu::BindingType::StorageImage},  {3, gpu::BindingType::StorageImage},
+                         {7, gpu::BindingType::StorageBuffer}, {8, gpu::BindingType::StorageImage},
+                         {9, gpu::BindingType::StorageImage},  {10, gpu::BindingType::StorageImage},
+                         {11, gpu::BindingType::StorageImage}, {12, gpu::BindingType::StorageImage}};
+        desc.pushConstantSize = sizeof(CombineConstants);
+        mResidentPipeline = context.createPipeline(desc);
+        // Bound where the frame gives no visibilities (the shader does not read it then).
+        mNoVisibility = context.createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float, 1, 1, 1,
+                                             gpu::ImageUsage::StorageAndSampled,
+                                             "voxel_gi.combine.no_visibility"});
+    }
+}
+
+int ConeCombineGpu::uploadCapsules(const std::vector<scene::PosedCapsule>* in, const glm::dvec3& anchor)
+{
+    // Relative to the anchor (the camera), with what combineCones computes per capsule.
+    std::vector<glm::vec4> capsules;
+    if (in != nullptr)
+        for (const scene::PosedCapsule& c : *in) {
+            const glm::dvec3 a = glm::dvec3(c.capsule.a) - anchor,
+                             u = glm::dvec3(c.capsule.b) - glm::dvec3(c.capsule.a);
+            const double uu = glm::dot(u, u), r = double(c.capsule.radius);
+            const double half = 0.5 * std::sqrt(uu);
+            capsules.emplace_back(glm::vec3(a), float(r));
+            capsules.emplace_back(glm::vec3(u), float(uu > 0.0 ? 1.0 / uu : 0.0));
+            capsules.emplace_back(glm::vec3(a + 0.5 * u), float(half + r));
+            capsules.emplace_back(float((40.0 * r) * (40.0 * r)),
+                                  float((half + 40.0 * r) * (half + 40.0 * r)), 0.0f, 0.0f);
+        }
+    const std::size_t bytes = capsules.size() * sizeof(glm::vec4);
+    reserve(mCapsules, bytes, "voxel_gi.combine.capsules");
+    if (bytes > 0)
+        mCapsules.upload(capsules.data(), bytes);
+    mLastUploadBytes += bytes;
+    return int(capsules.size() / 4);
 }
 
 Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const ConeCombineInputs& in)
@@ -141,32 +201,13 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
                                std::size_t(k) * pixels * sizeof(float));
             mLastUploadBytes += pixels * sizeof(float);
         }
-    // Capsules relative to the anchor (the camera), with what combineCones computes per capsule.
     const glm::dvec3 anchor(full.camera.position);
-    std::vector<glm::vec4> capsules;
-    if (in.capsules != nullptr)
-        for (const scene::PosedCapsule& c : *in.capsules) {
-            const glm::dvec3 a = glm::dvec3(c.capsule.a) - anchor,
-                             u = glm::dvec3(c.capsule.b) - glm::dvec3(c.capsule.a);
-            const double uu = glm::dot(u, u), r = double(c.capsule.radius);
-            const double half = 0.5 * std::sqrt(uu);
-            capsules.emplace_back(glm::vec3(a), float(r));
-            capsules.emplace_back(glm::vec3(u), float(uu > 0.0 ? 1.0 / uu : 0.0));
-            capsules.emplace_back(glm::vec3(a + 0.5 * u), float(half + r));
-            capsules.emplace_back(float((40.0 * r) * (40.0 * r)),
-                                  float((half + 40.0 * r) * (half + 40.0 * r)), 0.0f, 0.0f);
-        }
-    upload(mCapsules, capsules.data(), capsules.size() * sizeof(glm::vec4),
-           "voxel_gi.combine.capsules");
+    const int capsuleCount = uploadCapsules(in.capsules, anchor);
     reserve(mOutput, pixels * sizeof(glm::vec4), "voxel_gi.combine.irradiance");
 
-    CombineConstants constants;
-    constants.size = {w, h, reduced.gbuffer.width, reduced.gbuffer.height};
-    constants.flags = {reduced.factor, int(capsules.size() / 4), useVisibility ? 1 : 0, 0};
-    constants.angle = {float(in.coneHalfAngle), float(std::cos(in.coneHalfAngle)),
-                       float(std::sin(in.coneHalfAngle)),
-                       float(2.0 * std::pow(std::sin(0.5 * in.coneHalfAngle), 2))};
-    constants.anchor = glm::vec4(glm::vec3(anchor), 0.0f);
+    CombineConstants constants =
+        makeConstants(w, h, {reduced.gbuffer.width, reduced.gbuffer.height}, reduced.factor, capsuleCount,
+                      useVisibility, in.coneHalfAngle, anchor);
     const std::vector<gpu::Binding> bindings = {gpu::Binding::storageBuffer(0, coneRadiance),
                                                 gpu::Binding::storageBuffer(1, mRepresentative),
                                                 gpu::Binding::storageBuffer(2, mPositions),
@@ -181,7 +222,7 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
         return out;
     // The capsules at the traced pixels: a first dispatch over the reduced pixels multiplies the
     // cone radiances in place, then the combine runs without capsules.
-    const bool traced = in.capsuleResolution == CapsuleResolution::Traced && !capsules.empty();
+    const bool traced = in.capsuleResolution == CapsuleResolution::Traced && capsuleCount > 0;
     CombineConstants tracedConstants = constants;
     tracedConstants.flags.w = 1;
     if (traced)
@@ -201,6 +242,87 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
     mLastGpuMs = result.sumGpuMs(kDispatchLabel);
     const std::vector<glm::vec4> e = mOutput.downloadVector<glm::vec4>(pixels);
     for (std::size_t i = 0; i < pixels; ++i)
+        out.pixels[i] = glm::vec3(e[i]);
+    return out;
+}
+
+const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
+                                                  int factor, const ResidentCombineInputs& in)
+{
+    if (in.gbuffer == nullptr || in.gbuffer->positionDepth == nullptr || in.gbuffer->normal == nullptr)
+        throw Error("cone combine: the resident combine needs the G-buffer's GPU images");
+    const plugin::VoxelGiGpuGBuffer& g = *in.gbuffer;
+    const int w = g.width, h = g.height;
+    const glm::ivec2 low = dispatch.getPixelsSize();
+    if (low != glm::ivec2((w + factor - 1) / factor, (h + factor - 1) / factor))
+        throw Error("cone combine: the cones were traced over " + std::to_string(low.x) + "x" +
+                    std::to_string(low.y) + " pixels, not a " + std::to_string(w) + "x" +
+                    std::to_string(h) + " G-buffer reduced by " + std::to_string(factor));
+    const bool useVisibility = in.visibility[0] != nullptr;
+    for (const gpu::Image* image : in.visibility) {
+        if (useVisibility != (image != nullptr))
+            throw Error("cone combine: give all four visibility images or none");
+        if (image != nullptr &&
+            (int(image->getDesc().width) != w || int(image->getDesc().height) != h ||
+             image->getDesc().format != gpu::Format::RGBA32Float))
+            throw Error("cone combine: the visibility image '" + image->getDesc().name + "' is " +
+                        std::to_string(image->getDesc().width) + "x" + std::to_string(image->getDesc().height) +
+                        " " + std::string(gpu::getFormatName(image->getDesc().format)) +
+                        ", expected RGBA32Float " + std::to_string(w) + "x" + std::to_string(h));
+    }
+    prepare(context, true);
+    mLastUploadBytes = 0;
+    if (!mOutputImage.isValid() || int(mOutputImage.getDesc().width) != w ||
+        int(mOutputImage.getDesc().height) != h)
+        mOutputImage = context.createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float,
+                                            std::uint32_t(std::max(w, 1)), std::uint32_t(std::max(h, 1)), 1,
+                                            gpu::ImageUsage::StorageAndSampled, "voxel_gi.irradiance"});
+    const glm::dvec3 anchor(g.cameraPosition);
+    const int capsuleCount = uploadCapsules(in.capsules, anchor);
+    CombineConstants constants =
+        makeConstants(w, h, low, factor, capsuleCount, useVisibility, in.coneHalfAngle, anchor);
+    const auto vis = [&](std::size_t k) -> const gpu::Image& {
+        return useVisibility ? *in.visibility[k] : mNoVisibility;
+    };
+    const std::vector<gpu::Binding> bindings = {
+        gpu::Binding::storageBuffer(0, dispatch.getOutput()),
+        gpu::Binding::storageBuffer(1, dispatch.getRepresentative()),
+        gpu::Binding::storageImage(2, *g.positionDepth),
+        gpu::Binding::storageImage(3, *g.normal),
+        gpu::Binding::storageBuffer(7, mCapsules),
+        gpu::Binding::storageImage(8, mOutputImage),
+        gpu::Binding::storageImage(9, vis(0)),
+        gpu::Binding::storageImage(10, vis(1)),
+        gpu::Binding::storageImage(11, vis(2)),
+        gpu::Binding::storageImage(12, vis(3))};
+    const bool traced = in.capsuleResolution == CapsuleResolution::Traced && capsuleCount > 0;
+    CombineConstants tracedConstants = constants;
+    tracedConstants.flags.w = 1;
+    if (traced)
+        constants.flags.y = 0;
+    const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
+        if (traced)
+            cmd.dispatch(mResidentPipeline, bindings, gpu::PushConstants(tracedConstants),
+                         gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(low.x), 8),
+                                         gpu::computeGroupCount(std::uint64_t(low.y), 8), 1},
+                         kDispatchLabel);
+        cmd.dispatch(mResidentPipeline, bindings, gpu::PushConstants(constants),
+                     gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), 8),
+                                     gpu::computeGroupCount(std::uint64_t(h), 8), 1},
+                     kDispatchLabel);
+    });
+    mLastGpuMs = result.sumGpuMs(kDispatchLabel);
+    return mOutputImage;
+}
+
+Image<glm::vec3> ConeCombineGpu::readBackResident() const
+{
+    if (!mOutputImage.isValid())
+        throw Error("cone combine: no resident combine has run to read back");
+    const int w = int(mOutputImage.getDesc().width), h = int(mOutputImage.getDesc().height);
+    const std::vector<glm::vec4> e = mOutputImage.downloadVector<glm::vec4>();
+    Image<glm::vec3> out(w, h, glm::vec3(0.0f));
+    for (std::size_t i = 0; i < out.pixels.size() && i < e.size(); ++i)
         out.pixels[i] = glm::vec3(e[i]);
     return out;
 }
@@ -265,6 +387,30 @@ gatherConesReducedOnGpu(gpu::Context& context, ConeCombineGpu& combiner, const s
                                                                (Clock::now() - tracedAt))
                          .count();
     return irradiance;
+}
+
+const gpu::Image& gatherConesResident(
+    gpu::Context& context, ConeCombineGpu& combiner, const plugin::VoxelGiGpuGBuffer& gbuffer, int traceStep,
+    double coneHalfAngle, const std::array<const gpu::Image*, 4>& visibility,
+    const std::vector<scene::PosedCapsule>* capsules,
+    const std::function<const PixelConeDispatch&(const PixelSource&)>& traceCones, double* combineMs,
+    CapsuleResolution capsuleResolution)
+{
+    PixelSource source;
+    source.gpu = &gbuffer;
+    source.factor = traceStep;
+    const PixelConeDispatch& dispatch = traceCones(source);
+    const auto tracedAt = std::chrono::steady_clock::now();
+    ResidentCombineInputs in;
+    in.gbuffer = &gbuffer;
+    in.visibility = visibility;
+    in.capsules = capsules;
+    in.coneHalfAngle = coneHalfAngle;
+    in.capsuleResolution = capsuleResolution;
+    const gpu::Image& out = combiner.combineResident(context, dispatch, traceStep, in);
+    if (combineMs != nullptr)
+        *combineMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tracedAt).count();
+    return out;
 }
 
 } // namespace rtlab::voxelgi

@@ -4,9 +4,11 @@
 // dispatch left them on the device, so that only the full-resolution irradiance comes back.
 // Shared by the structures gathered on Vulkan (cascades, svo, adaptive_voxel_tree_cones).
 
+#include "families/voxel_gi/cone_gather_gpu.h"
 #include "families/voxel_gi/upsample.h"
 #include "gpu/context.h"
 
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -16,6 +18,17 @@
 #include <vector>
 
 namespace rtlab::voxelgi {
+
+//! The inputs of the resident combine (ConeCombineGpu::combineResident): everything where the
+//! frame keeps it on the GPU but the capsules (a few vec4 per character).
+struct ResidentCombineInputs {
+    const plugin::VoxelGiGpuGBuffer* gbuffer = nullptr;
+    //! Cone k's visibility in channel k % 4 of RGBA32Float image k / 4; all null: none.
+    std::array<const gpu::Image*, 4> visibility{};
+    const std::vector<scene::PosedCapsule>* capsules = nullptr; //!< or null
+    double coneHalfAngle = 0.5;                                 //!< radians
+    CapsuleResolution capsuleResolution = CapsuleResolution::Full;
+};
 
 class ConeCombineGpu {
 public:
@@ -28,6 +41,20 @@ public:
                              const ConeCombineInputs& in);
     //! The same with in.coneRadiance uploaded first.
     Image<glm::vec3> combine(gpu::Context& context, const ConeCombineInputs& in);
+    //! The combine of cones traced from pixels that `dispatch` reduced on the device
+    //! (PixelConeDispatch::preparePixels with the G-buffer's GPU images; its output and
+    //! representatives are read where they are), the G-buffer and the visibilities read from
+    //! their images, the irradiance written to an RGBA32Float image of the G-buffer's size that
+    //! this object owns (valid until the next call). Only the capsules go up.
+    const gpu::Image& combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
+                                      int factor, const ResidentCombineInputs& in);
+    //! The image of the last combineResident on the CPU. Throws rtlab::Error before one.
+    Image<glm::vec3> readBackResident() const;
+    //! The image of the last combineResident, or null.
+    const gpu::Image* getResidentOutput() const
+    {
+        return mOutputImage.isValid() ? &mOutputImage : nullptr;
+    }
     //! Uploads cone radiances traced elsewhere (the C++ gather) for combine(context, buffer, in);
     //! the buffer is valid until the next call.
     const gpu::Buffer& uploadCones(gpu::Context& context,
@@ -42,19 +69,34 @@ public:
 
 private:
     // The pipeline on `context`, the cone directions compiled in (everything anew for another
-    // context).
-    void prepare(gpu::Context& context);
+    // context); `resident` also the variant that reads and writes images.
+    void prepare(gpu::Context& context, bool resident = false);
+    // The capsules relative to `anchor` as the shader reads them, uploaded; returns their count.
+    int uploadCapsules(const std::vector<scene::PosedCapsule>* capsules, const glm::dvec3& anchor);
     // A buffer of at least `bytes`; every one here is written or read once per frame, so all are
     // gpu::BufferDesc::hostVisible.
     gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name);
 
     gpu::Context* mContext = nullptr;
-    gpu::ComputePipeline mPipeline;
+    gpu::ComputePipeline mPipeline, mResidentPipeline;
+    gpu::Image mOutputImage, mNoVisibility;
     gpu::Buffer mRepresentative, mPositions, mNormals, mDepths, mMaterials, mVisibility, mCapsules,
         mOutput, mUploadedCones;
     std::optional<double> mLastGpuMs;
     std::size_t mLastUploadBytes = 0;
 };
+
+//! A cone-traced gather resident on the device: `traceCones(source)` prepares the pixels of
+//! `source` (the G-buffer's GPU images, reduced by `traceStep` on the device) in its
+//! PixelConeDispatch, runs its cones without reading back and returns the dispatch; the combine
+//! then reads them there and writes the irradiance into `combiner`'s image, which is returned.
+//! `combineMs`, when given, receives the combine's wall time.
+const gpu::Image& gatherConesResident(
+    gpu::Context& context, ConeCombineGpu& combiner, const plugin::VoxelGiGpuGBuffer& gbuffer,
+    int traceStep, double coneHalfAngle, const std::array<const gpu::Image*, 4>& visibility,
+    const std::vector<scene::PosedCapsule>* capsules,
+    const std::function<const PixelConeDispatch&(const PixelSource&)>& traceCones,
+    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full);
 
 //! Where a gather's combine runs for `setting` "vulkan", "cpu" or "auto" (without a device, in
 //! C++). "auto": on Vulkan when the cones were traced there and the device is a GPU; in C++ when

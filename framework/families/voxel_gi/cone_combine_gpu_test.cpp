@@ -1,12 +1,14 @@
 // The Vulkan combine (cone_combine_gpu.h) against the C++ one (upsample.h combineCones) on the
 // same inputs: a reduced G-buffer with a depth step, sky, thin features that take the 3 x 3
 // fallback, tilted normals, the occlusion family's visibilities and characters' capsules; the
-// same far from the origin; and what it refuses.
+// same far from the origin; and what it refuses. The resident gather (the G-buffer reduced on the
+// device from its GPU images, the combine reading images and writing one) against the same.
 
 #include "families/voxel_gi/cone_combine_gpu.h"
 
 #include "core/error.h"
 #include "families/voxel_gi/cone_tracing.h"
+#include "families/voxel_gi/voxel_gi.h"
 #include "gpu/context.h"
 
 #include <glm/geometric.hpp>
@@ -16,6 +18,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <random>
 
 using namespace rtlab;
@@ -273,6 +277,203 @@ TEST(ConeCombineGpu, AutoCombinesOnTheDeviceOnlyForAGpuGather)
     EXPECT_TRUE(shouldCombineOnGpu(&context, false, "vulkan"));
     EXPECT_FALSE(shouldCombineOnGpu(&context, true, "cpu"));
     EXPECT_FALSE(shouldCombineOnGpu(nullptr, true, "vulkan"));
+}
+
+// The G-buffer as the frame keeps it on the GPU (pipeline/frame_start.h positionDepthGpu,
+// worldNormalGpu), and the visibilities as the occlusion family leaves them (four RGBA32F images,
+// cone k in channel k % 4 of image k / 4).
+struct GpuInputs {
+    gpu::Image positionDepth, normal;
+    std::array<gpu::Image, 4> visibility;
+    plugin::VoxelGiGpuGBuffer images;
+
+    GpuInputs(gpu::Context& context, const Inputs& in)
+    {
+        const scene::GBuffer& g = in.full;
+        const auto make = [&](const char* name, int w, int h) {
+            return context.createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float, std::uint32_t(w),
+                                        std::uint32_t(h), 1, gpu::ImageUsage::StorageAndSampled, name});
+        };
+        positionDepth = make("test.position_depth", g.width, g.height);
+        normal = make("test.normal", g.width, g.height);
+        std::vector<glm::vec4> p(g.position.pixels.size()), n(p.size());
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            p[i] = glm::vec4(g.position.pixels[i], g.depth.pixels[i]);
+            n[i] = glm::vec4(g.normal.pixels[i], 0.0f);
+        }
+        positionDepth.uploadSpan<glm::vec4>(p);
+        normal.uploadSpan<glm::vec4>(n);
+        for (std::size_t image = 0; image < 4; ++image) {
+            visibility[image] = make("test.visibility", g.width, g.height);
+            std::vector<glm::vec4> v(p.size());
+            for (std::size_t i = 0; i < v.size(); ++i)
+                for (int c = 0; c < 4; ++c)
+                    v[i][c] = in.visibility[4 * image + std::size_t(c)].pixels[i];
+            visibility[image].uploadSpan<glm::vec4>(v);
+        }
+        images = {&positionDepth, &normal, g.width, g.height, glm::dvec3(g.camera.position)};
+    }
+    std::array<const gpu::Image*, 4> getVisibility() const
+    {
+        return {&visibility[0], &visibility[1], &visibility[2], &visibility[3]};
+    }
+};
+
+// A pixel cone dispatch whose "cones" are given: mode 0 copies [pixel * 16 + cone] from the extra
+// buffer at binding 6, mode 1 writes each pixel's start (position in cone 0, normal in cone 1),
+// so that the reduction and the combine are tested apart from any structure's march.
+struct ProbeDispatch {
+    PixelConeDispatch dispatch;
+    gpu::Buffer unused, given;
+
+    explicit ProbeDispatch(gpu::Context& context)
+    {
+        const auto path = std::filesystem::temp_directory_path() / "rtlab_probe_cones.comp";
+        std::ofstream(path) << R"(#version 450
+layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
+layout(std430, binding = 0) readonly buffer A { vec4 a[]; };
+layout(std430, binding = 1) readonly buffer B { vec4 b[]; };
+layout(std430, binding = 2) readonly buffer P { vec4 positions[]; };
+layout(std430, binding = 3) readonly buffer N { vec4 normals[]; };
+layout(std430, binding = 4) writeonly buffer O { vec4 cones[]; };
+layout(std430, binding = 5) readonly buffer D { vec4 directions[]; };
+layout(std430, binding = 6) readonly buffer G { vec4 given[]; };
+layout(push_constant) uniform K { ivec4 size; } pc; // width, height, mode
+void main()
+{
+    const ivec3 id = ivec3(gl_GlobalInvocationID);
+    if (id.x >= pc.size.x || id.y >= pc.size.y)
+        return;
+    const int p = id.y * pc.size.x + id.x, k = id.z;
+    cones[p * 16 + k] = pc.size.z == 0 ? given[p * 16 + k] : k == 0 ? positions[p] : k == 1 ? normals[p] : vec4(0.0);
+}
+)";
+        dispatch.create(context, path, "test.probe", sizeof(glm::ivec4), ConeSet::make(29.0), 1);
+        unused = dispatch.makeBuffer(16, "test.unused");
+    }
+    const PixelConeDispatch& run(const PixelSource& pixels, const glm::dvec3& anchor, int mode,
+                                 const std::vector<glm::vec3>* cones = nullptr)
+    {
+        dispatch.preparePixels(pixels, anchor);
+        std::vector<glm::vec4> g(std::max<std::size_t>(cones ? cones->size() : 0, 1), glm::vec4(0.0f));
+        for (std::size_t i = 0; cones && i < cones->size(); ++i)
+            g[i] = glm::vec4((*cones)[i], 0.0f);
+        given = dispatch.makeBuffer(g.size() * sizeof(glm::vec4), "test.given", true);
+        given.uploadSpan<glm::vec4>(g);
+        const glm::ivec2 size = pixels.getSize();
+        const glm::ivec4 constants(size.x, size.y, mode, 0);
+        dispatch.run(unused, unused, gpu::PushConstants(constants), nullptr, {&given});
+        return dispatch;
+    }
+};
+
+// The reduction on the device picks reduceGBuffer's representatives and lays out their starts as
+// uploadPixels does, at every reduction and far from the origin (positions relative to an anchor
+// that is not a float). The upload rounds the double difference once; the device subtracts the
+// float anchor and then what that left, exact near the anchor (Sterbenz) and rounded twice
+// farther away: within one float ulp of the upload's.
+TEST(ConeCombineGpu, ReducesTheGBufferOnTheDeviceAsTheUploadDoes)
+{
+    gpu::Context context;
+    ProbeDispatch probe(context);
+    for (const glm::dvec3 shift : {glm::dvec3(0.0), glm::dvec3(1e5, -3e4, 7e4)})
+        for (const int factor : {1, 3, 4}) {
+            SCOPED_TRACE("factor " + std::to_string(factor) + ", shift " + std::to_string(shift.x));
+            const Inputs in = makeInputs(61, 37, factor, shift);
+            const GpuInputs onGpu(context, in);
+            const glm::dvec3 anchor = shift + glm::dvec3(0.1, 0.7, -1.3);
+            const PixelConeDispatch& d = probe.run({.gpu = &onGpu.images, .factor = factor}, anchor, 1);
+            const ReducedGBuffer& r = in.reduced;
+            ASSERT_EQ(d.getPixelsSize(), glm::ivec2(r.gbuffer.width, r.gbuffer.height));
+            EXPECT_EQ(d.getRepresentative().downloadVector<int>(r.representative.size()), r.representative);
+            const std::vector<glm::vec4> starts = d.getOutput().downloadVector<glm::vec4>(r.representative.size() * 16);
+            int surfaces = 0;
+            for (int y = 0; y < r.gbuffer.height; ++y)
+                for (int x = 0; x < r.gbuffer.width; ++x) {
+                    const std::size_t s = std::size_t(y * r.gbuffer.width + x);
+                    const bool surface = r.gbuffer.hasSurface(x, y);
+                    surfaces += surface ? 1 : 0;
+                    // uploadPixels: the double difference rounded to float once.
+                    const glm::vec3 p(surface ? glm::dvec3(r.gbuffer.position.at(x, y)) - anchor : glm::dvec3(0.0));
+                    for (int c = 0; c < 3; ++c)
+                        EXPECT_LE(std::abs(starts[s * 16][c] - p[c]),
+                                  std::nextafter(std::abs(p[c]), INFINITY) - std::abs(p[c]))
+                            << x << ", " << y << ": " << starts[s * 16][c] << " against " << p[c];
+                    EXPECT_EQ(starts[s * 16].w, surface ? 1.0f : 0.0f);
+                    EXPECT_EQ(starts[s * 16 + 1], glm::vec4(r.gbuffer.normal.at(x, y), 0.0f)) << x << ", " << y;
+                }
+            EXPECT_GT(surfaces, 50);
+        }
+}
+
+// The resident combine reads the G-buffer and the visibilities from images and writes an image:
+// the same as the combine of uploaded buffers (the same shader on the same floats: equal but for
+// the compiler's freedom to contract the two variants differently, 1e-6 relative), and so the
+// C++ combine within that test's tolerance, with and without visibilities and capsules (at every
+// pixel and at the traced ones), far from the origin too.
+TEST(ConeCombineGpu, TheResidentCombineMatchesTheUploadedOne)
+{
+    gpu::Context context;
+    ProbeDispatch probe(context);
+    ConeCombineGpu resident, uploaded;
+    for (const glm::dvec3 shift : {glm::dvec3(0.0), glm::dvec3(1e5, -3e4, 7e4)}) {
+        const Inputs in = makeInputs(61, 37, 4, shift);
+        const GpuInputs onGpu(context, in);
+        for (const bool visibility : {false, true})
+            for (const int capsules : {0, 1, 2}) {
+                SCOPED_TRACE("visibility " + std::to_string(visibility) + ", capsules " + std::to_string(capsules));
+                const ConeCombineInputs c = describe(in, visibility, capsules > 0,
+                                                     capsules == 2 ? CapsuleResolution::Traced : CapsuleResolution::Full);
+                ResidentCombineInputs r;
+                r.gbuffer = &onGpu.images;
+                if (visibility)
+                    r.visibility = onGpu.getVisibility();
+                r.capsules = c.capsules;
+                r.coneHalfAngle = c.coneHalfAngle;
+                r.capsuleResolution = c.capsuleResolution;
+                const PixelConeDispatch& d = probe.run({.gpu = &onGpu.images, .factor = 4}, shift, 0, &in.cones);
+                const gpu::Image& image = resident.combineResident(context, d, 4, r);
+                EXPECT_EQ(&image, resident.getResidentOutput());
+                EXPECT_EQ(image.getDesc().width, 61u);
+                const Image<glm::vec3> fromImages = resident.readBackResident();
+                const Image<glm::vec3> fromBuffers = uploaded.combine(context, c);
+                const Difference same = compare(fromBuffers, fromImages, in.full);
+                ASSERT_GT(same.lit, 1500);
+                EXPECT_EQ(same.skyNonZero, 0);
+                EXPECT_LT(same.worst, 1e-6);
+                const Difference cpu = compare(combineCones(c), fromImages, in.full);
+                EXPECT_LT(cpu.mean, 1e-6);
+                EXPECT_LT(cpu.worst, 1e-4);
+                // Only the capsules cross the bus: 4 vec4 each.
+                EXPECT_EQ(resident.getLastUploadBytes(), capsules > 0 ? in.capsules.size() * 64 : 0u);
+            }
+    }
+}
+
+// What the resident combine refuses: visibilities of another size (named), a reduction that is
+// not the traced one, and a read-back before any combine.
+TEST(ConeCombineGpu, TheResidentCombineRefusesInputsThatDoNotFit)
+{
+    gpu::Context context;
+    ProbeDispatch probe(context);
+    const Inputs in = makeInputs(40, 24, 2, glm::dvec3(0.0));
+    const GpuInputs onGpu(context, in);
+    ConeCombineGpu combiner;
+    EXPECT_THROW(combiner.readBackResident(), Error);
+    const PixelConeDispatch& d = probe.run({.gpu = &onGpu.images, .factor = 2}, glm::dvec3(0.0), 0, &in.cones);
+    ResidentCombineInputs r;
+    r.gbuffer = &onGpu.images;
+    EXPECT_THROW(combiner.combineResident(context, d, 4, r), Error);
+    gpu::Image small = context.createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float, 20, 12, 1,
+                                            gpu::ImageUsage::StorageAndSampled, "test.small_visibility"});
+    r.visibility = onGpu.getVisibility();
+    r.visibility[2] = &small;
+    try {
+        combiner.combineResident(context, d, 2, r);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("'test.small_visibility' is 20x12"), std::string::npos) << e.what();
+    }
 }
 
 // Not a test: the two combines' wall times at 1280x720 with a quarter-resolution trace, with and

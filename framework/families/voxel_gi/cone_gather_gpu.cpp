@@ -1,13 +1,37 @@
 #include "families/voxel_gi/cone_gather_gpu.h"
 
+#include "core/error.h"
+#include "families/voxel_gi/cone_combine_gpu.h"
+#include "families/voxel_gi/voxel_gi.h"
+#include "gpu/format.h"
 #include "gpu/shader_compiler.h"
 
 #include <glm/vec4.hpp>
 
 #include <algorithm>
+#include <cstring>
 #include <cmath>
 
 namespace rtlab::voxelgi {
+
+namespace {
+
+struct ReduceConstants {
+    glm::ivec4 size{0}; // full width, height; reduced width, height
+    glm::ivec4 factor{0};
+    glm::vec4 anchorHigh{0.0f};
+    glm::vec4 anchorLow{0.0f};
+};
+static_assert(sizeof(ReduceConstants) == 64, "must match gbuffer_reduce.comp");
+
+} // namespace
+
+glm::ivec2 PixelSource::getSize() const
+{
+    if (gpu != nullptr)
+        return {(gpu->width + factor - 1) / factor, (gpu->height + factor - 1) / factor};
+    return gbuffer != nullptr ? glm::ivec2(gbuffer->width, gbuffer->height) : glm::ivec2(0);
+}
 
 void PixelConeDispatch::create(gpu::Context& context, const std::filesystem::path& shader,
                                const std::string& label, std::size_t pushConstantSize, const ConeSet& cones,
@@ -37,17 +61,75 @@ gpu::Buffer PixelConeDispatch::makeBuffer(std::size_t bytes, const char* name, b
         {.size = std::max<std::size_t>(bytes, 16), .name = name, .hostVisible = hostVisible});
 }
 
-void PixelConeDispatch::reserve(Starts& starts, std::size_t entries, const char* what)
+void PixelConeDispatch::reserve(Starts& starts, std::size_t entries, const char* what, bool hostVisible)
 {
     if (starts.capacity != entries) {
         const std::string name = std::string("cone_gather.") + what;
-        // Uploaded for every dispatch: read by the shader where the host wrote them.
+        // Uploaded for every dispatch: read by the shader where the host wrote them (unless the
+        // device writes them: hostVisible false).
         starts.positions =
-            makeBuffer(entries * sizeof(glm::vec4), (name + ".positions").c_str(), true);
-        starts.normals = makeBuffer(entries * sizeof(glm::vec4), (name + ".normals").c_str(), true);
+            makeBuffer(entries * sizeof(glm::vec4), (name + ".positions").c_str(), hostVisible);
+        starts.normals = makeBuffer(entries * sizeof(glm::vec4), (name + ".normals").c_str(), hostVisible);
         starts.output = makeBuffer(entries * kConeCount * sizeof(glm::vec4), (name + ".cone_radiance").c_str());
+        if (!hostVisible)
+            starts.representative = makeBuffer(entries * sizeof(int), (name + ".representative").c_str());
         starts.capacity = entries;
     }
+}
+
+std::size_t PixelConeDispatch::preparePixels(const PixelSource& source, const glm::dvec3& anchor)
+{
+    if (source.gpu == nullptr) {
+        if (source.gbuffer == nullptr)
+            throw Error("cone gather: no pixels given (neither a G-buffer nor its GPU images)");
+        return uploadPixels(*source.gbuffer, anchor);
+    }
+    const plugin::VoxelGiGpuGBuffer& g = *source.gpu;
+    if (g.positionDepth == nullptr || g.normal == nullptr)
+        throw Error("cone gather: the G-buffer's GPU images are missing");
+    for (const gpu::Image* image : {g.positionDepth, g.normal}) {
+        const gpu::ImageDesc& d = image->getDesc();
+        if (int(d.width) != g.width || int(d.height) != g.height || d.format != gpu::Format::RGBA32Float)
+            throw Error("cone gather: the G-buffer image '" + d.name + "' is " + std::to_string(d.width) + "x" +
+                        std::to_string(d.height) + " " + std::string(gpu::getFormatName(d.format)) +
+                        ", expected RGBA32Float " + std::to_string(g.width) + "x" + std::to_string(g.height));
+    }
+    if (source.factor < 1 || source.factor > 16)
+        throw Error("cone gather: the reduction factor must be in [1, 16], found " + std::to_string(source.factor));
+    if (!mReduce.isValid()) {
+        gpu::ComputePipelineDesc desc;
+        desc.name = "voxel_gi.reduce";
+        desc.spirv = gpu::ShaderCompiler().compileFile(ConeCombineGpu::getShaderDir() / "gbuffer_reduce.comp").spirv;
+        desc.bindings = {{0, gpu::BindingType::StorageImage},
+                         {1, gpu::BindingType::StorageImage},
+                         {2, gpu::BindingType::StorageBuffer},
+                         {3, gpu::BindingType::StorageBuffer},
+                         {4, gpu::BindingType::StorageBuffer}};
+        desc.pushConstantSize = sizeof(ReduceConstants);
+        mReduce = mContext->createPipeline(desc);
+    }
+    const glm::ivec2 low = source.getSize();
+    const std::size_t pixels = std::size_t(low.x) * std::size_t(low.y);
+    reserve(mDevicePixels, pixels, "device_pixels", false);
+    mDevicePixels.width = low.x;
+    mDevicePixels.height = low.y;
+    mDevicePixels.count = pixels;
+    ReduceConstants c;
+    c.size = {g.width, g.height, low.x, low.y};
+    c.factor = {source.factor, 0, 0, 0};
+    // The anchor as float plus what that left. Through volatile: GCC 12 at -O3 vectorizes
+    // anchor - double(float(anchor)) for x and y into anchor - anchor (0), dropping the rounding.
+    volatile float rounded[3] = {float(anchor.x), float(anchor.y), float(anchor.z)};
+    const glm::vec3 high(rounded[0], rounded[1], rounded[2]);
+    const glm::dvec3 rest = anchor - glm::dvec3(high);
+    c.anchorHigh = glm::vec4(high, 0.0f);
+    c.anchorLow = glm::vec4(glm::vec3(rest), 0.0f);
+    mReduceConstants.resize(sizeof(c));
+    std::memcpy(mReduceConstants.data(), &c, sizeof(c));
+    mReducePositions = g.positionDepth;
+    mReduceNormals = g.normal;
+    mOnDevice = true;
+    return 0;
 }
 
 std::size_t PixelConeDispatch::uploadPoints(const std::vector<glm::vec4>& positions,
@@ -73,6 +155,7 @@ std::size_t PixelConeDispatch::uploadPixels(const scene::GBuffer& gbuffer, const
 {
     const int w = gbuffer.width, h = gbuffer.height;
     const std::size_t pixels = std::size_t(w) * std::size_t(h);
+    mOnDevice = false;
     reserve(mPixels, pixels, "pixels");
     mPixels.width = w;
     mPixels.height = h;
@@ -91,12 +174,37 @@ std::size_t PixelConeDispatch::uploadPixels(const scene::GBuffer& gbuffer, const
     return 2 * pixels * sizeof(glm::vec4);
 }
 
+void PixelConeDispatch::runWithoutCones()
+{
+    Starts& starts = mOnDevice ? mDevicePixels : mPixels;
+    mContext->run([&](gpu::CommandList& cmd) {
+        if (mOnDevice)
+            recordReduce(cmd);
+        cmd.fillBuffer(starts.output, 0u);
+    });
+}
+
+void PixelConeDispatch::recordReduce(gpu::CommandList& cmd)
+{
+    cmd.dispatch(mReduce,
+                 {gpu::Binding::storageImage(0, *mReducePositions),
+                  gpu::Binding::storageImage(1, *mReduceNormals),
+                  gpu::Binding::storageBuffer(2, mDevicePixels.positions),
+                  gpu::Binding::storageBuffer(3, mDevicePixels.normals),
+                  gpu::Binding::storageBuffer(4, mDevicePixels.representative)},
+                 gpu::PushConstants(mReduceConstants.data(), mReduceConstants.size()),
+                 gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(mDevicePixels.width), 8),
+                                 gpu::computeGroupCount(std::uint64_t(mDevicePixels.height), 8), 1},
+                 "voxel_gi.reduce");
+}
+
 std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& second,
                                              const gpu::PushConstants& constants,
                                              std::vector<glm::vec3>* out,
                                              const std::vector<gpu::Buffer*>& extra, bool points)
 {
-    Starts& starts = points ? mPoints : mPixels;
+    Starts& starts = points ? mPoints : mOnDevice ? mDevicePixels : mPixels;
+    const bool reduce = !points && mOnDevice;
     std::vector<gpu::Binding> bindings = {
         gpu::Binding::storageBuffer(0, first),            gpu::Binding::storageBuffer(1, second),
         gpu::Binding::storageBuffer(2, starts.positions), gpu::Binding::storageBuffer(3, starts.normals),
@@ -104,6 +212,8 @@ std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& se
     for (std::size_t i = 0; i < extra.size(); ++i)
         bindings.push_back(gpu::Binding::storageBuffer(std::uint32_t(6 + i), *extra[i]));
     const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
+        if (reduce)
+            recordReduce(cmd);
         cmd.dispatch(mPipeline, bindings, constants,
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(starts.width), 8),
                                      gpu::computeGroupCount(std::uint64_t(starts.height), 8),

@@ -4,6 +4,9 @@
 // buffers, 2 the pixels' positions (relative to an anchor, w = 1 for a surface), 3 their normals,
 // 4 the output [pixel * 16 + cone], 5 the 16 cone directions, and from 6 on the structure's extra
 // buffers, if any; the per-pixel buffers, the dispatch, and the read-back of the cone radiances.
+// The pixels come from the CPU G-buffer (uploaded), or from the G-buffer's GPU images reduced on
+// the device in the same submission as the cones (shaders/gbuffer_reduce.comp): nothing crosses
+// the bus then.
 // The dispatch is 8 x 8 groups of pixels times 16 in z: one invocation per pixel and cone
 // (gl_GlobalInvocationID.z the cone), so that a GPU has 16 times the invocations of a pixel per
 // invocation to hide its memory latency with, and a warp marches one direction.
@@ -12,12 +15,28 @@
 #include "gpu/context.h"
 #include "scene/gbuffer.h"
 
+#include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
+namespace rtlab::plugin {
+struct VoxelGiGpuGBuffer;
+}
+
 namespace rtlab::voxelgi {
+
+//! Where the pixels of a gather come from: a CPU G-buffer (as given: the caller reduced it), or
+//! the G-buffer's GPU images, reduced on the device to one pixel per `factor` x `factor` block
+//! (voxelgi::reduceGBuffer's choice).
+struct PixelSource {
+    const scene::GBuffer* gbuffer = nullptr;
+    const plugin::VoxelGiGpuGBuffer* gpu = nullptr;
+    int factor = 1;
+    //! The traced pixels' grid: the G-buffer's size, or the reduced size for `gpu`.
+    glm::ivec2 getSize() const;
+};
 
 class PixelConeDispatch {
 public:
@@ -29,6 +48,18 @@ public:
                 std::size_t pushConstantSize, const ConeSet& cones, std::uint32_t extraBuffers = 0);
     //! Uploads the pixels' positions relative to `anchor` and their normals; returns the bytes.
     std::size_t uploadPixels(const scene::GBuffer& gbuffer, const glm::dvec3& anchor);
+    //! uploadPixels for a CPU source; for a GPU one, the reduction is recorded before the next
+    //! run()'s cones (device-local buffers, nothing uploaded) and getRepresentative() holds the
+    //! reduced pixels' full-resolution indices after it. Returns the bytes uploaded.
+    std::size_t preparePixels(const PixelSource& source, const glm::dvec3& anchor);
+    //! After a run() over pixels reduced on the device: [reduced pixel] -> full pixel, -1 none.
+    const gpu::Buffer& getRepresentative() const { return mDevicePixels.representative; }
+    //! The grid of the pixels of the last uploadPixels or preparePixels.
+    glm::ivec2 getPixelsSize() const
+    {
+        const Starts& s = mOnDevice ? mDevicePixels : mPixels;
+        return {s.width, s.height};
+    }
     //! Uploads points to trace cones from instead of pixels (a structure's own points, such as
     //! voxel centres; their own buffers, laid out as rows of 256 "pixels", w = 0 past the last):
     //! positions (w = 1) and a second vec4 per point whose meaning is the shader's; returns the
@@ -43,8 +74,11 @@ public:
     std::optional<double> run(gpu::Buffer& first, gpu::Buffer& second,
                               const gpu::PushConstants& constants, std::vector<glm::vec3>* out,
                               const std::vector<gpu::Buffer*>& extra = {}, bool points = false);
+    //! For a structure with nothing to trace: the prepared pixels' reduction (if on the device)
+    //! and zero radiances in getOutput().
+    void runWithoutCones();
     //! The cone radiances of the last run over pixels, [pixel * 16 + cone] as vec4.
-    const gpu::Buffer& getOutput() const { return mPixels.output; }
+    const gpu::Buffer& getOutput() const { return mOnDevice ? mDevicePixels.output : mPixels.output; }
     //! A storage buffer of at least `bytes` (16 at least) named `name`; `hostVisible` for data
     //! uploaded anew for each dispatch (gpu::BufferDesc::hostVisible).
     gpu::Buffer makeBuffer(std::size_t bytes, const char* name, bool hostVisible = false);
@@ -57,12 +91,21 @@ private:
     // What the cones start from: the pixels, or points.
     struct Starts {
         gpu::Buffer positions, normals, output;
+        gpu::Buffer representative; //!< mDevicePixels only
         int width = 0, height = 0;
         std::size_t count = 0;    //!< entries read back
         std::size_t capacity = 0; //!< entries the buffers hold
     };
-    Starts mPixels, mPoints;
-    void reserve(Starts& starts, std::size_t entries, const char* what);
+    // Uploaded pixels, uploaded points, pixels reduced on the device (device-local buffers).
+    Starts mPixels, mPoints, mDevicePixels;
+    bool mOnDevice = false; //!< the last pixels prepared were reduced on the device
+    // The reduction recorded before the next run() (mOnDevice).
+    gpu::ComputePipeline mReduce;
+    std::vector<std::byte> mReduceConstants;
+    const gpu::Image* mReducePositions = nullptr;
+    const gpu::Image* mReduceNormals = nullptr;
+    void reserve(Starts& starts, std::size_t entries, const char* what, bool hostVisible = true);
+    void recordReduce(gpu::CommandList& cmd);
 };
 
 } // namespace rtlab::voxelgi

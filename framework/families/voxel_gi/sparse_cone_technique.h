@@ -16,6 +16,7 @@
 #include "families/voxel_gi/sparse_cone_params.h"
 #include "families/voxel_gi/upsample.h"
 #include "families/voxel_gi/voxel_gi.h"
+#include "core/error.h"
 
 #include <cmath>
 #include <optional>
@@ -67,11 +68,42 @@ public:
                                          std::to_string(mParams.bounces) + " passes");
     }
 
+    std::string whyNotGatheredOnGpu(const gpu::Context& gpu) const override
+    {
+        if (!shouldGatherOnGpu(&gpu, mParams.device))
+            return "the pixel cones run in C++ (device: " + mParams.device +
+                   (mParams.device == "auto" ? " on a CPU device" : "") + ")";
+        return {};
+    }
+
+    const gpu::Image* getGpuIrradiance() const override { return mCombineGpu.getResidentOutput(); }
+
+    void readBackIrradiance(Image<glm::vec3>& irradiance) override
+    {
+        irradiance = mCombineGpu.readBackResident();
+    }
+
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
+        mSky.cones.clear();
+        if (input.gpuGBuffer != nullptr) {
+            // Resident: the pixels reduced on the device, their cones and the combine there.
+            if (input.gpu == nullptr || !whyNotGatheredOnGpu(*input.gpu).empty())
+                throw Error("the G-buffer was given on the GPU to a gather that does not run there");
+            mGatheredOnGpu = mCombinedOnGpu = true;
+            gatherConesResident(
+                *input.gpu, mCombineGpu, *input.gpuGBuffer, mParams.traceStep,
+                mStructure->getCones().halfAngle, input.gpuConeVisibility, input.capsules,
+                [&](const PixelSource& pixels) -> const PixelConeDispatch& {
+                    return mGpu.gatherConesResident(*input.gpu, *mStructure, pixels);
+                },
+                &mCombineMs, mParams.capsules);
+            if (input.readBack)
+                readBackIrradiance(irradiance);
+            return;
+        }
         mGatheredOnGpu = shouldGatherOnGpu(input.gpu, mParams.device);
         mCombinedOnGpu = shouldCombineOnGpu(input.gpu, mGatheredOnGpu);
-        mSky.cones.clear();
         if (mCombinedOnGpu) {
             irradiance = gatherConesReducedOnGpu(
                 *input.gpu, mCombineGpu, *input.gbuffer, mParams.traceStep,

@@ -14,6 +14,7 @@
 // The shared machinery lives beside this header: voxelize.h (triangles -> volumetric G-buffer)
 // and cone_tracing.h (the 16 cones, the march, light injection).
 
+#include "core/error.h"
 #include "core/image.h"
 #include "plugin/technique.h"
 #include "scene/gbuffer.h"
@@ -22,13 +23,15 @@
 
 #include <glm/vec3.hpp>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 namespace rtlab::gpu {
 class Context;
-}
+class Image;
+} // namespace rtlab::gpu
 
 namespace rtlab::plugin {
 
@@ -75,8 +78,21 @@ struct VoxelGiStep {
     static VoxelGiStep done(std::string what) { return {true, {}, std::move(what)}; }
 };
 
+//! The G-buffer as the frame keeps it on the GPU (pipeline/frame_start.h positionDepthGpu,
+//! worldNormalGpu): storage images of the G-buffer's size.
+struct VoxelGiGpuGBuffer {
+    //! RGBA32Float: world position in xyz, linear view depth in w (inf where no surface).
+    const gpu::Image* positionDepth = nullptr;
+    const gpu::Image* normal = nullptr; //!< RGBA32Float: world unit shading normal in xyz
+    int width = 0;
+    int height = 0;
+    glm::dvec3 cameraPosition{0.0};
+};
+
 struct VoxelGiInput {
-    const scene::GBuffer* gbuffer = nullptr; //!< world positions and normals of the pixels
+    //! World positions and normals of the pixels; null when the G-buffer is given on the GPU
+    //! only (gpuGBuffer).
+    const scene::GBuffer* gbuffer = nullptr;
     //! The frame's full triangle scene (characters included): ray-traced baselines only.
     const scene::RenderScene* scene = nullptr;
     glm::dvec3 cameraPosition{0.0};
@@ -89,6 +105,19 @@ struct VoxelGiInput {
     //! The frame will ask for the cones' sky (combineConeSky): the gather traces it too. False
     //! when nothing reads it (no lit frame, or `frame: {sky: lobes}`).
     bool coneSky = false;
+
+    // The resident gather ([12]: the frame stays on the GPU). Given to a technique whose
+    // gathersOnGpu() is true when the frame keeps its G-buffer on the GPU; `gbuffer` and
+    // `coneVisibility` are then null and the technique binds these instead.
+    const VoxelGiGpuGBuffer* gpuGBuffer = nullptr;
+    //! The occlusion family's 16 visibilities on the GPU (pipeline/compose.h
+    //! coneVisibilityGpuSlot: cone k in channel k % 4 of RGBA32Float image k / 4); all null when
+    //! the occlusion technique gives none or there is none.
+    std::array<const gpu::Image*, 4> gpuConeVisibility{};
+    //! With gpuGBuffer: false leaves the irradiance on the GPU only (getGpuIrradiance), and the
+    //! image given to gather() untouched; readBackIrradiance() brings it to the CPU when a
+    //! measurement reads it. True fills the image too.
+    bool readBack = true;
 };
 
 //! Sizes the family reports for the data-structure metrics.
@@ -106,6 +135,23 @@ public:
     //! Indirect diffuse irradiance at every G-buffer pixel (0 where there is no surface).
     virtual void gather(const VoxelGiInput& input, Image<glm::vec3>& irradiance) = 0;
     virtual VoxelGiMemory memory() const = 0;
+    //! Whether gather() on `gpu` runs on the device from start to end (the pixel cones and their
+    //! combine), so that it can take the G-buffer and the cone visibilities as GPU images
+    //! (VoxelGiInput::gpuGBuffer) and leave its irradiance there (getGpuIrradiance): no read-back
+    //! and no upload per frame but the capsules. "" when it does, else why not (recorded in the
+    //! row as `voxel_gather.resident`).
+    virtual std::string whyNotGatheredOnGpu(const gpu::Context& gpu) const
+    {
+        return "the technique has no resident Vulkan gather";
+    }
+    //! The irradiance of the last gather() with VoxelGiInput::gpuGBuffer: RGBA32Float (rgb), the
+    //! G-buffer's size, owned by the technique and valid until its next gather(); null before.
+    virtual const gpu::Image* getGpuIrradiance() const { return nullptr; }
+    //! That image on the CPU. Throws rtlab::Error when there is none.
+    virtual void readBackIrradiance(Image<glm::vec3>& /*irradiance*/)
+    {
+        throw Error("this voxel_gi technique keeps no irradiance on the GPU to read back");
+    }
     //! The irradiance from the sky and from emissive surfaces that the 16 cones of the last
     //! gather() saw past the technique's voxels (the sky where a cone leaves the structure, times
     //! what the voxels let through; the emitters the cones meet), at every pixel of that gather's

@@ -38,11 +38,14 @@
 #include "pipeline/compose.h"
 #include "pipeline/frame_graph.h"
 #include "pipeline/frame_start.h"
+#include "gpu/resources.h"
 #include "reference/reference.h"
 
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 namespace rtlab::families {
 namespace {
@@ -148,8 +151,105 @@ private:
         return f;
     }
 
+    std::string mResidentRow; //!< voxel_gather.resident: "yes", or "no: " and why
+    bool mResident = false;   //!< the gather runs resident (addResidentGather)
     //! Whether the run's lit frame takes its sky from the technique's cones.
     bool wantsConeSky() const { return mRun.lighting && mRun.sky != "lobes"; }
+
+    //! The resident gather's passes: `voxel_gather` on the G-buffer's GPU images into the
+    //! technique's image, `voxel_gather_readback` (runs only for the passes that read `indirect`
+    //! on the CPU), `indirect_gpu_slot` (the lighting pass binds the image) and `voxel_cone_sky`,
+    //! which says why the frame's sky takes the lobes.
+    void addResidentGather(pipeline::FrameGraph& graph, pipeline::FrameStart& start,
+                           const pipeline::Resource<int>& voxelLight,
+                           const pipeline::Resource<Image<glm::vec3>>& indirect,
+                           const pipeline::Resource<std::array<const gpu::Image*, 4>>* conesGpu,
+                           const pipeline::Resource<std::vector<scene::PosedCapsule>>* capsules)
+    {
+        const int w = mRun.width, h = mRun.height;
+        const auto gbufferGpu = start.gbuffer();
+        const auto positionGpu = start.positionDepthGpu();
+        const auto normalGpu = start.worldNormalGpu();
+        const pipeline::Resource<const gpu::Image*> onGpu{
+            "technique_indirect_gpu", pipeline::ResourceType::gpuImage("rgba32f irradiance", w, h)};
+        std::vector<pipeline::ResourceRef> optional;
+        if (conesGpu != nullptr)
+            optional.push_back(*conesGpu);
+        if (capsules != nullptr)
+            optional.push_back(*capsules);
+        const auto cones = conesGpu ? std::optional(*conesGpu) : std::nullopt;
+        const auto posed = capsules ? std::optional(*capsules) : std::nullopt;
+        graph.addPass(
+            {.name = "voxel_gather",
+             .reads = {voxelLight, gbufferGpu, positionGpu, normalGpu},
+             .optionalReads = optional,
+             .writes = {onGpu}},
+            [this, gbufferGpu, positionGpu, normalGpu, cones, posed, onGpu, w,
+             h](pipeline::PassContext& ctx) {
+                const pipeline::GpuGBuffer& g = ctx.read(gbufferGpu);
+                plugin::VoxelGiGpuGBuffer images;
+                images.positionDepth = &ctx.read(positionGpu);
+                images.normal = &ctx.read(normalGpu);
+                images.width = g.width;
+                images.height = g.height;
+                images.cameraPosition = glm::dvec3(g.camera.position);
+                plugin::VoxelGiInput input;
+                input.gpuGBuffer = &images;
+                input.cameraPosition = images.cameraPosition;
+                input.frameIndex = ctx.frame();
+                input.gpu = &mContext.getGpu();
+                input.capsules = posed ? ctx.tryRead(*posed) : nullptr;
+                if (const auto* v = cones ? ctx.tryRead(*cones) : nullptr)
+                    input.gpuConeVisibility = *v;
+                input.readBack = false;
+                Image<glm::vec3> unused;
+                mTechnique->gather(input, unused);
+                const gpu::Image* image = mTechnique->getGpuIrradiance();
+                if (image == nullptr)
+                    throw Error("technique '" + mTechniqueName +
+                                "' says its gather runs on the GPU but left no irradiance there");
+                if (int(image->getDesc().width) != w || int(image->getDesc().height) != h)
+                    throw Error("technique '" + mTechniqueName + "' left a " +
+                                std::to_string(image->getDesc().width) + "x" +
+                                std::to_string(image->getDesc().height) +
+                                " irradiance image on the GPU for a " + std::to_string(w) + "x" +
+                                std::to_string(h) + " G-buffer");
+                ctx.write(onGpu) = image;
+                mRow->set("gather.cone_visibility", input.gpuConeVisibility[0] != nullptr);
+                mRow->set("voxel_gather.resident", mResidentRow);
+                return pipeline::PassOutcome{};
+            });
+        graph.addPass({.name = "voxel_gather_readback",
+                       .reads = {onGpu},
+                       .writes = {indirect},
+                       .forReaders = true},
+                      [this, indirect, w, h](pipeline::PassContext& ctx) {
+                          Image<glm::vec3>& out = ctx.write(indirect);
+                          mTechnique->readBackIrradiance(out);
+                          if (out.width != w || out.height != h)
+                              throw Error("technique '" + mTechniqueName + "' read back " +
+                                          std::to_string(out.width) + "x" +
+                                          std::to_string(out.height) + " irradiance for a " +
+                                          std::to_string(w) + "x" + std::to_string(h) +
+                                          " G-buffer");
+                          return pipeline::PassOutcome{};
+                      });
+        const auto slotGpu = pipeline::Compose::indirectIrradianceGpuSlot(w, h);
+        graph.addPass({.name = "indirect_gpu_slot", .reads = {onGpu}, .writes = {slotGpu}},
+                      [onGpu, slotGpu](pipeline::PassContext& ctx) {
+                          ctx.write(slotGpu) = ctx.read(onGpu);
+                          return pipeline::PassOutcome{};
+                      });
+        // No cone sky on this path yet: the lit frame takes the lobes, and the row says why.
+        const auto coneSkyGpu = pipeline::Compose::coneSkyGpuSlot(w, h);
+        graph.addPass({.name = "voxel_cone_sky", .reads = {onGpu}, .writes = {coneSkyGpu}},
+                      [this, coneSkyGpu](pipeline::PassContext& ctx) {
+                          ctx.write(coneSkyGpu) = nullptr;
+                          mRow->set("voxel_cone_sky.none",
+                                    "the resident Vulkan gather traces no cone sky yet (device: cpu does)");
+                          return pipeline::PassOutcome{};
+                      });
+    }
 
     void addPasses(experiment::RunSetup& setup)
     {
@@ -267,49 +367,69 @@ private:
                             what + " for a " + std::to_string(g.width) + "x" +
                             std::to_string(g.height) + " G-buffer");
         };
-        graph.addPass(
-            {.name = "voxel_gather",
-             .reads = {voxelLight, gbuffer, geometry},
-             .optionalReads = gatherOptional,
-             .writes = {indirect}},
-            [this, gbuffer, geometry, makeInput, checkSize, indirect](pipeline::PassContext& ctx) {
-                const scene::GBuffer& g = ctx.read(gbuffer);
-                plugin::VoxelGiInput input = makeInput(ctx, g);
-                input.scene = &ctx.read(geometry);
-                Image<glm::vec3>& out = ctx.write(indirect);
-                mTechnique->gather(input, out);
-                checkSize(out, g, "irradiance");
-                mRow->set("gather.cone_visibility", input.coneVisibility != nullptr);
-                return pipeline::PassOutcome{};
-            });
+        // Resident ([12]): the technique reduces the G-buffer's GPU images, traces and combines
+        // its cones on the device, and the lighting pass binds its image; the irradiance comes
+        // to the CPU only for the passes that read it there (measurements). Otherwise the gather
+        // reads the CPU G-buffer and the compose passes upload its result.
+        const auto conesGpu = pipeline::Compose::coneVisibilityGpuSlot(w, h);
+        std::string whyNotResident;
+        if (!mRun.gbufferOnGpu)
+            whyNotResident = "frame: {gbuffer_on_gpu: false} (the round trip through the CPU)";
+        else if (std::string why = mTechnique->whyNotGatheredOnGpu(mContext.getGpu()); !why.empty())
+            whyNotResident = why;
+        else if (hasCones && !graph.declares(conesGpu.name))
+            whyNotResident = "the occlusion technique's cone visibilities are on the CPU only";
+        const bool resident = mResident = whyNotResident.empty();
+        mResidentRow = resident ? "yes" : "no: " + whyNotResident;
         const auto slot = pipeline::Compose::indirectIrradianceSlot(w, h);
+        const auto coneSky = pipeline::Compose::coneSkySlot(w, h);
+        if (resident)
+            addResidentGather(graph, start, voxelLight, indirect, hasCones ? &conesGpu : nullptr,
+                              hasCapsules ? &capsules : nullptr);
+        else {
+            graph.addPass(
+                {.name = "voxel_gather",
+                 .reads = {voxelLight, gbuffer, geometry},
+                 .optionalReads = gatherOptional,
+                 .writes = {indirect}},
+                [this, gbuffer, geometry, makeInput, checkSize, indirect](pipeline::PassContext& ctx) {
+                    const scene::GBuffer& g = ctx.read(gbuffer);
+                    plugin::VoxelGiInput input = makeInput(ctx, g);
+                    input.scene = &ctx.read(geometry);
+                    Image<glm::vec3>& out = ctx.write(indirect);
+                    mTechnique->gather(input, out);
+                    checkSize(out, g, "irradiance");
+                    mRow->set("gather.cone_visibility", input.coneVisibility != nullptr);
+                    mRow->set("voxel_gather.resident", mResidentRow);
+                    return pipeline::PassOutcome{};
+                });
+            // The sky and the emitters through the technique's cones, for the lit frame (culled
+            // when no frame is lit: nothing reads the slot then).
+            graph.addPass(
+                {.name = "voxel_cone_sky",
+                 .reads = {indirect, gbuffer},
+                 .optionalReads = gatherOptional,
+                 .writes = {coneSky}},
+                [this, gbuffer, makeInput, checkSize, coneSky](pipeline::PassContext& ctx) {
+                    const scene::GBuffer& g = ctx.read(gbuffer);
+                    const plugin::VoxelGiInput input = makeInput(ctx, g);
+                    Image<glm::vec3>& out = ctx.write(coneSky);
+                    out = Image<glm::vec3>();
+                    const std::string whyNot = mTechnique->combineConeSky(input, out);
+                    if (!whyNot.empty()) {
+                        out = Image<glm::vec3>(); // the frame lights its sky with the lobes
+                        mRow->set("voxel_cone_sky.none", whyNot);
+                    } else {
+                        checkSize(out, g, "cone sky");
+                    }
+                    return pipeline::PassOutcome{};
+                });
+        }
         graph.addPass({.name = "indirect_slot", .reads = {indirect}, .writes = {slot}},
                       [indirect, slot](pipeline::PassContext& ctx) {
                           ctx.write(slot) = ctx.read(indirect);
                           return pipeline::PassOutcome{};
                       });
-        // The sky and the emitters through the technique's cones, for the lit frame (culled
-        // when no frame is lit: nothing reads the slot then).
-        const auto coneSky = pipeline::Compose::coneSkySlot(w, h);
-        graph.addPass(
-            {.name = "voxel_cone_sky",
-             .reads = {indirect, gbuffer},
-             .optionalReads = gatherOptional,
-             .writes = {coneSky}},
-            [this, gbuffer, makeInput, checkSize, coneSky](pipeline::PassContext& ctx) {
-                const scene::GBuffer& g = ctx.read(gbuffer);
-                const plugin::VoxelGiInput input = makeInput(ctx, g);
-                Image<glm::vec3>& out = ctx.write(coneSky);
-                out = Image<glm::vec3>();
-                const std::string whyNot = mTechnique->combineConeSky(input, out);
-                if (!whyNot.empty()) {
-                    out = Image<glm::vec3>(); // the frame lights its sky with the lobes
-                    mRow->set("voxel_cone_sky.none", whyNot);
-                } else {
-                    checkSize(out, g, "cone sky");
-                }
-                return pipeline::PassOutcome{};
-            });
         graph.addPass(
             {.name = "reference_indirect",
              .reads = {geometry, gbuffer, view},
@@ -451,7 +571,7 @@ private:
                               .set("split.rays_per_pixel", std::int64_t(kSplitRays));
                           return pipeline::PassOutcome{};
                       });
-        if (wantsConeSky()) {
+        if (wantsConeSky() && !mResident) { // the resident gather traces no cone sky yet
             voxelgi::addConeSkySplit(graph,
                                      {.geometry = geometry, .gbuffer = gbuffer, .view = view,
                                       .voxelLight = voxelLight, .coneSky = coneSky},

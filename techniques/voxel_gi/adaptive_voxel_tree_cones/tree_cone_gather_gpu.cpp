@@ -33,14 +33,14 @@ std::filesystem::path TreeConeGatherGpu::getShaderDir()
 void TreeConeGatherGpu::gatherCones(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
                                     std::vector<glm::vec3>& out)
 {
-    trace(context, tree, gbuffer, &out);
+    trace(context, tree, PixelSource{.gbuffer = &gbuffer}, &out);
 }
 
 const gpu::Buffer& TreeConeGatherGpu::gatherConesOnDevice(gpu::Context& context,
                                                           const VoxelTreeCones& tree,
                                                           const scene::GBuffer& gbuffer)
 {
-    trace(context, tree, gbuffer, nullptr);
+    trace(context, tree, PixelSource{.gbuffer = &gbuffer}, nullptr);
     if (tree.getTree() != nullptr)
         return mDispatch.getOutput();
     const std::vector<glm::vec4> zeros(
@@ -53,8 +53,15 @@ const gpu::Buffer& TreeConeGatherGpu::gatherConesOnDevice(gpu::Context& context,
     return mZeros;
 }
 
+const PixelConeDispatch& TreeConeGatherGpu::gatherConesResident(gpu::Context& context, const VoxelTreeCones& tree,
+                                                               const PixelSource& pixels)
+{
+    trace(context, tree, pixels, nullptr);
+    return mDispatch;
+}
+
 void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
-                              const scene::GBuffer& gbuffer, std::vector<glm::vec3>* out)
+                              const PixelSource& pixels, std::vector<glm::vec3>* out)
 {
     if (!mDispatch.isReadyFor(context)) {
         *this = TreeConeGatherGpu();
@@ -62,10 +69,15 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
                          tree.getCones());
     }
     const AdaptiveVoxelTree* t = tree.getTree();
+    const glm::ivec2 size = pixels.getSize();
     if (t == nullptr) {
         if (out != nullptr)
-            out->assign(std::size_t(gbuffer.width) * std::size_t(gbuffer.height) * kConeCount,
-                        glm::vec3(0.0f));
+            out->assign(std::size_t(size.x) * std::size_t(size.y) * kConeCount, glm::vec3(0.0f));
+        // Pixels reduced on the device: their representatives and no light.
+        if (pixels.gpu != nullptr) {
+            mDispatch.preparePixels(pixels, tree.getOrigin());
+            mDispatch.runWithoutCones();
+        }
         return;
     }
     mLastUploadBytes = 0;
@@ -87,10 +99,10 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
         mUploadedStamp = tree.getStamp();
     }
     const glm::dvec3 anchor = tree.getOrigin() + 0.5 * tree.getBoxSize();
-    mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
+    mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
     const TreeConeSettings& s = tree.getSettings();
     GatherConstants constants;
-    constants.size = {gbuffer.width, gbuffer.height, s.depth, 1024};
+    constants.size = {size.x, size.y, s.depth, 1024};
     constants.march = {float(tree.getLeafSize()), float(tree.getCones().tanHalfAngle), float(s.startOffset),
                        float(s.stepScale)};
     constants.box = glm::vec4(glm::vec3(tree.getOrigin() - anchor), 0.0f);

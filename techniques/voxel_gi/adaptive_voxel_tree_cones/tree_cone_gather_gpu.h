@@ -28,6 +28,11 @@ public:
     //! (for cone_combine_gpu.h), valid until the next call.
     const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const VoxelTreeCones& tree,
                                            const scene::GBuffer& gbuffer);
+    //! The same from pixels reduced on the device (the resident gather, cone_combine_gpu.h
+    //! gatherConesResident): the dispatch holds the radiances (zero for an empty tree) and the
+    //! representatives.
+    const PixelConeDispatch& gatherConesResident(gpu::Context& context, const VoxelTreeCones& tree,
+                                                 const PixelSource& pixels);
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/adaptive_voxel_tree_cones/shaders when set, else the
@@ -35,7 +40,7 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
-    void trace(gpu::Context& context, const VoxelTreeCones& tree, const scene::GBuffer& gbuffer,
+    void trace(gpu::Context& context, const VoxelTreeCones& tree, const PixelSource& pixels,
                std::vector<glm::vec3>* out);
 
     PixelConeDispatch mDispatch;

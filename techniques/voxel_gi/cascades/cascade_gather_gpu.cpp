@@ -117,26 +117,35 @@ GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anc
 void CascadeGatherGpu::gatherCones(gpu::Context& context, const CascadeVolume& volume,
                                    const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
-    trace(context, volume, gbuffer, &out);
+    trace(context, volume, PixelSource{.gbuffer = &gbuffer}, &out);
 }
 
 const gpu::Buffer& CascadeGatherGpu::gatherConesOnDevice(gpu::Context& context,
                                                          const CascadeVolume& volume,
                                                          const scene::GBuffer& gbuffer)
 {
-    trace(context, volume, gbuffer, nullptr);
+    trace(context, volume, PixelSource{.gbuffer = &gbuffer}, nullptr);
     return mDispatch.getOutput();
 }
 
+const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& context, const CascadeVolume& volume,
+                                                              const PixelSource& pixels)
+{
+    if (volume.getSettings().farStart > 0.0)
+        throw Error("cascades: the resident gather traces whole cones only (far_start: 0)");
+    trace(context, volume, pixels, nullptr);
+    return mDispatch;
+}
+
 void CascadeGatherGpu::trace(gpu::Context& context, const CascadeVolume& volume,
-                             const scene::GBuffer& gbuffer, std::vector<glm::vec3>* out)
+                             const PixelSource& pixels, std::vector<glm::vec3>* out)
 {
     mLastUploadBytes = 0;
     const glm::dvec3 anchor = prepare(context, volume);
-    mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
+    mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
     uploadFarCones(volume);
     mLastGpuMs = mDispatch.run(mLevels, mCombined,
-                               gpu::PushConstants(makeConstants(volume, anchor, {gbuffer.width, gbuffer.height}, false)),
+                               gpu::PushConstants(makeConstants(volume, anchor, pixels.getSize(), false)),
                                out, {&mFarSlots, &mFarCones});
 }
 

@@ -40,6 +40,11 @@ public:
     //! (for cone_combine_gpu.h), valid until the next call.
     const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const CascadeVolume& volume,
                                            const scene::GBuffer& gbuffer);
+    //! The same from pixels reduced on the device (the resident gather, cone_combine_gpu.h
+    //! gatherConesResident), whole cones only (farStart 0: the far cones are chosen from the
+    //! pixels on the CPU): the dispatch holds the radiances and the representatives.
+    const PixelConeDispatch& gatherConesResident(gpu::Context& context, const CascadeVolume& volume,
+                                                 const PixelSource& pixels);
     //! CascadeVolume::FarConeTracer on Vulkan: the 16 far cones of each voxel centre, through
     //! the same pre-combined buffers (uploaded when they changed), [centre * 16 + cone].
     void traceFarCones(gpu::Context& context, const CascadeVolume& volume,
@@ -52,7 +57,7 @@ public:
     static std::filesystem::path getShaderDir();
 
 private:
-    void trace(gpu::Context& context, const CascadeVolume& volume, const scene::GBuffer& gbuffer,
+    void trace(gpu::Context& context, const CascadeVolume& volume, const PixelSource& pixels,
                std::vector<glm::vec3>* out);
     // The pipeline for `context`, the levels' descriptors and the pre-combined buffers of the
     // levels that changed; returns the anchor positions are relative to.

@@ -320,8 +320,47 @@ public:
         return plugin::VoxelGiStep::done("lit " + what);
     }
 
+    std::string whyNotGatheredOnGpu(const gpu::Context& gpu) const override
+    {
+        if (!voxelgi::shouldGatherOnGpu(&gpu, mDevice) || !mSettings.precombine)
+            return !mSettings.precombine ? "the Vulkan gather reads the pre-combined buffers (precombine: false)"
+                                         : "the pixel cones run in C++ (device: " + mDevice +
+                                               (mDevice == "auto" ? " on a CPU device" : "") + ")";
+        if (!voxelgi::shouldCombineOnGpu(&gpu, true, mCombineDevice))
+            return "the combine runs in C++ (combine_device: " + mCombineDevice +
+                   (mCombineDevice == "auto" ? " on a CPU device" : "") + ")";
+        if (mSettings.farStart > 0.0)
+            return "split cones choose their far cones from the pixels on the CPU (far_start > 0)";
+        return {};
+    }
+
+    const gpu::Image* getGpuIrradiance() const override { return mCombineGpu.getResidentOutput(); }
+
+    void readBackIrradiance(Image<glm::vec3>& irradiance) override
+    {
+        irradiance = mCombineGpu.readBackResident();
+    }
+
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
+        if (input.gpuGBuffer != nullptr) {
+            // Resident: the pixels reduced on the device, their cones and the combine there.
+            if (input.gpu == nullptr || !whyNotGatheredOnGpu(*input.gpu).empty())
+                throw Error("cascades: the G-buffer was given on the GPU to a gather that does not run there");
+            mGatheredOnGpu = mCombinedOnGpu = true;
+            mSky.cones.clear();
+            mSkyWhyNot = "the Vulkan gather traces no cone sky yet (device: cpu does)";
+            voxelgi::gatherConesResident(
+                *input.gpu, mCombineGpu, *input.gpuGBuffer, mTraceStep, mVolume->getCones().halfAngle,
+                input.gpuConeVisibility, input.capsules,
+                [&](const voxelgi::PixelSource& pixels) -> const voxelgi::PixelConeDispatch& {
+                    return mGpu.gatherConesResident(*input.gpu, *mVolume, pixels);
+                },
+                &mCombineMs, mCapsuleResolution);
+            if (input.readBack)
+                readBackIrradiance(irradiance);
+            return;
+        }
         // The Vulkan gather reads the pre-combined buffers; without them the C++ path runs.
         // Reduced resolution ("Trace at a lower resolution"): one pixel per trace_step^2 block,
         // each cone's radiance upsampled by depth and normal, times the pixel's own visibilities

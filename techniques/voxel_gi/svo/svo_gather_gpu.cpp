@@ -29,19 +29,26 @@ std::filesystem::path OctreeGatherGpu::getShaderDir()
 void OctreeGatherGpu::gatherCones(gpu::Context& context, const SparseVoxelOctree& tree,
                                   const scene::GBuffer& gbuffer, std::vector<glm::vec3>& out)
 {
-    trace(context, tree, gbuffer, &out);
+    trace(context, tree, PixelSource{.gbuffer = &gbuffer}, &out);
 }
 
 const gpu::Buffer& OctreeGatherGpu::gatherConesOnDevice(gpu::Context& context,
                                                         const SparseVoxelOctree& tree,
                                                         const scene::GBuffer& gbuffer)
 {
-    trace(context, tree, gbuffer, nullptr);
+    trace(context, tree, PixelSource{.gbuffer = &gbuffer}, nullptr);
     return mDispatch.getOutput();
 }
 
+const PixelConeDispatch& OctreeGatherGpu::gatherConesResident(gpu::Context& context, const SparseVoxelOctree& tree,
+                                                             const PixelSource& pixels)
+{
+    trace(context, tree, pixels, nullptr);
+    return mDispatch;
+}
+
 void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree,
-                            const scene::GBuffer& gbuffer, std::vector<glm::vec3>* out)
+                            const PixelSource& pixels, std::vector<glm::vec3>* out)
 {
     if (!mDispatch.isReadyFor(context)) {
         *this = OctreeGatherGpu();
@@ -64,8 +71,9 @@ void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree
         mUploadedStamp = tree.getStamp();
     }
     const glm::dvec3 anchor = tree.getOrigin() + glm::dvec3(0.5 * tree.getSide());
-    const int w = gbuffer.width, h = gbuffer.height;
-    mLastUploadBytes += mDispatch.uploadPixels(gbuffer, anchor);
+    const glm::ivec2 size = pixels.getSize();
+    const int w = size.x, h = size.y;
+    mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
 
     const OctreeSettings& s = tree.getSettings();
     GatherConstants constants;

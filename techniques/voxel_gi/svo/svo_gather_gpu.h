@@ -25,13 +25,17 @@ public:
     //! (for cone_combine_gpu.h), valid until the next call.
     const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const SparseVoxelOctree& tree,
                                            const scene::GBuffer& gbuffer);
+    //! The same from pixels reduced on the device (the resident gather, cone_combine_gpu.h
+    //! gatherConesResident): the dispatch holds the radiances and the representatives.
+    const PixelConeDispatch& gatherConesResident(gpu::Context& context, const SparseVoxelOctree& tree,
+                                                 const PixelSource& pixels);
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/svo/shaders when set, else the source folder.
     static std::filesystem::path getShaderDir();
 
 private:
-    void trace(gpu::Context& context, const SparseVoxelOctree& tree, const scene::GBuffer& gbuffer,
+    void trace(gpu::Context& context, const SparseVoxelOctree& tree, const PixelSource& pixels,
                std::vector<glm::vec3>* out);
 
     PixelConeDispatch mDispatch;

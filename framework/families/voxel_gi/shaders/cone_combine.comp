@@ -16,21 +16,36 @@
 // The G-buffer arrives as the frame holds it (float positions, normals and depth, one word of
 // material per pixel), so that the upload is a copy; positions are made relative to an anchor
 // near the camera here, which is exact for the float inputs wherever the capsule tests matter.
+// Compiled with GBUFFER_IMAGES it reads the G-buffer and the visibilities from the GPU images the
+// frame keeps and writes an image (the resident combine); otherwise from uploaded buffers.
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
 // [low pixel * 16 + cone]; written only by the capsules at the traced pixels (flags.w = 1).
 layout(std430, binding = 0) buffer ConeBuffer { vec4 coneRadiance[]; };
 layout(std430, binding = 1) readonly buffer RepresentativeBuffer { int representative[]; }; // [low pixel]: full pixel, -1: none
+#ifdef GBUFFER_IMAGES
+// The resident combine: the G-buffer and the visibilities as the frame keeps them on the GPU
+// (voxel_gi.h VoxelGiGpuGBuffer; compose.h coneVisibilityGpuSlot), the irradiance into an image
+// the lighting pass binds. No surface: an infinite depth (the G-buffer's clear value).
+layout(binding = 2, rgba32f) uniform readonly image2D gPositionDepth; // xyz world, w linear depth
+layout(binding = 3, rgba32f) uniform readonly image2D gNormal;
+layout(binding = 9, rgba32f) uniform readonly image2D gVisibility0; // cone k: channel k % 4 of image k / 4
+layout(binding = 10, rgba32f) uniform readonly image2D gVisibility1;
+layout(binding = 11, rgba32f) uniform readonly image2D gVisibility2;
+layout(binding = 12, rgba32f) uniform readonly image2D gVisibility3;
+layout(binding = 8, rgba32f) uniform writeonly image2D outIrradiance;
+#else
 layout(std430, binding = 2) readonly buffer PositionBuffer { float positions[]; };  // 3 per full pixel, world
 layout(std430, binding = 3) readonly buffer NormalBuffer { float normals[]; };      // 3 per full pixel
 layout(std430, binding = 4) readonly buffer DepthBuffer { float depths[]; };        // linear depth, inf: none
 layout(std430, binding = 5) readonly buffer MaterialBuffer { uint materials[]; };   // ~0u: no surface
 layout(std430, binding = 6) readonly buffer VisibilityBuffer { float visibility[]; }; // [cone][full pixel]
+layout(std430, binding = 8) writeonly buffer OutputBuffer { vec4 irradiance[]; }; // [full pixel]
+#endif
 // Per capsule, 4 vec4, relative to the anchor: (a, radius), (b - a, 1 / |b - a|^2 or 0),
 // (centre of the segment, radius of the sphere around the capsule), (near^2, reach^2, 0, 0).
 layout(std430, binding = 7) readonly buffer CapsuleBuffer { vec4 capsules[]; };
-layout(std430, binding = 8) writeonly buffer OutputBuffer { vec4 irradiance[]; }; // [full pixel]
 // The 16 directions as constants (scene/sky.h getConeDirections, defined by the caller), so that
 // the unrolled loops over the cones read immediates rather than memory.
 const vec3 kCones[16] = vec3[16](CONE_DIRECTIONS);
@@ -44,6 +59,47 @@ layout(push_constant) uniform Constants {
 
 const uint kNoMaterial = 0xffffffffu;
 
+#ifdef GBUFFER_IMAGES
+ivec2 toXy(int pixel)
+{
+    return ivec2(pixel % pc.size.x, pixel / pc.size.x);
+}
+
+vec3 readPosition(int pixel)
+{
+    return imageLoad(gPositionDepth, toXy(pixel)).xyz - pc.anchor.xyz;
+}
+
+vec3 readNormal(int pixel)
+{
+    return imageLoad(gNormal, toXy(pixel)).xyz;
+}
+
+float readDepth(int pixel)
+{
+    return imageLoad(gPositionDepth, toXy(pixel)).w;
+}
+
+bool hasSurface(int pixel)
+{
+    const float d = readDepth(pixel);
+    return !isinf(d) && !isnan(d);
+}
+
+float readVisibility(int k, int pixel)
+{
+    const ivec2 p = toXy(pixel);
+    const vec4 v = k < 4 ? imageLoad(gVisibility0, p)
+                 : k < 8 ? imageLoad(gVisibility1, p)
+                 : k < 12 ? imageLoad(gVisibility2, p) : imageLoad(gVisibility3, p);
+    return v[k % 4];
+}
+
+void writeIrradiance(int pixel, vec3 e)
+{
+    imageStore(outIrradiance, toXy(pixel), vec4(e, 0.0));
+}
+#else
 vec3 readPosition(int pixel)
 {
     return vec3(positions[3 * pixel], positions[3 * pixel + 1], positions[3 * pixel + 2]) - pc.anchor.xyz;
@@ -53,6 +109,27 @@ vec3 readNormal(int pixel)
 {
     return vec3(normals[3 * pixel], normals[3 * pixel + 1], normals[3 * pixel + 2]);
 }
+
+float readDepth(int pixel)
+{
+    return depths[pixel];
+}
+
+bool hasSurface(int pixel)
+{
+    return materials[pixel] != kNoMaterial;
+}
+
+float readVisibility(int k, int pixel)
+{
+    return visibility[k * pc.size.x * pc.size.y + pixel];
+}
+
+void writeIrradiance(int pixel, vec3 e)
+{
+    irradiance[pixel] = vec4(e, 0.0);
+}
+#endif
 
 // Geometric similarity of low-resolution sample s to the pixel (p, n, view depth d): distance of
 // the sample from the pixel's tangent plane against 2 % of the depth, and cos^8 of the normals.
@@ -231,7 +308,7 @@ void occludeTracedCones()
         return;
     const int s = y * lw + x;
     const int r = representative[s];
-    if (r < 0 || materials[r] == kNoMaterial)
+    if (r < 0 || !hasSurface(r))
         return;
     const vec3 p = readPosition(r), n = readNormal(r);
     if (dot(n, n) < 0.5)
@@ -264,11 +341,11 @@ void main()
     if (x >= w || y >= h)
         return;
     const int pixel = y * w + x;
-    irradiance[pixel] = vec4(0.0);
-    if (materials[pixel] == kNoMaterial)
+    writeIrradiance(pixel, vec3(0.0));
+    if (!hasSurface(pixel))
         return;
     const vec3 p = readPosition(pixel), n = readNormal(pixel);
-    const float depth = depths[pixel];
+    const float depth = readDepth(pixel);
     const float d = isinf(depth) || isnan(depth) ? 1.0 : depth;
     ivec4 samples;
     vec4 weights;
@@ -286,7 +363,7 @@ void main()
     }
     if (pc.flags.z != 0)
         [[unroll]] for (int k = 0; k < 16; ++k)
-            visible[k] = clamp(visibility[k * w * h + pixel], 0.0, 1.0);
+            visible[k] = clamp(readVisibility(k, pixel), 0.0, 1.0);
     // The capsules in order (as the C++ combine multiplies them per cone): those within 40 radii
     // of the pixel, and in them the cones that can reach the sphere around the capsule.
     for (int c = 0; c < pc.flags.y; ++c) {
@@ -309,5 +386,5 @@ void main()
                               weights.w * coneRadiance[samples.w * 16 + k].rgb;
         e += (coneWeight[k] * scale) * visible[k] * radiance;
     }
-    irradiance[pixel] = vec4(max(e, vec3(0.0)), 0.0);
+    writeIrradiance(pixel, max(e, vec3(0.0)));
 }
