@@ -9,6 +9,7 @@
 
 #include "families/voxel_gi/voxel_gi.h"
 #include "families/voxel_gi/voxel_gi_test_scenes.h"
+#include "gpu/context.h"
 #include "reference/reference.h"
 
 #include <glm/gtc/constants.hpp>
@@ -176,6 +177,96 @@ StressCase makeSceneCase(std::string name, std::string group, std::string descri
             }};
 }
 
+//! The G-buffer on the GPU as the frame keeps it (pipeline/frame_start.h positionDepthGpu,
+//! worldNormalGpu).
+struct GpuGBufferImages {
+    gpu::Image positionDepth, normal;
+    plugin::VoxelGiGpuGBuffer view;
+
+    GpuGBufferImages(gpu::Context& context, const scene::GBuffer& g)
+    {
+        const auto make = [&](const char* name) {
+            return context.createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float, std::uint32_t(g.width),
+                                        std::uint32_t(g.height), 1, gpu::ImageUsage::StorageAndSampled, name});
+        };
+        positionDepth = make("stress.position_depth");
+        normal = make("stress.normal");
+        std::vector<glm::vec4> p(g.position.pixels.size()), n(p.size());
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            // No surface: the infinite depth the G-buffer pass clears to.
+            const bool surface = g.materialId.pixels[i] != scene::kNoMaterial;
+            p[i] = glm::vec4(g.position.pixels[i], surface ? g.depth.pixels[i] : INFINITY);
+            n[i] = glm::vec4(g.normal.pixels[i], 0.0f);
+        }
+        positionDepth.uploadSpan<glm::vec4>(p);
+        normal.uploadSpan<glm::vec4>(n);
+        view = {&positionDepth, &normal, g.width, g.height, glm::dvec3(g.camera.position)};
+    }
+};
+
+//! The resident gather (voxel_gi.h gathersOnGpu: the G-buffer's GPU images in, the irradiance
+//! left in an image) against the same instance's gather of the CPU G-buffer on the same device,
+//! for a technique that has one with its pixel cones and combine on Vulkan. "" when compared,
+//! else why not (the technique has no resident gather).
+std::string compareResidentGather(gpu::Context& context, const TechniqueEntry& entry, const scene::RenderScene& s,
+                                  const scene::GBuffer& g, StressOutcome& o)
+{
+    config::ParamSet params = config::ParamSet::defaultsOf(entry.schema);
+    // On Vulkan wherever there is a context, lavapipe included; whole cones (the cascades' split
+    // cones choose their far cones on the CPU).
+    for (const char* key : {"device", "combine_device"})
+        if (entry.schema.find(key) != nullptr)
+            params.set(key, std::string("vulkan"));
+    if (entry.schema.find("far_start") != nullptr)
+        params.set("far_start", 0.0);
+    auto t = entry.create(params);
+    auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*t);
+    if (std::string why = gi.whyNotGatheredOnGpu(context); !why.empty())
+        return why;
+    plugin::VoxelGiFrame frame;
+    frame.geometry = &s;
+    frame.geometryKey = s.computeContentHash();
+    frame.cameraPosition = glm::dvec3(g.camera.position);
+    frame.gpu = &context;
+    gi.voxelize(frame);
+    gi.injectLight(frame);
+    plugin::VoxelGiInput uploaded;
+    uploaded.gbuffer = &g;
+    uploaded.scene = &s;
+    uploaded.cameraPosition = frame.cameraPosition;
+    uploaded.gpu = &context;
+    Image<glm::vec3> expected;
+    gi.gather(uploaded, expected);
+    const GpuGBufferImages images(context, g);
+    plugin::VoxelGiInput resident;
+    resident.gpuGBuffer = &images.view;
+    resident.cameraPosition = frame.cameraPosition;
+    resident.gpu = &context;
+    resident.readBack = false;
+    Image<glm::vec3> untouched;
+    gi.gather(resident, untouched);
+    o.check(untouched.pixels.empty(), "the resident gather wrote the CPU image although readBack was false");
+    o.check(gi.getGpuIrradiance() != nullptr, "the resident gather left no image on the GPU");
+    Image<glm::vec3> e;
+    gi.readBackIrradiance(e);
+    checkIrradiance(e, g, o);
+    if (e.pixels.size() != expected.pixels.size())
+        return {};
+    // The same cones on the same device from starts within a float ulp of the upload's, and the
+    // combine on Vulkan (or, for the uploaded gather at `auto` on a CPU device, in C++: float
+    // against double, within 4.4e-6 per pixel, cone_combine_gpu_test.cpp): 1e-4 of the pixel's
+    // value, or of 1e-3 of the image's largest where it is darker.
+    double largest = 0.0, worst = 0.0;
+    for (const glm::vec3& v : expected.pixels)
+        largest = std::max(largest, double(std::max(v.x, std::max(v.y, v.z))));
+    for (std::size_t i = 0; i < e.pixels.size(); ++i)
+        for (int c = 0; c < 3; ++c)
+            worst = std::max(worst, std::abs(double(e.pixels[i][c]) - double(expected.pixels[i][c])) /
+                                        std::max(double(expected.pixels[i][c]), 1e-3 * largest + 1e-30));
+    o.compare(worst, 1e-4, "largest relative difference, resident against uploaded gather");
+    return {};
+}
+
 scene::RenderScene makeLightInsideAWall()
 {
     scene::RenderScene s;
@@ -262,6 +353,37 @@ std::vector<plugin::StressCase> makeVoxelGiStressCases()
                          plugin::runOrRefuse(o, [&] { checkIrradiance(runTechnique(e, s, g), g, o); });
                          return o;
                      }});
+    cases.push_back(
+        {"resident_gather", "gpu",
+         "the gather on the G-buffer's GPU images, irradiance left on the GPU (techniques with a resident Vulkan "
+         "gather): finite, >= 0, 0 off the surface, and the gather of the uploaded G-buffer within 1e-4, in a lit "
+         "room 1e5 from the origin and on voxel boundaries",
+         [](const TechniqueEntry& e, const StressSettings& settings) {
+             StressOutcome o;
+             if (settings.gpu == nullptr) {
+                 o.note = "no Vulkan device (C++ paths only)";
+                 return o;
+             }
+             const glm::vec3 far(1e5f, 0.0f, -1e5f);
+             scene::RenderScene room;
+             addRoom(room, far - 1.0f, far + 1.0f, 0.2f, addMaterial(room, glm::vec3(0.6f)));
+             room.pointLights.push_back({far + glm::vec3(0.3f, 0.5f, 0.0f), glm::vec3(2.0f)});
+             scene::RenderScene boundaries;
+             const auto m = addMaterial(boundaries, glm::vec3(0.7f));
+             addRoom(boundaries, glm::vec3(-2.0f), glm::vec3(2.0f), 1.0f, m);
+             addBox(boundaries, glm::vec3(-1.0f, -2.0f, -1.0f), glm::vec3(0.0f, 0.0f, 0.0f), m);
+             boundaries.pointLights.push_back({glm::vec3(1.0f, 1.0f, 1.0f), glm::vec3(4.0f)});
+             const std::pair<const scene::RenderScene*, scene::Camera> views[] = {
+                 {&room, lookAt(far + glm::vec3(0.0f, 0.2f, 0.8f), far + glm::vec3(0.0f, -0.5f, 0.0f))},
+                 {&boundaries, lookAt({1.0f, 1.0f, 1.5f}, {-0.5f, -1.0f, -0.5f})}};
+             for (const auto& [s, camera] : views)
+                 if (std::string why = compareResidentGather(*settings.gpu, e, *s, makeGBuffer(*s, camera), o);
+                     !why.empty()) {
+                     o.note = "no resident gather: " + why;
+                     break;
+                 }
+             return o;
+         }});
     cases.push_back({"closed_dark_room", "closed_form",
                      "a closed room without light: exactly 0 everywhere (the cones' sky too)",
                      [](const TechniqueEntry& e, const StressSettings&) {
