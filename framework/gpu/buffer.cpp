@@ -203,7 +203,8 @@ Buffer Context::createBuffer(const BufferDesc& desc)
     const Kind kind = !mDevice->stagingUploads ? Kind::DeviceLocalMapped
                       : desc.hostVisible       ? Kind::HostStaging
                                                : Kind::DeviceLocal;
-    VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+    // Any storage buffer may hold the arguments of an indirect dispatch (a count the device wrote).
+    VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT |
                                VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
     if (desc.vertexIndexUsage)
         usage |= VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_INDEX_BUFFER_BIT;

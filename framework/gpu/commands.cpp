@@ -73,6 +73,8 @@ struct RecordedCommand {
     VkBuffer source = VK_NULL_HANDLE;
     VkBuffer destination = VK_NULL_HANDLE;
     VkDeviceSize size = 0;
+    VkDeviceSize offset = 0; // Fill; DispatchIndirect: of the arguments
+    VkBuffer indirect = VK_NULL_HANDLE; // Dispatch: read the group count from here
     std::uint32_t fillValue = 0;
     std::function<void(VkCommandBuffer)> encode; // CommandKind::Encoded
 };
@@ -205,6 +207,21 @@ void CommandList::dispatch(const ComputePipeline& pipeline, const std::vector<Bi
     mImpl->commands.push_back(std::move(cmd));
 }
 
+void CommandList::dispatchIndirect(const ComputePipeline& pipeline, const std::vector<Binding>& bindings,
+                                   PushConstants pushConstants, const Buffer& args, std::size_t offset,
+                                   std::string_view label)
+{
+    const detail::BufferState& state = args.getState();
+    if (state.device != mImpl->device)
+        throw Error("dispatchIndirect: buffer '" + state.name + "' belongs to another context");
+    if (offset % 4 != 0 || offset > state.raw.size || state.raw.size - offset < 3 * sizeof(std::uint32_t))
+        throw Error("dispatchIndirect: no three words of arguments at byte " + std::to_string(offset) +
+                    " of buffer '" + state.name + "' (" + std::to_string(state.raw.size) + " bytes)");
+    dispatch(pipeline, bindings, pushConstants, GroupCount{0, 0, 0}, label);
+    mImpl->commands.back().indirect = state.raw.buffer;
+    mImpl->commands.back().offset = offset;
+}
+
 void CommandList::fillBuffer(const Buffer& buffer, std::uint32_t value, std::string_view label)
 {
     const detail::BufferState& state = buffer.getState();
@@ -217,6 +234,19 @@ void CommandList::fillBuffer(const Buffer& buffer, std::uint32_t value, std::str
     cmd.size = state.raw.size & ~VkDeviceSize{3};
     cmd.fillValue = value;
     mImpl->commands.push_back(std::move(cmd));
+}
+
+void CommandList::fillBuffer(const Buffer& buffer, std::uint32_t value, std::size_t offset,
+                             std::size_t size, std::string_view label)
+{
+    const detail::BufferState& state = buffer.getState();
+    if (offset % 4 != 0 || size % 4 != 0 || offset > state.raw.size || size > state.raw.size - offset)
+        throw Error("fillBuffer: [" + std::to_string(offset) + ", " + std::to_string(offset + size) +
+                    ") is not a range of whole words within buffer '" + state.name + "' of " +
+                    std::to_string(state.raw.size) + " bytes");
+    fillBuffer(buffer, value, label);
+    mImpl->commands.back().offset = offset;
+    mImpl->commands.back().size = size;
 }
 
 void CommandList::copyBuffer(const Buffer& source, const Buffer& destination,
@@ -372,11 +402,14 @@ void encodeCommand(VkCommandBuffer cb, const RecordedCommand& c, VkDescriptorSet
             vkCmdPushConstants(cb, c.pipeline->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
                                static_cast<std::uint32_t>(c.pushConstants.size()),
                                c.pushConstants.data());
-        vkCmdDispatch(cb, c.groups.x, c.groups.y, c.groups.z);
+        if (c.indirect != VK_NULL_HANDLE)
+            vkCmdDispatchIndirect(cb, c.indirect, c.offset);
+        else
+            vkCmdDispatch(cb, c.groups.x, c.groups.y, c.groups.z);
         break;
     case CommandKind::Fill:
         if (c.size > 0)
-            vkCmdFillBuffer(cb, c.destination, 0, c.size, c.fillValue);
+            vkCmdFillBuffer(cb, c.destination, c.offset, c.size, c.fillValue);
         break;
     case CommandKind::Copy: {
         const VkBufferCopy region{0, 0, c.size};

@@ -117,8 +117,19 @@ public:
     //! Same, with push constants (their size must equal the pipeline's push-constant size).
     void dispatch(const ComputePipeline& pipeline, const std::vector<Binding>& bindings,
                   PushConstants pushConstants, GroupCount groups, std::string_view label = {});
+    //! Dispatches with the group count read on the device from `args` at `offset` (three
+    //! uint32: x, y, z, as an earlier command wrote them; vkCmdDispatchIndirect), so that work
+    //! whose size the device computes needs no read-back. A count beyond the device's limits is
+    //! undefined behaviour in Vulkan: the writer must bound it.
+    void dispatchIndirect(const ComputePipeline& pipeline, const std::vector<Binding>& bindings,
+                          PushConstants pushConstants, const Buffer& args, std::size_t offset,
+                          std::string_view label = {});
     //! Sets every 32-bit word of the buffer to `value`.
     void fillBuffer(const Buffer& buffer, std::uint32_t value, std::string_view label = {});
+    //! Sets the 32-bit words of [offset, offset + size) to `value` (both multiples of 4 within
+    //! the buffer; throws rtlab::Error otherwise).
+    void fillBuffer(const Buffer& buffer, std::uint32_t value, std::size_t offset, std::size_t size,
+                    std::string_view label = {});
     //! Copies min(source size, destination size) bytes.
     void copyBuffer(const Buffer& source, const Buffer& destination, std::string_view label = {});
     //! Draws indexed triangles with `pipeline` into `target` in one render pass (see

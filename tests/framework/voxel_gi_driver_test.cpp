@@ -174,10 +174,11 @@ TEST(VoxelGiDriver, TheVulkanCombineGivesTheCppCombinesFrame)
     }
 }
 
-// The resident gather ([12]): the cascades' pixel cones and combine on Vulkan read the G-buffer
-// and SSDO's visibilities where the frame keeps them and leave the irradiance in an image the
-// lighting pass binds; nothing of the gather crosses the bus in the frame, and the irradiance
-// comes to the CPU only for the measurements. The round trip (`frame: {gbuffer_on_gpu: false}`)
+// The resident gather ([12]): the cascades' pixel cones (split near/far: the far cones marked,
+// traced and kept on the device) and combine on Vulkan read the G-buffer and SSDO's visibilities
+// where the frame keeps them and leave the irradiance in an image the lighting pass binds; nothing
+// of the gather crosses the bus in the frame, and the irradiance comes to the CPU only for the
+// measurements. The round trip (`frame: {gbuffer_on_gpu: false}`)
 // gives the same frame: the same combine on the same cones but for the reduced positions, which
 // the device rounds within a float ulp of the upload's (cone_combine_gpu_test.cpp): the lit
 // frame within 1e-4 per pixel and the indirect RMSE within 1e-5.
@@ -186,7 +187,7 @@ TEST(VoxelGiDriver, TheResidentGatherKeepsTheFrameOnTheGpu)
     const auto dir = std::filesystem::temp_directory_path() / "rtlab_voxel_gi_driver_resident";
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
-    const std::string params = ", device: vulkan, far_start: 0";
+    const std::string params = ", device: vulkan"; // split cones: the far cones resident too
     const auto resident = runGameFrame("true", dir, "vulkan", params);
     const auto roundTrip = runGameFrame("true", dir, "vulkan", params, ", gbuffer_on_gpu: false");
     ASSERT_EQ(resident.size(), 2u) << (resident.empty() ? "" : resident[0].at("error"));
@@ -199,6 +200,9 @@ TEST(VoxelGiDriver, TheResidentGatherKeepsTheFrameOnTheGpu)
         EXPECT_EQ(roundTrip[i].at("voxel_gather.resident").rfind("no: frame: {gbuffer_on_gpu: false}", 0), 0u)
             << roundTrip[i].at("voxel_gather.resident");
         EXPECT_EQ(row.at("gather.cone_visibility"), "true");
+        // Frame 0 traces every level's far cones; frame 1 (a still camera, nothing changed)
+        // keeps them all.
+        EXPECT_EQ(experiment::getNumber(row, "counter.far_levels_dropped"), i == 0 ? 3.0 : 0.0);
         const std::string& passes = row.at("passes");
         EXPECT_NE(passes.find("indirect_gpu_slot:run"), std::string::npos) << passes;
         EXPECT_NE(passes.find("voxel_gather_readback:run"), std::string::npos) << passes;

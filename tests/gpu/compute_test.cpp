@@ -360,6 +360,52 @@ TEST_F(ComputeTest, FillAndCopyBuffers)
     EXPECT_EQ(b.downloadVector<std::uint32_t>(), std::vector<std::uint32_t>(600, 0xdeadbeefu));
 }
 
+// A count the device computes drives a dispatch without a read-back: the group count is written
+// by one dispatch and read by the next (vkCmdDispatchIndirect) in the same submission.
+TEST_F(ComputeTest, DispatchesAGroupCountTheDeviceWrote)
+{
+    struct Push {
+        std::uint32_t mode;
+    };
+    const ComputePipeline pipeline = createTestPipeline(
+        "indirect.comp", {{0, BindingType::StorageBuffer}, {1, BindingType::StorageBuffer}}, sizeof(Push));
+    Buffer args = getContext().createBuffer({4 * sizeof(std::uint32_t), "args"});
+    Buffer marks = getContext().createBuffer({1024 * sizeof(std::uint32_t), "marks"});
+    args.uploadSpan<std::uint32_t>(std::vector<std::uint32_t>{0, 0, 0, 130}); // 130 items: 3 groups
+    const Push write{0}, mark{1};
+    getContext().run([&](CommandList& cmd) {
+        cmd.fillBuffer(marks, 0u);
+        cmd.dispatch(pipeline, {Binding::storageBuffer(0, args), Binding::storageBuffer(1, marks)},
+                     PushConstants(write), GroupCount{1});
+        cmd.dispatchIndirect(pipeline, {Binding::storageBuffer(0, args), Binding::storageBuffer(1, marks)},
+                             PushConstants(mark), args, 0);
+    });
+    const std::vector<std::uint32_t> got = marks.downloadVector<std::uint32_t>();
+    for (std::uint32_t i = 0; i < 1024; ++i)
+        ASSERT_EQ(got[i], i < 192 ? 1u : 0u) << "at " << i;
+    // Arguments outside the buffer are refused when recorded.
+    getContext().run([&](CommandList& cmd) {
+        EXPECT_THROW(cmd.dispatchIndirect(pipeline, {Binding::storageBuffer(0, args), Binding::storageBuffer(1, marks)},
+                                          PushConstants(mark), args, 8),
+                     Error);
+    });
+}
+
+TEST_F(ComputeTest, FillsARangeOfABuffer)
+{
+    Buffer a = getContext().createBuffer({100 * sizeof(std::uint32_t), "a"});
+    a.uploadSpan<std::uint32_t>(std::vector<std::uint32_t>(100, 1u));
+    getContext().run([&](CommandList& cmd) { cmd.fillBuffer(a, 7u, 40 * 4, 20 * 4); });
+    std::vector<std::uint32_t> expected(100, 1u);
+    std::fill(expected.begin() + 40, expected.begin() + 60, 7u);
+    EXPECT_EQ(a.downloadVector<std::uint32_t>(), expected);
+    // Not whole words, or past the end: refused when recorded.
+    getContext().run([&](CommandList& cmd) {
+        EXPECT_THROW(cmd.fillBuffer(a, 0u, 2, 8), Error);
+        EXPECT_THROW(cmd.fillBuffer(a, 0u, 96 * 4, 8 * 4), Error);
+    });
+}
+
 TEST_F(ComputeTest, PartialUploadsAndDownloadsRespectOffsets)
 {
     Buffer buffer = getContext().createBuffer({64, "partial"});

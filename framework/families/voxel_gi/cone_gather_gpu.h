@@ -74,6 +74,28 @@ public:
     std::optional<double> run(gpu::Buffer& first, gpu::Buffer& second,
                               const gpu::PushConstants& constants, std::vector<glm::vec3>* out,
                               const std::vector<gpu::Buffer*>& extra = {}, bool points = false);
+    //! A dispatch of the pipeline before the pixels' cones (run with `before`): its push
+    //! constants and group count (z included), or the group count the device wrote into
+    //! `indirect` at `indirectOffset` (gpu::CommandList::dispatchIndirect).
+    struct Step {
+        std::vector<std::byte> constants;
+        gpu::GroupCount groups;
+        const gpu::Buffer* indirect = nullptr;
+        std::size_t indirectOffset = 0;
+    };
+    //! Bytes [offset, offset + size) of extra buffer `extra`, to be zeroed.
+    struct Clear {
+        std::size_t extra = 0;
+        std::size_t offset = 0;
+        std::size_t size = 0;
+    };
+    //! run() over the prepared pixels with, in the same submission after the reduction, the
+    //! ranges `clear` zeroed and the `before` dispatches of the same pipeline and bindings (a
+    //! structure's work that depends on the pixels, such as marking and tracing what their cones
+    //! will read), then the cones. Nothing is read back.
+    std::optional<double> runWithSteps(gpu::Buffer& first, gpu::Buffer& second, const gpu::PushConstants& constants,
+                                       const std::vector<gpu::Buffer*>& extra, const std::vector<Clear>& clear,
+                                       const std::vector<Step>& before);
     //! For a structure with nothing to trace: the prepared pixels' reduction (if on the device)
     //! and zero radiances in getOutput().
     void runWithoutCones();

@@ -212,13 +212,10 @@ std::string compareResidentGather(gpu::Context& context, const TechniqueEntry& e
                                   const scene::GBuffer& g, StressOutcome& o)
 {
     config::ParamSet params = config::ParamSet::defaultsOf(entry.schema);
-    // On Vulkan wherever there is a context, lavapipe included; whole cones (the cascades' split
-    // cones choose their far cones on the CPU).
+    // On Vulkan wherever there is a context, lavapipe included.
     for (const char* key : {"device", "combine_device"})
         if (entry.schema.find(key) != nullptr)
             params.set(key, std::string("vulkan"));
-    if (entry.schema.find("far_start") != nullptr)
-        params.set("far_start", 0.0);
     auto t = entry.create(params);
     auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*t);
     if (std::string why = gi.whyNotGatheredOnGpu(context); !why.empty())

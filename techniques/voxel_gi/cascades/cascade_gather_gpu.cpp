@@ -6,6 +6,7 @@
 #include <glm/vec4.hpp>
 
 #include <algorithm>
+#include <cstring>
 
 namespace rtlab::voxelgi {
 
@@ -61,7 +62,8 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
     if (!mDispatch.isReadyFor(context)) {
         *this = CascadeGatherGpu();
         mDispatch.create(context, getShaderDir() / "cascade_gather.comp", kDispatchLabel,
-                         sizeof(GatherConstants), volume.getCones(), 2);
+                         sizeof(GatherConstants), volume.getCones(), 3);
+        mFarListPlaceholder = mDispatch.makeBuffer(64, "cascades.far_list_placeholder");
     }
     const int n = volume.getLevelCount();
     const int R = settings.resolution;
@@ -131,9 +133,63 @@ const gpu::Buffer& CascadeGatherGpu::gatherConesOnDevice(gpu::Context& context,
 const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& context, const CascadeVolume& volume,
                                                               const PixelSource& pixels)
 {
-    if (volume.getSettings().farStart > 0.0)
-        throw Error("cascades: the resident gather traces whole cones only (far_start: 0)");
-    trace(context, volume, pixels, nullptr);
+    const CascadeSettings& settings = volume.getSettings();
+    mLastFarLevelsDropped = 0;
+    if (settings.farStart <= 0.0) {
+        trace(context, volume, pixels, nullptr);
+        return mDispatch;
+    }
+    mLastUploadBytes = 0;
+    const glm::dvec3 anchor = prepare(context, volume);
+    mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
+    const int n = volume.getLevelCount();
+    const std::size_t R = std::size_t(settings.resolution);
+    const std::size_t levelVoxels = R * R * R;
+    if (!mResidentFarState.isValid() || mResidentFarVoxels != levelVoxels * std::size_t(n)) {
+        mResidentFarVoxels = levelVoxels * std::size_t(n);
+        mResidentFarState = mDispatch.makeBuffer(mResidentFarVoxels * sizeof(std::uint32_t), "cascades.far_state");
+        mResidentFarCones =
+            mDispatch.makeBuffer(mResidentFarVoxels * kConeCount * sizeof(glm::vec4), "cascades.far_cones_resident");
+        mResidentFarList = mDispatch.makeBuffer(32 + mResidentFarVoxels * sizeof(std::uint32_t), "cascades.far_list");
+        mResidentFarInputs.assign(std::size_t(n), {});
+    }
+    // The far cones of level i sample levels getFarDependency(i) and coarser: drop them when one
+    // of those changed since (CascadeVolume::invalidateFarCones), or on first use.
+    std::vector<std::uint64_t> stamps(static_cast<std::size_t>(n));
+    for (int j = 0; j < n; ++j)
+        stamps[std::size_t(j)] = std::max(volume.getLevel(j).voxelStamp, volume.getLevel(j).lightStamp);
+    // The list's header (its count) every time; the states of the levels whose far cones are
+    // dropped.
+    std::vector<PixelConeDispatch::Clear> clear = {{2, 0, 32}};
+    for (int i = 0; i < n; ++i) {
+        std::vector<std::uint64_t> inputs(stamps.begin() + volume.getFarDependency(i), stamps.end());
+        if (inputs == mResidentFarInputs[std::size_t(i)])
+            continue;
+        mResidentFarInputs[std::size_t(i)] = std::move(inputs);
+        clear.push_back({0, std::size_t(i) * levelVoxels * sizeof(std::uint32_t), levelVoxels * sizeof(std::uint32_t)});
+    }
+    mLastFarLevelsDropped = clear.size() - 1;
+    const glm::ivec2 size = pixels.getSize();
+    GatherConstants gather = makeConstants(volume, anchor, size, false);
+    gather.flags.w = 1; // resident far cones
+    const auto mode = [&](int z) {
+        GatherConstants c = gather;
+        c.flags.z = z;
+        std::vector<std::byte> b(sizeof(c));
+        std::memcpy(b.data(), &c, sizeof(c));
+        return b;
+    };
+    const gpu::GroupCount pixelGroups{gpu::computeGroupCount(std::uint64_t(size.x), 8),
+                                      gpu::computeGroupCount(std::uint64_t(size.y), 8), 1};
+    // Mark and list (2), count (5), trace the listed voxels' 16 cones (3) and commit them (4),
+    // the last two sized by the count on the device.
+    const std::vector<PixelConeDispatch::Step> steps = {
+        {mode(2), pixelGroups},
+        {mode(5), {1, 1, 1}},
+        {mode(3), {}, &mResidentFarList, 4},
+        {mode(4), {}, &mResidentFarList, 16}};
+    mLastGpuMs = mDispatch.runWithSteps(mLevels, mCombined, gpu::PushConstants(gather),
+                                        {&mResidentFarState, &mResidentFarCones, &mResidentFarList}, clear, steps);
     return mDispatch;
 }
 
@@ -146,7 +202,7 @@ void CascadeGatherGpu::trace(gpu::Context& context, const CascadeVolume& volume,
     uploadFarCones(volume);
     mLastGpuMs = mDispatch.run(mLevels, mCombined,
                                gpu::PushConstants(makeConstants(volume, anchor, pixels.getSize(), false)),
-                               out, {&mFarSlots, &mFarCones});
+                               out, {&mFarSlots, &mFarCones, &mFarListPlaceholder});
 }
 
 void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume& volume,
@@ -170,7 +226,7 @@ void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume&
     mLastGpuMs = mDispatch.run(
         mLevels, mCombined,
         gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true)), &out,
-        {&mFarSlots, &mFarCones}, true);
+        {&mFarSlots, &mFarCones, &mFarListPlaceholder}, true);
 }
 
 void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)

@@ -41,8 +41,12 @@ public:
     const gpu::Buffer& gatherConesOnDevice(gpu::Context& context, const CascadeVolume& volume,
                                            const scene::GBuffer& gbuffer);
     //! The same from pixels reduced on the device (the resident gather, cone_combine_gpu.h
-    //! gatherConesResident), whole cones only (farStart 0: the far cones are chosen from the
-    //! pixels on the CPU): the dispatch holds the radiances and the representatives.
+    //! gatherConesResident): the dispatch holds the radiances and the representatives. With
+    //! split cones the far cones stay on the device too: per level voxel a state and 16
+    //! radiances; in one submission the pixels mark the voxels they will read, the marked ones
+    //! not yet traced are traced and committed, then the pixels' cones run (what
+    //! CascadeVolume::prepareFarCones does on the CPU for the other paths). A level's far cones
+    //! are dropped when a level they sample changed (CascadeVolume::invalidateFarCones' rule).
     const PixelConeDispatch& gatherConesResident(gpu::Context& context, const CascadeVolume& volume,
                                                  const PixelSource& pixels);
     //! CascadeVolume::FarConeTracer on Vulkan: the 16 far cones of each voxel centre, through
@@ -53,6 +57,8 @@ public:
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     //! Bytes uploaded by the last call (levels that changed, pixels).
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
+    //! Levels whose resident far cones the last resident gather dropped (their inputs changed).
+    std::size_t getLastFarLevelsDropped() const { return mLastFarLevelsDropped; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/cascades/shaders when set, else the source folder.
     static std::filesystem::path getShaderDir();
 
@@ -69,6 +75,16 @@ private:
     gpu::Buffer mLevels, mCombined;
     gpu::Buffer mFarSlots, mFarCones; //!< split cones: slot per level voxel, radiance per slot
     std::vector<std::pair<std::uint64_t, std::size_t>> mUploadedFar; //!< per level: stamp, slots
+    // The resident far cones: per level voxel a state (0 none, 1 wanted, 2 traced) and 16
+    // radiances; per level the stamps of the levels its far cones sampled when last dropped.
+    gpu::Buffer mResidentFarState, mResidentFarCones;
+    // The voxels listed for tracing: a 32-byte header (count, two dispatchIndirect argument
+    // triples) and one uint per voxel (shaders/cascade_gather.comp FarListBuffer); a 64-byte
+    // placeholder where the far cones are not resident.
+    gpu::Buffer mResidentFarList, mFarListPlaceholder;
+    std::size_t mResidentFarVoxels = 0;
+    std::vector<std::vector<std::uint64_t>> mResidentFarInputs;
+    std::size_t mLastFarLevelsDropped = 0;
     std::size_t mCombinedLevelVoxels = 0;
     int mCombinedLevelCount = 0;
     std::vector<std::uint64_t> mUploadedStamps;

@@ -329,8 +329,6 @@ public:
         if (!voxelgi::shouldCombineOnGpu(&gpu, true, mCombineDevice))
             return "the combine runs in C++ (combine_device: " + mCombineDevice +
                    (mCombineDevice == "auto" ? " on a CPU device" : "") + ")";
-        if (mSettings.farStart > 0.0)
-            return "split cones choose their far cones from the pixels on the CPU (far_start > 0)";
         return {};
     }
 
@@ -347,7 +345,7 @@ public:
             // Resident: the pixels reduced on the device, their cones and the combine there.
             if (input.gpu == nullptr || !whyNotGatheredOnGpu(*input.gpu).empty())
                 throw Error("cascades: the G-buffer was given on the GPU to a gather that does not run there");
-            mGatheredOnGpu = mCombinedOnGpu = true;
+            mGatheredOnGpu = mCombinedOnGpu = mGatheredResident = true;
             mSky.cones.clear();
             mSkyWhyNot = "the Vulkan gather traces no cone sky yet (device: cpu does)";
             voxelgi::gatherConesResident(
@@ -365,6 +363,7 @@ public:
         // Reduced resolution ("Trace at a lower resolution"): one pixel per trace_step^2 block,
         // each cone's radiance upsampled by depth and normal, times the pixel's own visibilities
         // (bent-cone SSDO) and the characters' capsules.
+        mGatheredResident = false;
         mGatheredOnGpu = voxelgi::shouldGatherOnGpu(input.gpu, mDevice) && mSettings.precombine;
         mCombinedOnGpu = voxelgi::shouldCombineOnGpu(input.gpu, mGatheredOnGpu, mCombineDevice);
         // The Vulkan gather's cones: the far cones first with split cones (on Vulkan too).
@@ -493,7 +492,8 @@ public:
         const auto& voxelizer = mVoxelizer.getCounters();
         counters.insert(
             counters.end(),
-            {{"far_cones_traced", double(c.farConesTraced)},
+            {{"far_levels_dropped", mGatheredResident ? double(mGpu.getLastFarLevelsDropped()) : std::nan("")},
+             {"far_cones_traced", mGatheredResident ? std::nan("") : double(c.farConesTraced)},
              {"far_cones_ms", c.farConesMs},
              {"pixel_cones_ms", mGatheredOnGpu ? std::nan("") : c.pixelConesMs},
              {"far_voxels_cached", double(c.farVoxelsCached)},
@@ -525,6 +525,7 @@ private:
     std::string mDevice = "auto";
     std::string mCombineDevice = "auto";
     bool mCombinedOnGpu = false;
+    bool mGatheredResident = false; // the last gather ran resident (far cones on the device)
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;
     voxelgi::ConeSkyTrace mSky; // the last C++ gather's cone sky, for combineConeSky

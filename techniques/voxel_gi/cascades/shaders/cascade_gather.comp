@@ -19,14 +19,28 @@ layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
 layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
 layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
 // Split near/far cones (noise.y > 0): [level][voxel] the slot of the voxel centre's far cones
-// (~0u: not traced), and [slot][cone] their radiance (CascadeVolume::prepareFarCones).
-layout(std430, binding = 6) readonly buffer FarSlotBuffer { uint farSlots[]; };
-layout(std430, binding = 7) readonly buffer FarConeBuffer { vec4 farCones[]; };
+// (~0u: not traced), and [slot][cone] their radiance (CascadeVolume::prepareFarCones). Resident
+// (flags.w = 1): [level][voxel] the state of the voxel's far cones (0 none, 1 wanted, 2 traced)
+// and [level][voxel][cone] their radiance, kept on the device: the pixels mark the voxels they
+// read and list the newly marked ones (flags.z = 2), one invocation turns the list's length into
+// the group counts of the next two dispatches (5), which trace the listed voxels' far cones (3)
+// and commit them (4), all before the pixels' cones read them, in one submission: the far cones
+// never cross the bus, and only the listed voxels are visited.
+layout(std430, binding = 6) buffer FarSlotBuffer { uint farSlots[]; };
+layout(std430, binding = 7) buffer FarConeBuffer { vec4 farCones[]; };
+layout(std430, binding = 8) buffer FarListBuffer {
+    uint farCount;        // voxels listed
+    uint traceGroups[3];  // dispatchIndirect arguments of the trace (z: the 16 cones)
+    uint commitGroups[3]; // and of the commit
+    uint farPad;
+    uint farList[];       // [level * R^3 + voxel]
+};
 
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, levels, resolution
     vec4 march;  // level-0 voxel size, tan(half-angle), start offset (voxels), step scale
-    ivec4 flags; // y: max steps, z: 1 = far cones of voxel centres instead of pixels
+    ivec4 flags; // y: max steps, z: 0 pixels, 1 far cones of uploaded voxel centres, 2 mark,
+                 // 5 count, 3 trace and 4 commit the resident far cones; w: 1 = resident far cones
     ivec4 anchorCell; // xyz: the anchor in level-0 voxels
     vec4 noise;       // x: level noise (of a level's radius), y: far start (level voxels; 0: off)
 } pc;
@@ -73,11 +87,36 @@ vec3 sampleFar(int level, vec3 p, int cone)
         if (w == 0.0)
             continue;
         const ivec3 v = i0 + d;
-        const uint slot = farSlots[base + uint(v.x + R * (v.y + R * v.z))];
+        const uint voxel = base + uint(v.x + R * (v.y + R * v.z));
+        if (pc.flags.w == 1) {
+            if (farSlots[voxel] == 2u)
+                acc += w * farCones[voxel * 16u + uint(cone)].rgb;
+            continue;
+        }
+        const uint slot = farSlots[voxel];
         if (slot != 0xffffffffu)
             acc += w * farCones[slot * 16u + uint(cone)].rgb;
     }
     return acc;
+}
+
+// Resident far cones: marks the voxels of level `level` whose far cones sampleFar reads at p.
+void markFar(int level, vec3 p)
+{
+    const int R = pc.size.w;
+    ivec3 i0;
+    vec3 t;
+    getTrilinear(level, p, R, i0, t);
+    const uint base = uint(level) * uint(R) * uint(R) * uint(R);
+    for (int corner = 0; corner < 8; ++corner) {
+        ivec3 d;
+        if (getCornerWeight(corner, t, d) == 0.0)
+            continue;
+        const ivec3 v = i0 + d;
+        const uint voxel = base + uint(v.x + R * (v.y + R * v.z));
+        if (atomicCompSwap(farSlots[voxel], 0u, 1u) == 0u)
+            farList[atomicAdd(farCount, 1u)] = voxel;
+    }
 }
 
 // One cone marched front to back from t0 until tMax: rgb the radiance, a the transmittance;
@@ -124,10 +163,49 @@ void main()
     // one direction: 16 times the parallelism of a pixel per invocation, and coherent steps.
     const ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     const int k = int(gl_GlobalInvocationID.z);
+    if (pc.flags.z == 5) {
+        // The group counts for the listed voxels, 64 invocations (one 8 x 8 group) each.
+        if (gl_GlobalInvocationID == uvec3(0)) {
+            const uint groups = (farCount + 63u) / 64u;
+            traceGroups[0] = groups;
+            traceGroups[1] = 1u;
+            traceGroups[2] = 16u;
+            commitGroups[0] = groups;
+            commitGroups[1] = 1u;
+            commitGroups[2] = 1u;
+        }
+        return;
+    }
+    if (pc.flags.z == 3 || pc.flags.z == 4) {
+        // Resident far cones of the listed voxels: invocation (list entry, cone).
+        const uint entry = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;
+        if (entry >= farCount)
+            return;
+        const uint voxel = farList[entry];
+        if (pc.flags.z == 4) {
+            farSlots[voxel] = 2u;
+            return;
+        }
+        const int R = pc.size.w;
+        const int levelVoxels = R * R * R;
+        const int level = int(voxel) / levelVoxels;
+        if (levels[level].centre.w <= 0.0)
+            return;
+        const int local = int(voxel) - level * levelVoxels;
+        const vec3 cell = vec3(local % R, (local / R) % R, local / (R * R)) + 0.5;
+        const float voxelSize = levels[level].origin.w;
+        bool escaped;
+        const vec3 light = marchCone(levels[level].origin.xyz + cell * voxelSize, cones[k].xyz, k,
+                                     pc.noise.y * voxelSize, 1e30, escaped).rgb;
+        farCones[voxel * 16u + uint(k)] = vec4(max(light, vec3(0.0)), 1.0);
+        return;
+    }
+
     if (pixel.x >= pc.size.x || pixel.y >= pc.size.y || k >= 16)
         return;
     const int index = pixel.y * pc.size.x + pixel.x;
-    coneRadiance[index * 16 + k] = vec4(0.0);
+    if (pc.flags.z != 2)
+        coneRadiance[index * 16 + k] = vec4(0.0);
     if (pc.flags.z == 1) {
         // Far cones ("Split Cone Trace"): the 16 cones from a voxel centre, from far start voxels
         // of its level on (CascadeVolume::prepareFarCones).
@@ -162,6 +240,15 @@ void main()
     const float frac = start - float(l0);
     const bool two = frac > 0.0 && l0 + 1 < pc.size.z && levels[l0 + 1].centre.w > 0.0;
     const float split0 = farStart * levels[l0].origin.w;
+    if (pc.flags.z == 2) {
+        // Resident far cones: mark the voxels whose far cones this pixel's cones will read.
+        if (k == 0 && farStart > 0.0) {
+            markFar(l0, origin);
+            if (two)
+                markFar(l0 + 1, origin);
+        }
+        return;
+    }
     if (dot(cones[k].xyz, n) <= 0.0)
         return;
     const vec3 dir = cones[k].xyz;
