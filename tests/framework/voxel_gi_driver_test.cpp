@@ -6,6 +6,9 @@
 #include "experiment/analysis.h"
 #include "experiment/image_files.h"
 #include "experiment/runner.h"
+#include "families/voxel_gi/voxel_gi.h"
+#include "gpu/context.h"
+#include "test_registry.h"
 #include "plugin/technique.h"
 #include "report/report.h"
 
@@ -229,6 +232,89 @@ TEST(VoxelGiDriver, TheResidentGatherKeepsTheFrameOnTheGpu)
             for (int c = 0; c < 3; ++c)
                 off += std::abs(x.pixels[p][c] - y.pixels[p][c]) > 1e-4f * std::max(1e-2f, y.pixels[p][c]) ? 1 : 0;
         EXPECT_EQ(off, 0u) << "frame " << i;
+    }
+}
+
+// svo as a technique that claims a resident gather and then leaves no image on the GPU (`mode:
+// none`) or one the lighting pass cannot bind (`mode: small`, a 1x1 R32Float image): the frame
+// stops with an error that names the technique and what it left, never a stale image.
+class ResidentButWrong final : public plugin::VoxelGiTechnique {
+public:
+    static plugin::TechniqueInfo describe() { return {.summary = "test double: a resident gather gone wrong"}; }
+    static const plugin::TechniqueEntry& inner()
+    {
+        for (const auto* e : plugin::builtinRegistry().techniques("voxel_gi"))
+            if (e->info.name == "svo")
+                return *e;
+        throw Error("svo is not registered");
+    }
+    static config::ParamSchema declareParams()
+    {
+        config::ParamSchema s = inner().schema;
+        s.addEnum("mode", "none", {"none", "small"}, "what the resident gather leaves on the GPU");
+        return s;
+    }
+    explicit ResidentButWrong(const config::ParamSet& p)
+        : mMode(p.getString("mode")), mInner(inner().create(config::ParamSet::defaultsOf(inner().schema))),
+          mTechnique(dynamic_cast<plugin::VoxelGiTechnique&>(*mInner))
+    {
+    }
+    config::ParamSet effectiveParams() const override
+    {
+        config::ParamSet p = mInner->effectiveParams();
+        p.set("mode", mMode);
+        return p;
+    }
+    plugin::VoxelGiDefinition definition() const override { return mTechnique.definition(); }
+    plugin::VoxelGiStep voxelize(const plugin::VoxelGiFrame& f) override { return mTechnique.voxelize(f); }
+    plugin::VoxelGiStep injectLight(const plugin::VoxelGiFrame& f) override { return mTechnique.injectLight(f); }
+    plugin::VoxelGiMemory memory() const override { return mTechnique.memory(); }
+    std::string whyNotGatheredOnGpu(const gpu::Context&) const override { return {}; }
+    void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>&) override
+    {
+        if (mMode == "small" && input.gpu != nullptr)
+            mImage = input.gpu->createImage({gpu::ImageDimension::Image2D, gpu::Format::R32Float, 1, 1, 1,
+                                             gpu::ImageUsage::StorageAndSampled, "test.small"});
+    }
+    const gpu::Image* getGpuIrradiance() const override { return mImage.isValid() ? &mImage : nullptr; }
+
+private:
+    std::string mMode;
+    std::unique_ptr<plugin::Technique> mInner;
+    plugin::VoxelGiTechnique& mTechnique;
+    gpu::Image mImage;
+};
+
+TEST(VoxelGiDriver, AResidentGatherThatLeavesNoUsableImageStopsTheFrameWithAClearError)
+{
+    auto registry = test::makeTestRegistry();
+    plugin::registerTechnique<ResidentButWrong>(registry, "voxel_gi", "resident_but_wrong");
+    const auto dir = std::filesystem::temp_directory_path() / "rtlab_voxel_gi_driver_wrong";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    for (const std::string mode : {"none", "small"}) {
+        const auto e = experiment::parseExperiment(R"(base:
+  scene: cornell_box
+  resolution: [24, 16]
+  frames: 1
+  metrics: [error]
+  frame: {lighting: true, shadow_map_size: 16}
+  timing: {warmup: 0, repeats: 1}
+  reference: {target_stderr: 0.2, target_rel_stderr: 0.5, max_samples: 4}
+  techniques:
+    voxel_gi: {technique: resident_but_wrong, params: {resolution: 16, mode: )" + mode + R"(}}
+)",
+                                                   (dir / (mode + ".yaml")).string(), registry);
+        const std::string out = (dir / mode).string();
+        experiment::runExperiment(e, registry, {.outputDirectory = out, .quiet = true, .queryVulkanForManifest = false});
+        const auto rows = experiment::loadResults(out);
+        ASSERT_EQ(rows.size(), 1u);
+        EXPECT_EQ(rows[0].at("status"), "failed");
+        const std::string& error = rows[0].at("error");
+        EXPECT_NE(error.find("technique 'resident_but_wrong'"), std::string::npos) << error;
+        EXPECT_NE(error.find(mode == "none" ? "left no irradiance there" : "left a 1x1 R32_SFLOAT irradiance image"),
+                  std::string::npos)
+            << error;
     }
 }
 

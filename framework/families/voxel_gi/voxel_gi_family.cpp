@@ -38,6 +38,7 @@
 #include "pipeline/compose.h"
 #include "pipeline/frame_graph.h"
 #include "pipeline/frame_start.h"
+#include "gpu/format.h"
 #include "gpu/resources.h"
 #include "reference/reference.h"
 
@@ -208,12 +209,14 @@ private:
                 if (image == nullptr)
                     throw Error("technique '" + mTechniqueName +
                                 "' says its gather runs on the GPU but left no irradiance there");
-                if (int(image->getDesc().width) != w || int(image->getDesc().height) != h)
-                    throw Error("technique '" + mTechniqueName + "' left a " +
-                                std::to_string(image->getDesc().width) + "x" +
-                                std::to_string(image->getDesc().height) +
-                                " irradiance image on the GPU for a " + std::to_string(w) + "x" +
-                                std::to_string(h) + " G-buffer");
+                const gpu::ImageDesc& d = image->getDesc();
+                if (int(d.width) != w || int(d.height) != h || d.format != gpu::Format::RGBA32Float)
+                    throw Error("technique '" + mTechniqueName + "' left a " + std::to_string(d.width) +
+                                "x" + std::to_string(d.height) + " " +
+                                std::string(gpu::getFormatName(d.format)) +
+                                " irradiance image on the GPU where the lighting pass binds an "
+                                "RGBA32Float image of the G-buffer's size (" +
+                                std::to_string(w) + "x" + std::to_string(h) + ")");
                 ctx.write(onGpu) = image;
                 mRow->set("gather.cone_visibility", input.gpuConeVisibility[0] != nullptr);
                 mRow->set("voxel_gather.resident", mResidentRow);
