@@ -146,6 +146,7 @@ void FrameStart::addPasses(FrameGraph& graph)
                           mSdfChanges.push_back(logged);
                       mMeshedEditKey = mScene.getEditStateKey(ctx.frame());
                       mMeshedFrame = ctx.frame();
+                      ++mSdfMeshVersion;
                       return PassOutcome{};
                   });
     graph.addPass({.name = "character_pose",
@@ -165,10 +166,31 @@ void FrameStart::addPasses(FrameGraph& graph)
                       static const std::vector<scene::PosedCapsule> kNoCapsules;
                       const auto* meshes = ctx.tryRead(sdfMeshes);
                       const auto* posed = ctx.tryRead(capsules);
-                      const scene::RenderScene& g = ctx.write(geometryRes) =
-                          mScene.assembleRenderScene(meshes ? *meshes : kNoMeshes,
-                                                     posed ? *posed : kNoCapsules, ctx.frame());
-                      ctx.write(geometryKeyRes) = g.computeContentHash();
+                      // The static part (meshes and SDF meshes) and its content hash are kept
+                      // until sdf_remesh gives new meshes; a frame where only the characters
+                      // moved copies it and appends their capsules (culling off: assembled and
+                      // hashed anew, the ablation). The key hashes the static part's hash with
+                      // the capsules, from which their triangles follow: it changes exactly when
+                      // the geometry does.
+                      if (!ctx.mayReuse() || mStaticVersion != mSdfMeshVersion || mStaticKey.empty()) {
+                          mStaticGeometry = mScene.assembleStaticGeometry(meshes ? *meshes : kNoMeshes);
+                          mStaticKey = mStaticGeometry.computeContentHash();
+                          mStaticVersion = mSdfMeshVersion;
+                      }
+                      scene::RenderScene& g = ctx.write(geometryRes);
+                      g = mStaticGeometry;
+                      const auto& characters = posed ? *posed : kNoCapsules;
+                      mScene.appendCharacters(g, characters);
+                      if (g.indices.empty())
+                          throw Error("scene '" + mScene.name + "' has no triangles at frame " +
+                                      std::to_string(ctx.frame()) +
+                                      "; a scene needs at least one mesh, SDF model or character");
+                      Hasher key;
+                      key.add("assembled geometry v1").add(mStaticKey).addValue(characters.size());
+                      for (const scene::PosedCapsule& c : characters)
+                          key.addValue(c.capsule.a).addValue(c.capsule.b).addValue(c.capsule.radius).addValue(
+                              c.material);
+                      ctx.write(geometryKeyRes) = key.hexDigest();
                       return PassOutcome{};
                   });
     graph.addPass({.name = "scene_upload",

@@ -196,6 +196,11 @@ private:
     int mMeshedFrame = -1;
     std::string mUploadedHash;
     int mUploadedFrame = -1;
+    // assemble_geometry's static part (no characters), its content hash, and the count of
+    // sdf_remesh runs it was made after (mSdfMeshVersion: incremented by each).
+    scene::RenderScene mStaticGeometry;
+    std::string mStaticKey;
+    std::uint64_t mStaticVersion = 0, mSdfMeshVersion = 0;
     std::string mDrawnKey;
     int mDrawnFrame = -1;
     std::string mReadKey;

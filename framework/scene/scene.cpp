@@ -200,20 +200,36 @@ RenderScene Scene::buildRenderScene(int frame) const
 RenderScene Scene::assembleRenderScene(const std::vector<SdfMesh>& sdfMeshes, const std::vector<PosedCapsule>& capsules,
                                        int frame) const
 {
+    RenderScene out = assembleStaticGeometry(sdfMeshes);
+    appendCharacters(out, capsules);
+    if (out.indices.empty())
+        throw Error("scene '" + name + "' has no triangles at frame " + std::to_string(frame) +
+                    "; a scene needs at least one mesh, SDF model or character");
+    return out;
+}
+
+namespace {
+
+// `owner()` names what uses material m, built only for the error.
+template <class Owner>
+std::uint32_t checkMaterial(const RenderScene& out, const std::string& scene, std::uint32_t m, const Owner& owner)
+{
+    if (m >= out.materials.size())
+        throw Error("scene '" + scene + "': " + owner() + " uses material " + std::to_string(m) +
+                    " but the scene has " + std::to_string(out.materials.size()));
+    return m;
+}
+
+} // namespace
+
+RenderScene Scene::assembleStaticGeometry(const std::vector<SdfMesh>& sdfMeshes) const
+{
     RenderScene out;
     out.materials = materials;
     if (out.materials.empty())
         out.materials.push_back(Material{"default"});
     out.pointLights = pointLights;
     out.sky = sky;
-    const auto materialCount = std::uint32_t(out.materials.size());
-    auto checkMaterial = [&](std::uint32_t m, const std::string& owner) {
-        if (m >= materialCount)
-            throw Error("scene '" + name + "': " + owner + " uses material " + std::to_string(m) + " but the scene has " +
-                        std::to_string(materialCount));
-        return m;
-    };
-
     for (const auto& mesh : meshes) {
         const auto base = std::uint32_t(out.positions.size());
         out.positions.insert(out.positions.end(), mesh.positions.begin(), mesh.positions.end());
@@ -227,28 +243,43 @@ RenderScene Scene::assembleRenderScene(const std::vector<SdfMesh>& sdfMeshes, co
         for (auto i : mesh.indices)
             out.indices.push_back(base + i);
         for (std::size_t t = 0; t < mesh.indices.size() / 3; ++t)
-            out.triangleMaterial.push_back(
-                checkMaterial(t < mesh.triangleMaterial.size() ? mesh.triangleMaterial[t] : 0, "mesh '" + mesh.name + "'"));
+            out.triangleMaterial.push_back(checkMaterial(out, name,
+                                                         t < mesh.triangleMaterial.size() ? mesh.triangleMaterial[t] : 0,
+                                                         [&] { return "mesh '" + mesh.name + "'"; }));
     }
     for (std::size_t k = 0; k < sdfMeshes.size(); ++k) {
         const SdfMesh& m = sdfMeshes[k];
-        const std::string owner = "SDF model '" + (k < sdfModels.size() ? sdfModels[k].name : std::string("?")) + "'";
+        const auto owner = [&] {
+            return "SDF model '" + (k < sdfModels.size() ? sdfModels[k].name : std::string("?")) + "'";
+        };
         const auto base = std::uint32_t(out.positions.size());
         out.positions.insert(out.positions.end(), m.mesh.positions.begin(), m.mesh.positions.end());
         out.normals.insert(out.normals.end(), m.mesh.normals.begin(), m.mesh.normals.end());
         for (auto i : m.mesh.indices)
             out.indices.push_back(base + i);
         for (auto mat : m.triangleMaterial)
-            out.triangleMaterial.push_back(checkMaterial(mat, owner));
+            out.triangleMaterial.push_back(checkMaterial(out, name, mat, owner));
     }
-    for (const auto& c : capsules)
-        appendCapsule(out, c.capsule, checkMaterial(c.material, "character '" + c.character + "'"));
-
-    if (out.indices.empty())
-        throw Error("scene '" + name + "' has no triangles at frame " + std::to_string(frame) +
-                    "; a scene needs at least one mesh, SDF model or character");
     out.updateBounds();
     return out;
+}
+
+void Scene::appendCharacters(RenderScene& out, const std::vector<PosedCapsule>& capsules) const
+{
+    const std::size_t first = out.positions.size();
+    for (const auto& c : capsules)
+        appendCapsule(out, c.capsule,
+                      checkMaterial(out, name, c.material, [&] { return "character '" + c.character + "'"; }));
+    // The bounds are a min and max: extending them over the new vertices is what recomputing
+    // them over all gives.
+    if (first == 0) {
+        out.updateBounds();
+        return;
+    }
+    for (std::size_t i = first; i < out.positions.size(); ++i) {
+        out.boundsMin = glm::min(out.boundsMin, out.positions[i]);
+        out.boundsMax = glm::max(out.boundsMax, out.positions[i]);
+    }
 }
 
 } // namespace rtlab::scene

@@ -124,9 +124,16 @@ struct Scene {
     //! Changes exactly when the set of applied edits changes (the number of edits started by
     //! `frame`): two frames with the same key mesh to the same SDF meshes.
     std::uint64_t getEditStateKey(int frame) const;
-    //! Joins the static meshes with the given parts (as buildRenderScene does).
+    //! Joins the static meshes with the given parts (as buildRenderScene does):
+    //! assembleStaticGeometry, then appendCharacters, then the check for triangles.
     RenderScene assembleRenderScene(const std::vector<SdfMesh>& sdfMeshes, const std::vector<PosedCapsule>& capsules,
                                     int frame) const;
+    //! The part of a frame that changes only with the SDF meshes: the meshes and meshed SDF
+    //! models with the materials, lights and sky, and their bounds (may have no triangles).
+    RenderScene assembleStaticGeometry(const std::vector<SdfMesh>& sdfMeshes) const;
+    //! Appends the tessellated capsules to `geometry` (after its triangles) and extends its
+    //! bounds over them.
+    void appendCharacters(RenderScene& geometry, const std::vector<PosedCapsule>& capsules) const;
 };
 
 } // namespace rtlab::scene
