@@ -73,9 +73,9 @@ void writePassRecords(ResultRow& row, const std::vector<pipeline::PassRecord>& r
             framePasses += (framePasses.empty() ? "" : ";") + r.name;
         if (!r.ran || !r.time)
             continue;
-        // What crossed the bus, and the host's own time: the CPU wall time less the waits on
-        // the device (gpu/bus_counters.h).
-        const double hostMs = std::max(0.0, r.time->cpuMs.median - r.waitMs);
+        // What crossed the bus, and the host's own time: per call the CPU wall time less the
+        // waits on the device (gpu/bus_counters.h), the median over the timed calls.
+        const double hostMs = r.hostMs;
         if (!r.measurement) {
             frameCpu += r.time->cpuMs.median;
             if (!r.time->gpuMs.empty())

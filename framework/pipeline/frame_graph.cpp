@@ -368,25 +368,36 @@ std::vector<PassRecord> FrameGraph::execute(const FrameOptions& options)
             collect(); // GPU work submitted before this pass is not its own
             const gpu::BusCounters busBefore = gpu::getBusCounters();
             int calls = 1;
+            std::vector<double> hostMs; // per call: wall time less the waits on the device
+            const auto call = [&] {
+                const double waitedBefore = gpu::getBusCounters().waitMs;
+                const auto start = std::chrono::steady_clock::now();
+                outcome = mCallbacks[i](context);
+                const double ms =
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                        .count();
+                hostMs.push_back(std::max(0.0, ms - (gpu::getBusCounters().waitMs - waitedBefore)));
+                return ms;
+            };
             if (!reused.empty()) {
                 outcome = PassOutcome::skipped(reused);
             } else if (mPasses[i].timing == PassTiming::Repeated) {
                 calls = 0;
-                const auto report =
-                    metrics::measure(mPasses[i].timingOptions.value_or(options.timing), [&] {
-                        ++calls;
-                        outcome = mCallbacks[i](context);
-                        return collect();
-                    });
+                const metrics::TimingOptions timing = mPasses[i].timingOptions.value_or(options.timing);
+                const auto report = metrics::measure(timing, [&] {
+                    ++calls;
+                    call();
+                    return collect();
+                });
                 records[i].time = report;
+                // The timed calls are the last max(1, repeats) (metrics::measure).
+                const std::size_t timed = std::size_t(std::max(1, timing.repeats));
+                hostMs.erase(hostMs.begin(), hostMs.end() - std::ptrdiff_t(std::min(timed, hostMs.size())));
             } else {
-                const auto start = std::chrono::steady_clock::now();
-                outcome = mCallbacks[i](context);
-                const double ms = std::chrono::duration<double, std::milli>(
-                                      std::chrono::steady_clock::now() - start)
-                                      .count();
-                records[i].time = makeSingleReport(ms, collect());
+                records[i].time = makeSingleReport(call(), collect());
             }
+            if (!hostMs.empty())
+                records[i].hostMs = metrics::computeStats(std::move(hostMs)).median;
             {
                 // Per call of the pass (a repeated one is called warm-up + repeats times).
                 const gpu::BusCounters bus = gpu::getBusCounters() - busBefore;

@@ -178,13 +178,16 @@ struct PassRecord {
     //! When it ran: the CPU wall time (and GPU pass times) the graph measured.
     std::optional<metrics::TimingReport> time;
     //! When it ran: what crossed the bus per call of the pass (gpu/bus_counters.h): bytes
-    //! uploaded and read back, queue submissions, host waits on a fence and their wall time
-    //! (the pass's host time is its CPU wall time less that).
+    //! uploaded and read back, queue submissions, host waits on a fence and their wall time.
     std::uint64_t uploadBytes = 0;
     std::uint64_t readbackBytes = 0;
     std::uint64_t submits = 0;
     std::uint64_t waits = 0;
     double waitMs = 0.0;
+    //! The pass's host time: per call its CPU wall time less its waits on the device, the median
+    //! over the timed calls (a repeated pass's repeats; its first use and warm-ups, which wait
+    //! differently, are left out).
+    double hostMs = 0.0;
 };
 
 class FrameGraph;
