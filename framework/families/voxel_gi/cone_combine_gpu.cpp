@@ -17,8 +17,6 @@
 
 namespace rtlab::voxelgi {
 
-namespace {
-
 struct CombineConstants {
     glm::ivec4 size{0};  // full width, height; low width, height
     // factor, capsules, visibility given, 1 = the capsules at the traced pixels
@@ -27,6 +25,8 @@ struct CombineConstants {
     glm::vec4 anchor{0.0f};
 };
 static_assert(sizeof(CombineConstants) == 64, "must match cone_combine.comp");
+
+namespace {
 
 constexpr std::uint32_t kBindings = 9;
 
@@ -205,7 +205,7 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
     const int capsuleCount = uploadCapsules(in.capsules, anchor);
     reserve(mOutput, pixels * sizeof(glm::vec4), "voxel_gi.combine.irradiance");
 
-    CombineConstants constants =
+    const CombineConstants constants =
         makeConstants(w, h, {reduced.gbuffer.width, reduced.gbuffer.height}, reduced.factor, capsuleCount,
                       useVisibility, in.coneHalfAngle, anchor);
     const std::vector<gpu::Binding> bindings = {gpu::Binding::storageBuffer(0, coneRadiance),
@@ -220,30 +220,38 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
     Image<glm::vec3> out(w, h, glm::vec3(0.0f));
     if (pixels == 0)
         return out;
+    runCombine(context, mPipeline, bindings, constants, in.capsuleResolution);
+    const std::vector<glm::vec4> e = mOutput.downloadVector<glm::vec4>(pixels);
+    for (std::size_t i = 0; i < pixels; ++i)
+        out.pixels[i] = glm::vec3(e[i]);
+    return out;
+}
+
+void ConeCombineGpu::runCombine(gpu::Context& context, const gpu::ComputePipeline& pipeline,
+                                const std::vector<gpu::Binding>& bindings, const CombineConstants& given,
+                                CapsuleResolution capsuleResolution)
+{
     // The capsules at the traced pixels: a first dispatch over the reduced pixels multiplies the
     // cone radiances in place, then the combine runs without capsules.
-    const bool traced = in.capsuleResolution == CapsuleResolution::Traced && capsuleCount > 0;
+    CombineConstants constants = given;
+    const bool traced = capsuleResolution == CapsuleResolution::Traced && constants.flags.y > 0;
     CombineConstants tracedConstants = constants;
     tracedConstants.flags.w = 1;
     if (traced)
         constants.flags.y = 0;
+    const int w = constants.size.x, h = constants.size.y, lw = constants.size.z, lh = constants.size.w;
     const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
         if (traced)
-            cmd.dispatch(mPipeline, bindings, gpu::PushConstants(tracedConstants),
-                         gpu::GroupCount{
-                             gpu::computeGroupCount(std::uint64_t(reduced.gbuffer.width), 8),
-                             gpu::computeGroupCount(std::uint64_t(reduced.gbuffer.height), 8), 1},
+            cmd.dispatch(pipeline, bindings, gpu::PushConstants(tracedConstants),
+                         gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(lw), 8),
+                                         gpu::computeGroupCount(std::uint64_t(lh), 8), 1},
                          kDispatchLabel);
-        cmd.dispatch(mPipeline, bindings, gpu::PushConstants(constants),
+        cmd.dispatch(pipeline, bindings, gpu::PushConstants(constants),
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), 8),
                                      gpu::computeGroupCount(std::uint64_t(h), 8), 1},
                      kDispatchLabel);
     });
     mLastGpuMs = result.sumGpuMs(kDispatchLabel);
-    const std::vector<glm::vec4> e = mOutput.downloadVector<glm::vec4>(pixels);
-    for (std::size_t i = 0; i < pixels; ++i)
-        out.pixels[i] = glm::vec3(e[i]);
-    return out;
 }
 
 const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
@@ -279,7 +287,7 @@ const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const P
                                             gpu::ImageUsage::StorageAndSampled, "voxel_gi.irradiance"});
     const glm::dvec3 anchor(g.cameraPosition);
     const int capsuleCount = uploadCapsules(in.capsules, anchor);
-    CombineConstants constants =
+    const CombineConstants constants =
         makeConstants(w, h, low, factor, capsuleCount, useVisibility, in.coneHalfAngle, anchor);
     const auto vis = [&](std::size_t k) -> const gpu::Image& {
         return useVisibility ? *in.visibility[k] : mNoVisibility;
@@ -295,23 +303,7 @@ const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const P
         gpu::Binding::storageImage(10, vis(1)),
         gpu::Binding::storageImage(11, vis(2)),
         gpu::Binding::storageImage(12, vis(3))};
-    const bool traced = in.capsuleResolution == CapsuleResolution::Traced && capsuleCount > 0;
-    CombineConstants tracedConstants = constants;
-    tracedConstants.flags.w = 1;
-    if (traced)
-        constants.flags.y = 0;
-    const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
-        if (traced)
-            cmd.dispatch(mResidentPipeline, bindings, gpu::PushConstants(tracedConstants),
-                         gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(low.x), 8),
-                                         gpu::computeGroupCount(std::uint64_t(low.y), 8), 1},
-                         kDispatchLabel);
-        cmd.dispatch(mResidentPipeline, bindings, gpu::PushConstants(constants),
-                     gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), 8),
-                                     gpu::computeGroupCount(std::uint64_t(h), 8), 1},
-                     kDispatchLabel);
-    });
-    mLastGpuMs = result.sumGpuMs(kDispatchLabel);
+    runCombine(context, mResidentPipeline, bindings, constants, in.capsuleResolution);
     return mOutputImage;
 }
 

@@ -30,6 +30,9 @@ struct ResidentCombineInputs {
     CapsuleResolution capsuleResolution = CapsuleResolution::Full;
 };
 
+//! The combine shader's push constants (cone_combine_gpu.cpp).
+struct CombineConstants;
+
 class ConeCombineGpu {
 public:
     static constexpr const char* kDispatchLabel = "voxel_gi.combine";
@@ -73,6 +76,11 @@ private:
     void prepare(gpu::Context& context, bool resident = false);
     // The capsules relative to `anchor` as the shader reads them, uploaded; returns their count.
     int uploadCapsules(const std::vector<scene::PosedCapsule>* capsules, const glm::dvec3& anchor);
+    // The combine's dispatches with `pipeline` (either variant): with the capsules at the traced
+    // pixels a first one over the reduced pixels, then the full-resolution one.
+    void runCombine(gpu::Context& context, const gpu::ComputePipeline& pipeline,
+                    const std::vector<gpu::Binding>& bindings, const CombineConstants& constants,
+                    CapsuleResolution capsuleResolution);
     // A buffer of at least `bytes`; every one here is written or read once per frame, so all are
     // gpu::BufferDesc::hostVisible.
     gpu::Buffer& reserve(gpu::Buffer& buffer, std::size_t bytes, const char* name);

@@ -174,37 +174,50 @@ std::size_t PixelConeDispatch::uploadPixels(const scene::GBuffer& gbuffer, const
     return 2 * pixels * sizeof(glm::vec4);
 }
 
-std::optional<double> PixelConeDispatch::runWithSteps(gpu::Buffer& first, gpu::Buffer& second,
-                                                      const gpu::PushConstants& constants,
-                                                      const std::vector<gpu::Buffer*>& extra,
-                                                      const std::vector<Clear>& clear,
-                                                      const std::vector<Step>& before)
+std::vector<gpu::Binding> PixelConeDispatch::bindStarts(const Starts& starts, gpu::Buffer& first, gpu::Buffer& second,
+                                                        const std::vector<gpu::Buffer*>& extra) const
 {
-    Starts& starts = mOnDevice ? mDevicePixels : mPixels;
     std::vector<gpu::Binding> bindings = {
         gpu::Binding::storageBuffer(0, first),            gpu::Binding::storageBuffer(1, second),
         gpu::Binding::storageBuffer(2, starts.positions), gpu::Binding::storageBuffer(3, starts.normals),
         gpu::Binding::storageBuffer(4, starts.output),    gpu::Binding::storageBuffer(5, mCones)};
     for (std::size_t i = 0; i < extra.size(); ++i)
         bindings.push_back(gpu::Binding::storageBuffer(std::uint32_t(6 + i), *extra[i]));
+    return bindings;
+}
+
+void PixelConeDispatch::recordCones(gpu::CommandList& cmd, const std::vector<gpu::Binding>& bindings,
+                                    const gpu::PushConstants& constants, const Starts& starts) const
+{
+    cmd.dispatch(mPipeline, bindings, constants,
+                 gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(starts.width), 8),
+                                 gpu::computeGroupCount(std::uint64_t(starts.height), 8),
+                                 std::uint32_t(kConeCount)},
+                 mLabel.c_str());
+}
+
+std::optional<double> PixelConeDispatch::runWithSteps(gpu::Buffer& first, gpu::Buffer& second,
+                                                      const gpu::PushConstants& constants,
+                                                      const std::vector<gpu::Buffer*>& extra,
+                                                      const std::vector<Clear>& clear,
+                                                      const std::vector<Step>& before)
+{
+    const Starts& starts = mOnDevice ? mDevicePixels : mPixels;
+    const std::vector<gpu::Binding> bindings = bindStarts(starts, first, second, extra);
     const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
         if (mOnDevice)
             recordReduce(cmd);
         for (const Clear& c : clear)
             cmd.fillBuffer(*extra.at(c.extra), 0u, c.offset, c.size);
         for (const Step& step : before) {
-            const gpu::PushConstants constants(step.constants.data(), step.constants.size());
+            const gpu::PushConstants stepConstants(step.constants.data(), step.constants.size());
             if (step.indirect != nullptr)
-                cmd.dispatchIndirect(mPipeline, bindings, constants, *step.indirect, step.indirectOffset,
+                cmd.dispatchIndirect(mPipeline, bindings, stepConstants, *step.indirect, step.indirectOffset,
                                      mLabel.c_str());
             else
-                cmd.dispatch(mPipeline, bindings, constants, step.groups, mLabel.c_str());
+                cmd.dispatch(mPipeline, bindings, stepConstants, step.groups, mLabel.c_str());
         }
-        cmd.dispatch(mPipeline, bindings, constants,
-                     gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(starts.width), 8),
-                                     gpu::computeGroupCount(std::uint64_t(starts.height), 8),
-                                     std::uint32_t(kConeCount)},
-                     mLabel.c_str());
+        recordCones(cmd, bindings, constants, starts);
     });
     return result.sumGpuMs(mLabel);
 }
@@ -240,20 +253,11 @@ std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& se
 {
     Starts& starts = points ? mPoints : mOnDevice ? mDevicePixels : mPixels;
     const bool reduce = !points && mOnDevice;
-    std::vector<gpu::Binding> bindings = {
-        gpu::Binding::storageBuffer(0, first),            gpu::Binding::storageBuffer(1, second),
-        gpu::Binding::storageBuffer(2, starts.positions), gpu::Binding::storageBuffer(3, starts.normals),
-        gpu::Binding::storageBuffer(4, starts.output),    gpu::Binding::storageBuffer(5, mCones)};
-    for (std::size_t i = 0; i < extra.size(); ++i)
-        bindings.push_back(gpu::Binding::storageBuffer(std::uint32_t(6 + i), *extra[i]));
+    const std::vector<gpu::Binding> bindings = bindStarts(starts, first, second, extra);
     const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
         if (reduce)
             recordReduce(cmd);
-        cmd.dispatch(mPipeline, bindings, constants,
-                     gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(starts.width), 8),
-                                     gpu::computeGroupCount(std::uint64_t(starts.height), 8),
-                                     std::uint32_t(kConeCount)},
-                     mLabel.c_str());
+        recordCones(cmd, bindings, constants, starts);
     });
     if (out != nullptr) {
         const std::vector<glm::vec4> e =

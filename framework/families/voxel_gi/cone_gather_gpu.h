@@ -128,6 +128,11 @@ private:
     const gpu::Image* mReduceNormals = nullptr;
     void reserve(Starts& starts, std::size_t entries, const char* what, bool hostVisible = true);
     void recordReduce(gpu::CommandList& cmd);
+    // The pipeline's bindings over `starts`, and the cones' dispatch over them.
+    std::vector<gpu::Binding> bindStarts(const Starts& starts, gpu::Buffer& first, gpu::Buffer& second,
+                                         const std::vector<gpu::Buffer*>& extra) const;
+    void recordCones(gpu::CommandList& cmd, const std::vector<gpu::Binding>& bindings,
+                     const gpu::PushConstants& constants, const Starts& starts) const;
 };
 
 } // namespace rtlab::voxelgi
