@@ -177,7 +177,7 @@ TEST(VoxelGiDriver, TheVulkanCombineGivesTheCppCombinesFrame)
     }
 }
 
-// The resident gather ([12]): the cascades' pixel cones (split near/far: the far cones marked,
+// The resident gather: the cascades' pixel cones (split near/far: the far cones marked,
 // traced and kept on the device) and combine on Vulkan read the G-buffer and SSDO's visibilities
 // where the frame keeps them and leave the irradiance in an image the lighting pass binds; nothing
 // of the gather crosses the bus in the frame, and the irradiance comes to the CPU only for the

@@ -106,8 +106,8 @@ struct VoxelGiInput {
     //! when nothing reads it (no lit frame, or `frame: {sky: lobes}`).
     bool coneSky = false;
 
-    // The resident gather ([12]: the frame stays on the GPU). Given to a technique whose
-    // gathersOnGpu() is true when the frame keeps its G-buffer on the GPU; `gbuffer` and
+    // The resident gather (the frame stays on the GPU). Given to a technique whose
+    // whyNotGatheredOnGpu() is "" when the frame keeps its G-buffer on the GPU; `gbuffer` and
     // `coneVisibility` are then null and the technique binds these instead.
     const VoxelGiGpuGBuffer* gpuGBuffer = nullptr;
     //! The occlusion family's 16 visibilities on the GPU (pipeline/compose.h

@@ -370,7 +370,7 @@ private:
                             what + " for a " + std::to_string(g.width) + "x" +
                             std::to_string(g.height) + " G-buffer");
         };
-        // Resident ([12]): the technique reduces the G-buffer's GPU images, traces and combines
+        // Resident: the technique reduces the G-buffer's GPU images, traces and combines
         // its cones on the device, and the lighting pass binds its image; the irradiance comes
         // to the CPU only for the passes that read it there (measurements). Otherwise the gather
         // reads the CPU G-buffer and the compose passes upload its result.
