@@ -59,6 +59,22 @@ scene::GBuffer makeGBuffer(const scene::RenderScene& s, const scene::Camera& cam
     return g;
 }
 
+//! Voxelizes `s` and lights it (the steps before a gather), the camera at the G-buffer's;
+//! returns the frame given to them.
+plugin::VoxelGiFrame voxelizeAndLight(plugin::VoxelGiTechnique& gi, const scene::RenderScene& s,
+                                      const scene::GBuffer& g, gpu::Context* gpu = nullptr, bool coneSky = false)
+{
+    plugin::VoxelGiFrame frame;
+    frame.geometry = &s;
+    frame.geometryKey = s.computeContentHash();
+    frame.cameraPosition = glm::dvec3(g.camera.position);
+    frame.gpu = gpu;
+    frame.coneSky = coneSky;
+    gi.voxelize(frame);
+    gi.injectLight(frame);
+    return frame;
+}
+
 //! A fresh instance at its defaults: voxelize, inject, gather.
 Image<glm::vec3> runTechnique(const TechniqueEntry& entry, const scene::RenderScene& s, const scene::GBuffer& g)
 {
@@ -66,12 +82,7 @@ Image<glm::vec3> runTechnique(const TechniqueEntry& entry, const scene::RenderSc
     auto* gi = dynamic_cast<plugin::VoxelGiTechnique*>(t.get());
     if (gi == nullptr)
         throw Error(entry.info.name + " is not a voxel_gi technique");
-    plugin::VoxelGiFrame frame;
-    frame.geometry = &s;
-    frame.geometryKey = s.computeContentHash();
-    frame.cameraPosition = glm::dvec3(g.camera.position);
-    gi->voxelize(frame);
-    gi->injectLight(frame);
+    const plugin::VoxelGiFrame frame = voxelizeAndLight(*gi, s, g);
     plugin::VoxelGiInput input;
     input.gbuffer = &g;
     input.scene = &s;
@@ -88,13 +99,7 @@ bool runConeSky(const TechniqueEntry& entry, const scene::RenderScene& s, const 
 {
     auto t = entry.create(config::ParamSet::defaultsOf(entry.schema));
     auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*t);
-    plugin::VoxelGiFrame frame;
-    frame.geometry = &s;
-    frame.geometryKey = s.computeContentHash();
-    frame.cameraPosition = glm::dvec3(g.camera.position);
-    frame.coneSky = true;
-    gi.voxelize(frame);
-    gi.injectLight(frame);
+    const plugin::VoxelGiFrame frame = voxelizeAndLight(gi, s, g, nullptr, true);
     plugin::VoxelGiInput input;
     input.gbuffer = &g;
     input.scene = &s;
@@ -220,13 +225,7 @@ std::string compareResidentGather(gpu::Context& context, const TechniqueEntry& e
     auto& gi = dynamic_cast<plugin::VoxelGiTechnique&>(*t);
     if (std::string why = gi.whyNotGatheredOnGpu(context); !why.empty())
         return why;
-    plugin::VoxelGiFrame frame;
-    frame.geometry = &s;
-    frame.geometryKey = s.computeContentHash();
-    frame.cameraPosition = glm::dvec3(g.camera.position);
-    frame.gpu = &context;
-    gi.voxelize(frame);
-    gi.injectLight(frame);
+    const plugin::VoxelGiFrame frame = voxelizeAndLight(gi, s, g, &context);
     plugin::VoxelGiInput uploaded;
     uploaded.gbuffer = &g;
     uploaded.scene = &s;

@@ -25,6 +25,7 @@
 
 #include "families/voxel_gi/voxel_gi.h"
 #include "families/voxel_gi/cone_sky_split.h"
+#include "families/voxel_gi/resident_gather.h"
 #include "families/voxel_gi/stress_cases.h"
 
 #include "core/error.h"
@@ -38,11 +39,8 @@
 #include "pipeline/compose.h"
 #include "pipeline/frame_graph.h"
 #include "pipeline/frame_start.h"
-#include "gpu/format.h"
-#include "gpu/resources.h"
 #include "reference/reference.h"
 
-#include <array>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -156,103 +154,6 @@ private:
     bool mResident = false;   //!< the gather runs resident (addResidentGather)
     //! Whether the run's lit frame takes its sky from the technique's cones.
     bool wantsConeSky() const { return mRun.lighting && mRun.sky != "lobes"; }
-
-    //! The resident gather's passes: `voxel_gather` on the G-buffer's GPU images into the
-    //! technique's image, `voxel_gather_readback` (runs only for the passes that read `indirect`
-    //! on the CPU), `indirect_gpu_slot` (the lighting pass binds the image) and `voxel_cone_sky`,
-    //! which says why the frame's sky takes the lobes.
-    void addResidentGather(pipeline::FrameGraph& graph, pipeline::FrameStart& start,
-                           const pipeline::Resource<int>& voxelLight,
-                           const pipeline::Resource<Image<glm::vec3>>& indirect,
-                           const pipeline::Resource<std::array<const gpu::Image*, 4>>* conesGpu,
-                           const pipeline::Resource<std::vector<scene::PosedCapsule>>* capsules)
-    {
-        const int w = mRun.width, h = mRun.height;
-        const auto gbufferGpu = start.gbuffer();
-        const auto positionGpu = start.positionDepthGpu();
-        const auto normalGpu = start.worldNormalGpu();
-        const pipeline::Resource<const gpu::Image*> onGpu{
-            "technique_indirect_gpu", pipeline::ResourceType::gpuImage("rgba32f irradiance", w, h)};
-        std::vector<pipeline::ResourceRef> optional;
-        if (conesGpu != nullptr)
-            optional.push_back(*conesGpu);
-        if (capsules != nullptr)
-            optional.push_back(*capsules);
-        const auto cones = conesGpu ? std::optional(*conesGpu) : std::nullopt;
-        const auto posed = capsules ? std::optional(*capsules) : std::nullopt;
-        graph.addPass(
-            {.name = "voxel_gather",
-             .reads = {voxelLight, gbufferGpu, positionGpu, normalGpu},
-             .optionalReads = optional,
-             .writes = {onGpu}},
-            [this, gbufferGpu, positionGpu, normalGpu, cones, posed, onGpu, w,
-             h](pipeline::PassContext& ctx) {
-                const pipeline::GpuGBuffer& g = ctx.read(gbufferGpu);
-                plugin::VoxelGiGpuGBuffer images;
-                images.positionDepth = &ctx.read(positionGpu);
-                images.normal = &ctx.read(normalGpu);
-                images.width = g.width;
-                images.height = g.height;
-                images.cameraPosition = glm::dvec3(g.camera.position);
-                plugin::VoxelGiInput input;
-                input.gpuGBuffer = &images;
-                input.cameraPosition = images.cameraPosition;
-                input.frameIndex = ctx.frame();
-                input.gpu = &mContext.getGpu();
-                input.capsules = posed ? ctx.tryRead(*posed) : nullptr;
-                if (const auto* v = cones ? ctx.tryRead(*cones) : nullptr)
-                    input.gpuConeVisibility = *v;
-                input.readBack = false;
-                Image<glm::vec3> unused;
-                mTechnique->gather(input, unused);
-                const gpu::Image* image = mTechnique->getGpuIrradiance();
-                if (image == nullptr)
-                    throw Error("technique '" + mTechniqueName +
-                                "' says its gather runs on the GPU but left no irradiance there");
-                const gpu::ImageDesc& d = image->getDesc();
-                if (int(d.width) != w || int(d.height) != h || d.format != gpu::Format::RGBA32Float)
-                    throw Error("technique '" + mTechniqueName + "' left a " + std::to_string(d.width) +
-                                "x" + std::to_string(d.height) + " " +
-                                std::string(gpu::getFormatName(d.format)) +
-                                " irradiance image on the GPU where the lighting pass binds an "
-                                "RGBA32Float image of the G-buffer's size (" +
-                                std::to_string(w) + "x" + std::to_string(h) + ")");
-                ctx.write(onGpu) = image;
-                mRow->set("gather.cone_visibility", input.gpuConeVisibility[0] != nullptr);
-                mRow->set("voxel_gather.resident", mResidentRow);
-                return pipeline::PassOutcome{};
-            });
-        graph.addPass({.name = "voxel_gather_readback",
-                       .reads = {onGpu},
-                       .writes = {indirect},
-                       .forReaders = true},
-                      [this, indirect, w, h](pipeline::PassContext& ctx) {
-                          Image<glm::vec3>& out = ctx.write(indirect);
-                          mTechnique->readBackIrradiance(out);
-                          if (out.width != w || out.height != h)
-                              throw Error("technique '" + mTechniqueName + "' read back " +
-                                          std::to_string(out.width) + "x" +
-                                          std::to_string(out.height) + " irradiance for a " +
-                                          std::to_string(w) + "x" + std::to_string(h) +
-                                          " G-buffer");
-                          return pipeline::PassOutcome{};
-                      });
-        const auto slotGpu = pipeline::Compose::indirectIrradianceGpuSlot(w, h);
-        graph.addPass({.name = "indirect_gpu_slot", .reads = {onGpu}, .writes = {slotGpu}},
-                      [onGpu, slotGpu](pipeline::PassContext& ctx) {
-                          ctx.write(slotGpu) = ctx.read(onGpu);
-                          return pipeline::PassOutcome{};
-                      });
-        // No cone sky on this path yet: the lit frame takes the lobes, and the row says why.
-        const auto coneSkyGpu = pipeline::Compose::coneSkyGpuSlot(w, h);
-        graph.addPass({.name = "voxel_cone_sky", .reads = {onGpu}, .writes = {coneSkyGpu}},
-                      [this, coneSkyGpu](pipeline::PassContext& ctx) {
-                          ctx.write(coneSkyGpu) = nullptr;
-                          mRow->set("voxel_cone_sky.none",
-                                    "the resident Vulkan gather traces no cone sky yet (device: cpu does)");
-                          return pipeline::PassOutcome{};
-                      });
-    }
 
     void addPasses(experiment::RunSetup& setup)
     {
@@ -387,8 +288,14 @@ private:
         const auto slot = pipeline::Compose::indirectIrradianceSlot(w, h);
         const auto coneSky = pipeline::Compose::coneSkySlot(w, h);
         if (resident)
-            addResidentGather(graph, start, voxelLight, indirect, hasCones ? &conesGpu : nullptr,
-                              hasCapsules ? &capsules : nullptr);
+            voxelgi::addResidentGather(graph, start,
+                                       {.voxelLight = voxelLight,
+                                        .indirect = indirect,
+                                        .coneVisibility = hasCones ? std::optional(conesGpu) : std::nullopt,
+                                        .capsules = hasCapsules ? std::optional(capsules) : std::nullopt},
+                                       {.width = w, .height = h, .technique = mTechnique.get(),
+                                        .techniqueName = mTechniqueName, .gpu = &mContext.getGpu(),
+                                        .resident = &mResidentRow, .row = &mRow});
         else {
             graph.addPass(
                 {.name = "voxel_gather",
