@@ -255,7 +255,8 @@ void ConeCombineGpu::runCombine(gpu::Context& context, const gpu::ComputePipelin
 }
 
 const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
-                                                  int factor, const ResidentCombineInputs& in)
+                                                  int factor, const ResidentCombineInputs& in,
+                                                  const gpu::Buffer* cones)
 {
     if (in.gbuffer == nullptr || in.gbuffer->positionDepth == nullptr || in.gbuffer->normal == nullptr)
         throw Error("cone combine: the resident combine needs the G-buffer's GPU images");
@@ -293,7 +294,7 @@ const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const P
         return useVisibility ? *in.visibility[k] : mNoVisibility;
     };
     const std::vector<gpu::Binding> bindings = {
-        gpu::Binding::storageBuffer(0, dispatch.getOutput()),
+        gpu::Binding::storageBuffer(0, cones != nullptr ? *cones : dispatch.getOutput()),
         gpu::Binding::storageBuffer(1, dispatch.getRepresentative()),
         gpu::Binding::storageImage(2, *g.positionDepth),
         gpu::Binding::storageImage(3, *g.normal),
@@ -386,7 +387,7 @@ const gpu::Image& gatherConesResident(
     double coneHalfAngle, const std::array<const gpu::Image*, 4>& visibility,
     const std::vector<scene::PosedCapsule>* capsules,
     const std::function<const PixelConeDispatch&(const PixelSource&)>& traceCones, double* combineMs,
-    CapsuleResolution capsuleResolution)
+    CapsuleResolution capsuleResolution, ConeCombineGpu* skyCombiner)
 {
     PixelSource source;
     source.gpu = &gbuffer;
@@ -400,6 +401,8 @@ const gpu::Image& gatherConesResident(
     in.coneHalfAngle = coneHalfAngle;
     in.capsuleResolution = capsuleResolution;
     const gpu::Image& out = combiner.combineResident(context, dispatch, traceStep, in);
+    if (skyCombiner != nullptr)
+        skyCombiner->combineResident(context, dispatch, traceStep, in, &dispatch.getSkyOutput());
     if (combineMs != nullptr)
         *combineMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tracedAt).count();
     return out;

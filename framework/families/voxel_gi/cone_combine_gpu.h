@@ -48,9 +48,11 @@ public:
     //! (PixelConeDispatch::preparePixels with the G-buffer's GPU images; its output and
     //! representatives are read where they are), the G-buffer and the visibilities read from
     //! their images, the irradiance written to an RGBA32Float image of the G-buffer's size that
-    //! this object owns (valid until the next call). Only the capsules go up.
+    //! this object owns (valid until the next call). Only the capsules go up. `cones`, when
+    //! given, is read instead of the dispatch's output (its cones' sky, laid out the same way).
     const gpu::Image& combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
-                                      int factor, const ResidentCombineInputs& in);
+                                      int factor, const ResidentCombineInputs& in,
+                                      const gpu::Buffer* cones = nullptr);
     //! The image of the last combineResident on the CPU. Throws rtlab::Error before one.
     Image<glm::vec3> readBackResident() const;
     //! The image of the last combineResident, or null.
@@ -98,13 +100,15 @@ private:
 //! `source` (the G-buffer's GPU images, reduced by `traceStep` on the device) in its
 //! PixelConeDispatch, runs its cones without reading back and returns the dispatch; the combine
 //! then reads them there and writes the irradiance into `combiner`'s image, which is returned.
-//! `combineMs`, when given, receives the combine's wall time.
+//! `combineMs`, when given, receives the combine's wall time. With `skyCombiner` the dispatch's
+//! cones' sky (PixelConeDispatch::getSkyOutput) is combined the same way into its image.
 const gpu::Image& gatherConesResident(
     gpu::Context& context, ConeCombineGpu& combiner, const plugin::VoxelGiGpuGBuffer& gbuffer,
     int traceStep, double coneHalfAngle, const std::array<const gpu::Image*, 4>& visibility,
     const std::vector<scene::PosedCapsule>* capsules,
     const std::function<const PixelConeDispatch&(const PixelSource&)>& traceCones,
-    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full);
+    double* combineMs = nullptr, CapsuleResolution capsuleResolution = CapsuleResolution::Full,
+    ConeCombineGpu* skyCombiner = nullptr);
 
 //! Where a gather's combine runs for `setting` "vulkan", "cpu" or "auto" (without a device, in
 //! C++). "auto": on Vulkan when the cones were traced there and the device is a GPU; in C++ when

@@ -35,24 +35,51 @@ glm::ivec2 PixelSource::getSize() const
 
 void PixelConeDispatch::create(gpu::Context& context, const std::filesystem::path& shader,
                                const std::string& label, std::size_t pushConstantSize, const ConeSet& cones,
-                               std::uint32_t extraBuffers)
+                               std::uint32_t extraBuffers, bool coneSky)
 {
     *this = PixelConeDispatch();
     mContext = &context;
     mLabel = label;
-    const gpu::ShaderCompiler compiler;
+    const gpu::ShaderCompiler compiler({.includeDirs = {ConeCombineGpu::getShaderDir()}});
     gpu::ComputePipelineDesc desc;
     desc.name = label;
     desc.spirv = compiler.compileFile(shader).spirv;
-    for (std::uint32_t b = 0; b < 6 + extraBuffers; ++b)
+    mSkyBinding = coneSky ? 6 + extraBuffers : 0;
+    for (std::uint32_t b = 0; b < 6 + extraBuffers + (coneSky ? 1 : 0); ++b)
         desc.bindings.push_back({b, gpu::BindingType::StorageBuffer});
     desc.pushConstantSize = std::uint32_t(pushConstantSize);
     mPipeline = context.createPipeline(desc);
-    std::vector<glm::vec4> directions(kConeCount);
+    // The directions, then the sky per cone (none until setSkyPerCone).
+    std::vector<glm::vec4> entries(2 * kConeCount, glm::vec4(0.0f));
     for (int k = 0; k < kConeCount; ++k)
-        directions[std::size_t(k)] = glm::vec4(glm::vec3(cones.directions[std::size_t(k)]), 0.0f);
-    mCones = makeBuffer(directions.size() * sizeof(glm::vec4), "cone_gather.cones");
-    mCones.uploadSpan<glm::vec4>(directions);
+        entries[std::size_t(k)] = glm::vec4(glm::vec3(cones.directions[std::size_t(k)]), 0.0f);
+    mCones = makeBuffer(entries.size() * sizeof(glm::vec4), "cone_gather.cones");
+    mCones.uploadSpan<glm::vec4>(entries);
+}
+
+std::size_t PixelConeDispatch::setSkyPerCone(const std::array<glm::vec3, kConeCount>& sky)
+{
+    if (mSkyBinding == 0)
+        throw Error("cone gather: the pipeline '" + mLabel + "' traces no cones' sky");
+    if (sky == mSkyPerCone)
+        return 0;
+    std::vector<glm::vec4> entries(kConeCount);
+    for (int k = 0; k < kConeCount; ++k)
+        entries[std::size_t(k)] = glm::vec4(sky[std::size_t(k)], 0.0f);
+    mCones.uploadSpan<glm::vec4>(entries, kConeCount * sizeof(glm::vec4));
+    mSkyPerCone = sky;
+    return entries.size() * sizeof(glm::vec4);
+}
+
+void PixelConeDispatch::readBackSky(std::vector<glm::vec3>& out) const
+{
+    const Starts& starts = mOnDevice ? mDevicePixels : mPixels;
+    if (mSkyBinding == 0 || !starts.skyOutput.isValid())
+        throw Error("cone gather: the pipeline '" + mLabel + "' traced no cones' sky to read back");
+    const std::vector<glm::vec4> e = starts.skyOutput.downloadVector<glm::vec4>(starts.count * kConeCount);
+    out.resize(e.size());
+    for (std::size_t i = 0; i < e.size(); ++i)
+        out[i] = glm::vec3(e[i]);
 }
 
 gpu::Buffer PixelConeDispatch::makeBuffer(std::size_t bytes, const char* name, bool hostVisible)
@@ -71,6 +98,8 @@ void PixelConeDispatch::reserve(Starts& starts, std::size_t entries, const char*
             makeBuffer(entries * sizeof(glm::vec4), (name + ".positions").c_str(), hostVisible);
         starts.normals = makeBuffer(entries * sizeof(glm::vec4), (name + ".normals").c_str(), hostVisible);
         starts.output = makeBuffer(entries * kConeCount * sizeof(glm::vec4), (name + ".cone_radiance").c_str());
+        if (mSkyBinding != 0)
+            starts.skyOutput = makeBuffer(entries * kConeCount * sizeof(glm::vec4), (name + ".cone_sky").c_str());
         if (!hostVisible)
             starts.representative = makeBuffer(entries * sizeof(int), (name + ".representative").c_str());
         starts.capacity = entries;
@@ -183,6 +212,12 @@ std::vector<gpu::Binding> PixelConeDispatch::bindStarts(const Starts& starts, gp
         gpu::Binding::storageBuffer(4, starts.output),    gpu::Binding::storageBuffer(5, mCones)};
     for (std::size_t i = 0; i < extra.size(); ++i)
         bindings.push_back(gpu::Binding::storageBuffer(std::uint32_t(6 + i), *extra[i]));
+    if (mSkyBinding != 0) {
+        if (extra.size() + 6 != mSkyBinding)
+            throw Error("cone gather: the pipeline '" + mLabel + "' was created with " +
+                        std::to_string(mSkyBinding - 6) + " extra buffers, given " + std::to_string(extra.size()));
+        bindings.push_back(gpu::Binding::storageBuffer(mSkyBinding, starts.skyOutput));
+    }
     return bindings;
 }
 
@@ -229,6 +264,8 @@ void PixelConeDispatch::runWithoutCones()
         if (mOnDevice)
             recordReduce(cmd);
         cmd.fillBuffer(starts.output, 0u);
+        if (starts.skyOutput.isValid())
+            cmd.fillBuffer(starts.skyOutput, 0u);
     });
 }
 
@@ -267,6 +304,27 @@ std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& se
             (*out)[i] = glm::vec3(e[i]);
     }
     return result.sumGpuMs(mLabel);
+}
+
+glm::vec4 makeConeSkyConstants(bool traced, double skyStartDistance, bool opticalDepth, bool emission)
+{
+    return {traced ? 1.0f : 0.0f, float(skyStartDistance), opticalDepth ? 1.0f : 0.0f,
+            traced && emission ? 1.0f : 0.0f};
+}
+
+std::size_t uploadFaceEmission(PixelConeDispatch& dispatch, gpu::Buffer& buffer,
+                               const std::vector<glm::vec3>& emission, const char* name)
+{
+    const std::size_t bytes = emission.size() * sizeof(glm::vec4);
+    if (!buffer.isValid() || buffer.getSize() < bytes)
+        buffer = dispatch.makeBuffer(bytes, name);
+    if (emission.empty())
+        return 0;
+    std::vector<glm::vec4> packed(emission.size());
+    for (std::size_t i = 0; i < emission.size(); ++i)
+        packed[i] = glm::vec4(emission[i], 0.0f);
+    buffer.uploadSpan<glm::vec4>(packed);
+    return bytes;
 }
 
 } // namespace rtlab::voxelgi

@@ -3,7 +3,8 @@
 // G-buffer (cascades, svo): a compute pipeline whose bindings are 0 and 1 the structure's two
 // buffers, 2 the pixels' positions (relative to an anchor, w = 1 for a surface), 3 their normals,
 // 4 the output [pixel * 16 + cone], 5 the 16 cone directions, and from 6 on the structure's extra
-// buffers, if any; the per-pixel buffers, the dispatch, and the read-back of the cone radiances.
+// buffers, if any, then (for a gather that traces the cones' sky) the sky output; the per-pixel
+// buffers, the dispatch, and the read-back of the cone radiances.
 // The pixels come from the CPU G-buffer (uploaded), or from the G-buffer's GPU images reduced on
 // the device in the same submission as the cones (shaders/gbuffer_reduce.comp): nothing crosses
 // the bus then.
@@ -43,9 +44,22 @@ public:
     //! True when the pipeline exists for `context` (else call create first).
     bool isReadyFor(const gpu::Context& context) const { return mContext == &context && mPipeline.isValid(); }
     //! Compiles `shader` into the pipeline `label` (with `extraBuffers` storage buffers at
-    //! bindings 6, 7, ...) and uploads the cone directions.
+    //! bindings 6, 7, ...) and uploads the cone directions. With `coneSky` the shader also writes
+    //! the sky and emitters each cone sees past the voxels (cone_tracing.h
+    //! computeConeSkyRadiance) at binding 6 + extraBuffers, [pixel * 16 + cone] (getSkyOutput),
+    //! and reads the sky radiance of cone k at entry 16 + k of the cone buffer (setSkyPerCone).
+    //! Shaders may #include <cone_march.glsl> (families/voxel_gi/shaders).
     void create(gpu::Context& context, const std::filesystem::path& shader, const std::string& label,
-                std::size_t pushConstantSize, const ConeSet& cones, std::uint32_t extraBuffers = 0);
+                std::size_t pushConstantSize, const ConeSet& cones, std::uint32_t extraBuffers = 0,
+                bool coneSky = false);
+    //! The mean sky radiance of each cone (computeSkyPerCone) where a `coneSky` shader reads it,
+    //! uploaded when it changed; returns the bytes uploaded.
+    std::size_t setSkyPerCone(const std::array<glm::vec3, kConeCount>& sky);
+    //! The cones' sky of the last run over pixels of a `coneSky` pipeline whose shader traced it,
+    //! [pixel * 16 + cone] as vec4.
+    const gpu::Buffer& getSkyOutput() const { return (mOnDevice ? mDevicePixels : mPixels).skyOutput; }
+    //! That buffer on the CPU (one row of 16 per pixel).
+    void readBackSky(std::vector<glm::vec3>& out) const;
     //! Uploads the pixels' positions relative to `anchor` and their normals; returns the bytes.
     std::size_t uploadPixels(const scene::GBuffer& gbuffer, const glm::dvec3& anchor);
     //! uploadPixels for a CPU source; for a GPU one, the reduction is recorded before the next
@@ -109,10 +123,13 @@ private:
     gpu::Context* mContext = nullptr;
     gpu::ComputePipeline mPipeline;
     std::string mLabel;
-    gpu::Buffer mCones;
+    gpu::Buffer mCones; //!< [k] directions, [16 + k] the sky per cone (coneSky)
+    std::array<glm::vec3, kConeCount> mSkyPerCone{};
+    std::uint32_t mSkyBinding = 0; //!< 0: the pipeline writes no cones' sky
     // What the cones start from: the pixels, or points.
     struct Starts {
         gpu::Buffer positions, normals, output;
+        gpu::Buffer skyOutput; //!< with mSkyBinding
         gpu::Buffer representative; //!< mDevicePixels only
         int width = 0, height = 0;
         std::size_t count = 0;    //!< entries read back
@@ -134,5 +151,16 @@ private:
     void recordCones(gpu::CommandList& cmd, const std::vector<gpu::Binding>& bindings,
                      const gpu::PushConstants& constants, const Starts& starts) const;
 };
+
+//! The push constant of a gather that traces the cones' sky (cone_march.glsl, the shader's `sky`):
+//! x 1 when traced, y the distance from which the voxels hide the sky (world units), z 1 for the
+//! sky's transmittance in optical depth, w 1 when an emission buffer is bound.
+glm::vec4 makeConeSkyConstants(bool traced, double skyStartDistance, bool opticalDepth, bool emission);
+
+//! Uploads a sparse structure's emission ([element * 6 + face], premultiplied; empty when nothing
+//! emits) into `buffer` as vec4 (grown as needed; 16 bytes when empty), for a gather that
+//! traces the cones' sky; returns the bytes uploaded.
+std::size_t uploadFaceEmission(PixelConeDispatch& dispatch, gpu::Buffer& buffer,
+                               const std::vector<glm::vec3>& emission, const char* name);
 
 } // namespace rtlab::voxelgi

@@ -26,10 +26,11 @@ void addResidentGather(pipeline::FrameGraph& graph, pipeline::FrameStart& start,
     const auto posed = resources.capsules;
     graph.addPass(
         {.name = "voxel_gather",
-         .reads = {resources.voxelLight, gbufferGpu, positionGpu, normalGpu},
+         .reads = {resources.voxelLight, gbufferGpu, positionGpu, normalGpu, resources.geometry},
          .optionalReads = optional,
          .writes = {onGpu}},
-        [s, gbufferGpu, positionGpu, normalGpu, cones, posed, onGpu, w, h](pipeline::PassContext& ctx) {
+        [s, gbufferGpu, positionGpu, normalGpu, cones, posed, onGpu, w, h,
+         geometry = resources.geometry](pipeline::PassContext& ctx) {
             const pipeline::GpuGBuffer& g = ctx.read(gbufferGpu);
             plugin::VoxelGiGpuGBuffer images;
             images.positionDepth = &ctx.read(positionGpu);
@@ -46,6 +47,8 @@ void addResidentGather(pipeline::FrameGraph& graph, pipeline::FrameStart& start,
             if (const auto* v = cones ? ctx.tryRead(*cones) : nullptr)
                 input.gpuConeVisibility = *v;
             input.readBack = false;
+            input.scene = &ctx.read(geometry);
+            input.coneSky = s.coneSky;
             Image<glm::vec3> unused;
             s.technique->gather(input, unused);
             const gpu::Image* image = s.technique->getGpuIrradiance();
@@ -84,13 +87,39 @@ void addResidentGather(pipeline::FrameGraph& graph, pipeline::FrameStart& start,
                       ctx.write(slotGpu) = ctx.read(onGpu);
                       return pipeline::PassOutcome{};
                   });
-    // No cone sky on this path yet: the lit frame takes the lobes, and the row says why.
+    // The cones' sky where the technique left it (checked as the irradiance is), else a null
+    // slot: the lit frame then takes the lobes, and the row says why.
     const auto coneSkyGpu = pipeline::Compose::coneSkyGpuSlot(w, h);
     graph.addPass({.name = "voxel_cone_sky", .reads = {onGpu}, .writes = {coneSkyGpu}},
-                  [s, coneSkyGpu](pipeline::PassContext& ctx) {
-                      ctx.write(coneSkyGpu) = nullptr;
-                      (*s.row)->set("voxel_cone_sky.none",
-                                    "the resident Vulkan gather traces no cone sky yet (device: cpu does)");
+                  [s, coneSkyGpu, w, h](pipeline::PassContext& ctx) {
+                      const gpu::Image* image = s.technique->getGpuConeSky();
+                      if (image == nullptr) {
+                          ctx.write(coneSkyGpu) = nullptr;
+                          (*s.row)->set("voxel_cone_sky.none",
+                                        "technique '" + s.techniqueName +
+                                            "' traced no cone sky in its resident Vulkan gather");
+                          return pipeline::PassOutcome{};
+                      }
+                      const gpu::ImageDesc& d = image->getDesc();
+                      if (int(d.width) != w || int(d.height) != h || d.format != gpu::Format::RGBA32Float)
+                          throw Error("technique '" + s.techniqueName + "' left a " + std::to_string(d.width) +
+                                      "x" + std::to_string(d.height) + " " +
+                                      std::string(gpu::getFormatName(d.format)) +
+                                      " cone sky image on the GPU where the lighting pass binds an "
+                                      "RGBA32Float image of the G-buffer's size (" +
+                                      std::to_string(w) + "x" + std::to_string(h) + ")");
+                      ctx.write(coneSkyGpu) = image;
+                      return pipeline::PassOutcome{};
+                  });
+    graph.addPass({.name = "voxel_cone_sky_readback",
+                   .reads = {coneSkyGpu},
+                   .writes = {resources.coneSky},
+                   .forReaders = true},
+                  [s, coneSkyGpu, coneSky = resources.coneSky](pipeline::PassContext& ctx) {
+                      Image<glm::vec3>& out = ctx.write(coneSky);
+                      out = Image<glm::vec3>();
+                      if (ctx.read(coneSkyGpu) != nullptr)
+                          s.technique->readBackConeSky(out);
                       return pipeline::PassOutcome{};
                   });
 }

@@ -8,7 +8,10 @@
 //                          GPU slot; its irradiance image checked (RGBA32Float, the G-buffer's size)
 //   voxel_gather_readback  that image to the CPU, only for passes that read it there (metrics)
 //   indirect_gpu_slot      the image in the lit frame's GPU slot (no upload)
-//   voxel_cone_sky         a null cone-sky slot and the reason (no Vulkan gather traces it yet)
+//   voxel_cone_sky         the technique's cones' sky image (VoxelGiTechnique::getGpuConeSky) in
+//                          the lit frame's GPU slot, or a null slot and the reason
+//   voxel_cone_sky_readback  that image to the CPU, only for passes that read it there (the
+//                          error split of the cones' sky)
 
 #include "core/image.h"
 #include "experiment/results.h"
@@ -28,6 +31,9 @@ namespace rtlab::voxelgi {
 struct ResidentGatherResources {
     pipeline::Resource<int> voxelLight;               //!< the technique's light is up to date
     pipeline::Resource<Image<glm::vec3>> indirect;    //!< the CPU irradiance the read-back writes
+    //! The frame's triangles, lights and sky (the sky of the cones' sky).
+    pipeline::Resource<scene::RenderScene> geometry;
+    pipeline::Resource<Image<glm::vec3>> coneSky; //!< the CPU cones' sky the read-back writes
     //! The occlusion family's GPU cone visibilities (pipeline/compose.h), when a family gives them.
     std::optional<pipeline::Resource<std::array<const gpu::Image*, 4>>> coneVisibility;
     std::optional<pipeline::Resource<std::vector<scene::PosedCapsule>>> capsules;
@@ -39,13 +45,14 @@ struct ResidentGatherSettings {
     plugin::VoxelGiTechnique* technique = nullptr;
     std::string techniqueName;
     gpu::Context* gpu = nullptr;
+    bool coneSky = false; //!< the lit frame takes its sky through the cones
     //! The row's `voxel_gather.resident` ("yes"), kept by the family.
     const std::string* resident = nullptr;
     //! Where the current frame's row is (the family's pointer, set every frame).
     experiment::ResultRow* const* row = nullptr;
 };
 
-//! Adds the four passes above to `graph`.
+//! Adds the passes above to `graph`.
 void addResidentGather(pipeline::FrameGraph& graph, pipeline::FrameStart& start,
                        const ResidentGatherResources& resources, const ResidentGatherSettings& settings);
 

@@ -9,8 +9,11 @@
 // Structure: injectLight(scene), getCones(), gatherCones(gbuffer, out), gatherRays(gbuffer, rays,
 // out), getLeaves(), getLeafSize(), getMeanStepsPerCone(), getTopologyBytes(), getPayloadBytes().
 // Gpu: gatherCones(context, structure, gbuffer, out), gatherConesOnDevice(context, structure,
-// gbuffer), getLastGpuMs(), getLastUploadBytes(). On a GPU the cones stay on the device and the
-// combine runs there too (cone_combine_gpu.h shouldCombineOnGpu).
+// gbuffer), gatherConesResident(context, structure, pixels), setConeSky(skyPerCone),
+// readBackSky(out), getLastGpuMs(), getLastUploadBytes(). On a GPU the cones stay on the device and the
+// combine runs there too (cone_combine_gpu.h shouldCombineOnGpu). Asked for the cones' sky
+// (VoxelGiInput::coneSky), every path traces it with the light: in C++, on Vulkan and read back
+// for combineConeSky, or resident, combined on the device (getGpuConeSky).
 
 #include "families/voxel_gi/cone_combine_gpu.h"
 #include "families/voxel_gi/sparse_cone_params.h"
@@ -18,6 +21,7 @@
 #include "families/voxel_gi/voxel_gi.h"
 #include "core/error.h"
 
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -83,27 +87,48 @@ public:
         irradiance = mCombineGpu.readBackResident();
     }
 
+    const gpu::Image* getGpuConeSky() const override
+    {
+        return mSkyOnGpu ? mSkyCombineGpu.getResidentOutput() : nullptr;
+    }
+
+    void readBackConeSky(Image<glm::vec3>& irradiance) override
+    {
+        if (!mSkyOnGpu)
+            throw Error("the last gather traced no cone sky on the GPU");
+        irradiance = mSkyCombineGpu.readBackResident();
+    }
+
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
         mSky.cones.clear();
+        mSkyOnGpu = false;
+        // The cones' sky and emitters, traced with the light when the frame asks for them.
+        std::optional<std::array<glm::vec3, kConeCount>> skyPerCone;
+        if (input.coneSky && input.scene != nullptr)
+            skyPerCone = computeSkyPerCone(input.scene->sky, mStructure->getCones());
         if (input.gpuGBuffer != nullptr) {
             // Resident: the pixels reduced on the device, their cones and the combine there.
             if (input.gpu == nullptr || !whyNotGatheredOnGpu(*input.gpu).empty())
                 throw Error("the G-buffer was given on the GPU to a gather that does not run there");
             mGatheredOnGpu = mCombinedOnGpu = true;
+            mGpu.setConeSky(skyPerCone);
             gatherConesResident(
                 *input.gpu, mCombineGpu, *input.gpuGBuffer, mParams.traceStep,
                 mStructure->getCones().halfAngle, input.gpuConeVisibility, input.capsules,
                 [&](const PixelSource& pixels) -> const PixelConeDispatch& {
                     return mGpu.gatherConesResident(*input.gpu, *mStructure, pixels);
                 },
-                &mCombineMs, mParams.capsules);
+                &mCombineMs, mParams.capsules, skyPerCone ? &mSkyCombineGpu : nullptr);
+            mSkyOnGpu = skyPerCone.has_value();
             if (input.readBack)
                 readBackIrradiance(irradiance);
             return;
         }
         mGatheredOnGpu = shouldGatherOnGpu(input.gpu, mParams.device);
         mCombinedOnGpu = shouldCombineOnGpu(input.gpu, mGatheredOnGpu);
+        if (mGatheredOnGpu)
+            mGpu.setConeSky(skyPerCone);
         if (mCombinedOnGpu) {
             irradiance = gatherConesReducedOnGpu(
                 *input.gpu, mCombineGpu, *input.gbuffer, mParams.traceStep,
@@ -112,11 +137,17 @@ public:
                     return mGpu.gatherConesOnDevice(*input.gpu, *mStructure, reduced);
                 },
                 &mCombineMs, mParams.capsules);
+            if (skyPerCone) {
+                // The cones' sky comes to the CPU for combineConeSky (this path's round trip).
+                mGpu.readBackSky(mSky.cones);
+                keepConeSky(mSky, *input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
+                            input.capsules, mParams.capsules);
+            }
             return;
         }
         ConeSkyOutput sky;
-        if (input.coneSky && input.scene != nullptr)
-            sky.skyPerCone = computeSkyPerCone(input.scene->sky, mStructure->getCones());
+        if (skyPerCone)
+            sky.skyPerCone = *skyPerCone;
         irradiance = gatherConesReduced(
             *input.gbuffer, mParams.traceStep, mStructure->getCones().halfAngle,
             input.coneVisibility, input.capsules,
@@ -124,9 +155,11 @@ public:
                 std::vector<glm::vec3>* skyCones) {
                 if (mGatheredOnGpu) {
                     mGpu.gatherCones(*input.gpu, *mStructure, reduced, cones);
+                    if (skyPerCone && skyCones != nullptr)
+                        mGpu.readBackSky(*skyCones);
                 } else {
                     sky.out = skyCones;
-                    mStructure->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
+                    mStructure->gatherCones(reduced, cones, skyPerCone ? &sky : nullptr);
                 }
             },
             &mCombineMs, mParams.capsules, &mSky);
@@ -134,8 +167,6 @@ public:
 
     std::string combineConeSky(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
-        if (mGatheredOnGpu)
-            return "the Vulkan gather traces no cone sky yet (device: cpu does)";
         if (!mSky.isValid())
             return "the last gather traced no cone sky";
         irradiance = voxelgi::combineConeSky(mSky, *input.gbuffer, mStructure->getCones().halfAngle,
@@ -200,7 +231,9 @@ protected:
 private:
     Gpu mGpu;
     ConeCombineGpu mCombineGpu;
-    ConeSkyTrace mSky; // the last C++ gather's cone sky, for combineConeSky
+    ConeCombineGpu mSkyCombineGpu; // the resident gather's cones' sky
+    bool mSkyOnGpu = false;        // the last gather left its cones' sky in mSkyCombineGpu
+    ConeSkyTrace mSky; // the last gather's cones' sky on the CPU, for combineConeSky
     std::string mGeometryKey, mLightsKey;
     bool mBuilt = false;
     bool mGatheredOnGpu = false;

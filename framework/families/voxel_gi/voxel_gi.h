@@ -163,6 +163,15 @@ public:
     {
         return "the technique traces no cones toward the sky";
     }
+    //! The cones' sky (as combineConeSky) of the last gather() with VoxelGiInput::gpuGBuffer and
+    //! VoxelGiInput::coneSky: RGBA32Float (rgb), the G-buffer's size, owned by the technique and
+    //! valid until its next gather(); null when that gather traced none.
+    virtual const gpu::Image* getGpuConeSky() const { return nullptr; }
+    //! That image on the CPU. Throws rtlab::Error when there is none.
+    virtual void readBackConeSky(Image<glm::vec3>& /*irradiance*/)
+    {
+        throw Error("this voxel_gi technique keeps no cone sky on the GPU to read back");
+    }
     //! For the split of the error: the technique's own voxels and light buffers gathered along
     //! `raysPerPixel` rays per pixel (zero aperture, no 16-direction quadrature, the finest voxels
     //! available) instead of its cones, at the same points. Technique vs this is the cone error;

@@ -151,7 +151,6 @@ private:
     }
 
     std::string mResidentRow; //!< voxel_gather.resident: "yes", or "no: " and why
-    bool mResident = false;   //!< the gather runs resident (addResidentGather)
     //! Whether the run's lit frame takes its sky from the technique's cones.
     bool wantsConeSky() const { return mRun.lighting && mRun.sky != "lobes"; }
 
@@ -283,7 +282,7 @@ private:
             whyNotResident = why;
         else if (hasCones && !graph.declares(conesGpu.name))
             whyNotResident = "the occlusion technique's cone visibilities are on the CPU only";
-        const bool resident = mResident = whyNotResident.empty();
+        const bool resident = whyNotResident.empty();
         mResidentRow = resident ? "yes" : "no: " + whyNotResident;
         const auto slot = pipeline::Compose::indirectIrradianceSlot(w, h);
         const auto coneSky = pipeline::Compose::coneSkySlot(w, h);
@@ -291,11 +290,13 @@ private:
             voxelgi::addResidentGather(graph, start,
                                        {.voxelLight = voxelLight,
                                         .indirect = indirect,
+                                        .geometry = geometry,
+                                        .coneSky = coneSky,
                                         .coneVisibility = hasCones ? std::optional(conesGpu) : std::nullopt,
                                         .capsules = hasCapsules ? std::optional(capsules) : std::nullopt},
                                        {.width = w, .height = h, .technique = mTechnique.get(),
                                         .techniqueName = mTechniqueName, .gpu = &mContext.getGpu(),
-                                        .resident = &mResidentRow, .row = &mRow});
+                                        .coneSky = wantsConeSky(), .resident = &mResidentRow, .row = &mRow});
         else {
             graph.addPass(
                 {.name = "voxel_gather",
@@ -481,7 +482,7 @@ private:
                               .set("split.rays_per_pixel", std::int64_t(kSplitRays));
                           return pipeline::PassOutcome{};
                       });
-        if (wantsConeSky() && !mResident) { // the resident gather traces no cone sky yet
+        if (wantsConeSky()) {
             voxelgi::addConeSkySplit(graph,
                                      {.geometry = geometry, .gbuffer = gbuffer, .view = view,
                                       .voxelLight = voxelLight, .coneSky = coneSky},

@@ -8,6 +8,7 @@
 // differently), 99 % of the lit pixels within 1e-3, at most 1 % of the cones off by more than 1e-3.
 
 #include "families/voxel_gi/upsample.h"
+#include "families/voxel_gi/voxel_gi_test_scenes.h"
 
 #include <gtest/gtest.h>
 
@@ -59,6 +60,13 @@ inline void expectGpuConesMatchCpu(const std::vector<glm::vec3>& cpuCones,
     ASSERT_GT(lit, 100);
     EXPECT_LT(sum / lit, 1e-5);
     EXPECT_GE(within, int(0.99 * lit));
+}
+
+//! A glowing box on the open room's floor (makeOpenRoom): the emitter the cones' sky carries.
+inline void addFloorEmitter(scene::RenderScene& s, glm::vec3 offset)
+{
+    addBox(s, offset + glm::vec3(0.5f, -1.0f, -0.9f), offset + glm::vec3(0.9f, -0.6f, -0.5f),
+           addMaterial(s, glm::vec3(0.5f), glm::vec3(2.0f, 1.5f, 1.0f)));
 }
 
 } // namespace rtlab::voxelgi::testing

@@ -216,15 +216,17 @@ namespace {
 // lattice's centre in the shader), with the tolerance stated in voxel_gi_gpu_parity.h. Two root
 // cells along x, so that the dense first level is indexed too. Both ways of keeping the masks:
 // shared masks' records are bit fields that straddle 32-bit words.
-void compareGpu(glm::vec3 offset, int resolution, int depth, NodeMasks masks = NodeMasks::Shared)
+void compareGpu(glm::vec3 offset, int resolution, int depth, NodeMasks masks = NodeMasks::Shared,
+                bool skyOpticalDepth = false)
 {
-    const scene::RenderScene s = makeOpenRoom(offset);
+    scene::RenderScene s = makeOpenRoom(offset);
+    addFloorEmitter(s, offset);
     scene::Camera camera;
     camera.position = offset + glm::vec3(0.8f, 0.4f, 1.6f);
     camera.target = offset + glm::vec3(-0.5f, -0.7f, -0.5f);
     camera.nearPlane = 1e-3f;
     const scene::GBuffer g = reference::castGBuffer(s, camera, 48, 32);
-    VoxelTreeCones tree({.depth = depth, .supersampling = 2, .nodeMasks = masks});
+    VoxelTreeCones tree({.depth = depth, .supersampling = 2, .skyOpticalDepth = skyOpticalDepth, .nodeMasks = masks});
     glm::dvec3 origin;
     double leaf = 0.0;
     glm::ivec3 roots;
@@ -262,6 +264,18 @@ void compareGpu(glm::vec3 offset, int resolution, int depth, NodeMasks masks = N
     // A second call uploads only the pixels (the tree and its light are unchanged).
     gather.gatherCones(context, tree, g, gpuCones);
     EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
+    // The cones' sky and emitters, traced with the light: the same light, and the sky as the
+    // C++ march gives it.
+    ConeSkyOutput sky;
+    sky.skyPerCone = computeSkyPerCone(s.sky, tree.getCones());
+    std::vector<glm::vec3> cpuSky, gpuSky, gpuLight;
+    sky.out = &cpuSky;
+    tree.gatherCones(g, cpuCones, &sky);
+    gather.setConeSky(sky.skyPerCone);
+    gather.gatherCones(context, tree, g, gpuLight);
+    gather.readBackSky(gpuSky);
+    EXPECT_EQ(gpuLight, gpuCones);
+    expectGpuConesMatchCpu(cpuSky, gpuSky, g, tree.getCones().halfAngle);
 }
 
 } // namespace
@@ -313,6 +327,7 @@ TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesTheCppGather)
     compareGpu(glm::vec3(0.0f), 32, 2);
     compareGpu(glm::vec3(0.0f), 128, 3);
     compareGpu(glm::vec3(0.0f), 128, 3, NodeMasks::Inline);
+    compareGpu(glm::vec3(0.0f), 128, 3, NodeMasks::Shared, true); // the sky in optical depth
 }
 
 TEST(AdaptiveVoxelTreeConesGpu, VulkanGatherMatchesFarFromTheOrigin)

@@ -15,8 +15,9 @@ struct GatherConstants {
     glm::ivec4 roots{
         0}; // xyz: root cells per axis, w: the first node record's uint in the topology buffer
     glm::ivec4 masks{0}; // x: shared masks' record bits (0: inline), y: first base's uint, z: table's
+    glm::vec4 sky{0};    // makeConeSkyConstants
 };
-static_assert(sizeof(GatherConstants) == 80, "must match tree_cone_gather.comp");
+static_assert(sizeof(GatherConstants) == 96, "must match tree_cone_gather.comp");
 static_assert(sizeof(VoxelTreeNode) == 3 * sizeof(std::uint32_t), "the shader reads 3 uints per node");
 static_assert(AdaptiveVoxelTree::kOffsetBits == 12, "the shader splits a record word at bit 12");
 static_assert(sizeof(VoxelTreeRank) == 3 * sizeof(std::uint32_t),
@@ -64,12 +65,16 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
                               const PixelSource& pixels, std::vector<glm::vec3>* out)
 {
     if (!mDispatch.isReadyFor(context)) {
+        const auto sky = mSkyPerCone;
         *this = TreeConeGatherGpu();
+        mSkyPerCone = sky;
         mDispatch.create(context, getShaderDir() / "tree_cone_gather.comp", kDispatchLabel, sizeof(GatherConstants),
-                         tree.getCones());
+                         tree.getCones(), 1, true);
     }
     const AdaptiveVoxelTree* t = tree.getTree();
     const glm::ivec2 size = pixels.getSize();
+    mEmptyTree = t == nullptr;
+    mLastPixels = std::size_t(size.x) * std::size_t(size.y);
     if (t == nullptr) {
         if (out != nullptr)
             out->assign(std::size_t(size.x) * std::size_t(size.y) * kConeCount, glm::vec3(0.0f));
@@ -96,10 +101,15 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
         mNodes.uploadSpan<std::uint32_t>(topology);
         mGathered.uploadSpan<glm::vec4>(gathered);
         mLastUploadBytes += nodeBytes + gathered.size() * sizeof(glm::vec4);
+        mEmits = !tree.getEmission().empty();
+        mLastUploadBytes +=
+            uploadFaceEmission(mDispatch, mEmission, tree.getEmission(), "adaptive_voxel_tree_cones.emission");
         mUploadedStamp = tree.getStamp();
     }
     const glm::dvec3 anchor = tree.getOrigin() + 0.5 * tree.getBoxSize();
     mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
+    if (mSkyPerCone)
+        mLastUploadBytes += mDispatch.setSkyPerCone(*mSkyPerCone);
     const TreeConeSettings& s = tree.getSettings();
     GatherConstants constants;
     constants.size = {size.x, size.y, s.depth, 1024};
@@ -108,7 +118,17 @@ void TreeConeGatherGpu::trace(gpu::Context& context, const VoxelTreeCones& tree,
     constants.box = glm::vec4(glm::vec3(tree.getOrigin() - anchor), 0.0f);
     constants.roots = glm::ivec4(t->getLayout().rootCells, int(mRecordStart));
     constants.masks = mMasks;
-    mLastGpuMs = mDispatch.run(mNodes, mGathered, gpu::PushConstants(constants), out);
+    constants.sky = makeConeSkyConstants(mSkyPerCone.has_value(), s.skyStart * tree.getLeafSize(), s.skyOpticalDepth,
+                                         mEmits);
+    mLastGpuMs = mDispatch.run(mNodes, mGathered, gpu::PushConstants(constants), out, {&mEmission});
+}
+
+void TreeConeGatherGpu::readBackSky(std::vector<glm::vec3>& out) const
+{
+    if (mEmptyTree)
+        out.assign(mLastPixels * kConeCount, glm::vec3(0.0f));
+    else
+        mDispatch.readBackSky(out);
 }
 
 } // namespace rtlab::voxelgi

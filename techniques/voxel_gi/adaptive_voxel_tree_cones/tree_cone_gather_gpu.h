@@ -2,7 +2,8 @@
 // The pixel gather of the adaptive voxel tree on Vulkan (shaders/tree_cone_gather.comp): the
 // tree's topology (its rank words, then its node records: mask low, mask high, offset; 3 uints
 // each) and the gathered light of every element in two storage buffers, uploaded again only when
-// the tree or its light changed; positions go up relative to the lattice's centre.
+// the tree or its light changed; positions go up relative to the lattice's centre. Asked for the
+// cones' sky, the same dispatch also writes the sky and emitters each cone sees past the voxels.
 
 #include "voxel_tree_cones.h"
 
@@ -33,6 +34,12 @@ public:
     //! representatives.
     const PixelConeDispatch& gatherConesResident(gpu::Context& context, const VoxelTreeCones& tree,
                                                  const PixelSource& pixels);
+    //! Whether the following gathers also trace the sky and emitters each cone sees past the
+    //! voxels (the sky per cone, computeSkyPerCone), or not (nullopt).
+    void setConeSky(const std::optional<std::array<glm::vec3, kConeCount>>& skyPerCone) { mSkyPerCone = skyPerCone; }
+    //! The cones' sky of the last gather, which traced it, [pixel * 16 + cone] (zero for an
+    //! empty tree).
+    void readBackSky(std::vector<glm::vec3>& out) const;
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/adaptive_voxel_tree_cones/shaders when set, else the
@@ -44,7 +51,11 @@ private:
                std::vector<glm::vec3>* out);
 
     PixelConeDispatch mDispatch;
-    gpu::Buffer mNodes, mGathered;
+    gpu::Buffer mNodes, mGathered, mEmission;
+    bool mEmits = false;
+    bool mEmptyTree = false; //!< the last gather had no tree: no cones traced
+    std::size_t mLastPixels = 0;
+    std::optional<std::array<glm::vec3, kConeCount>> mSkyPerCone;
     gpu::Buffer mZeros; //!< the radiances of an empty tree, when kept on the device
     std::uint32_t mRecordStart = 0; //!< uint index of the first node record in mNodes
     glm::ivec4 mMasks{0};           //!< the shader's masks constant (shared masks: where they lie)

@@ -73,6 +73,9 @@ public:
     glm::dvec3 getOrigin() const { return mOrigin; }
     double getLeafSize() const { return mLeafSize; }
     glm::dvec3 getBoxSize() const { return mBoxSize; } //!< the lattice's extent
+    //! [element * 6 + face]: the emitted radiance premultiplied by the occupancy, for the pixels'
+    //! cones that meet emitters; empty when no leaf emits.
+    const std::vector<glm::vec3>& getEmission() const { return mPayload.fields[kEmission]; }
     std::uint64_t getStamp() const { return mStamp; }  //!< changes when the tree or its light change
     //! Filtered occupancy of `face` of element `element`.
     float getAlpha(std::size_t element, int face) const

@@ -138,6 +138,9 @@ public:
     //! With corner bricks: [(node * 6 + face) * 8 + corner], corner = x | y << 1 | z << 2, the
     //! gathered light and occupancy at the node's corners (empty without bricks).
     const std::vector<glm::vec4>& getGatheredBricks() const { return mGatheredBricks; }
+    //! [element * 6 + face]: the emitted radiance premultiplied by the occupancy, for the pixels'
+    //! cones that meet emitters; empty when no leaf emits.
+    const std::vector<glm::vec3>& getEmission() const { return mPayload.fields[kEmission]; }
     std::uint64_t getStamp() const { return mStamp; } //!< changes when the tree or its light change
 
     //! The node holding voxel `coord` of `level`, or -1 (OctreeTopology::find).

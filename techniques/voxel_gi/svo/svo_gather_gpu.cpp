@@ -15,8 +15,9 @@ struct GatherConstants {
     glm::vec4 march{0}; // leaf size, tan(half-angle), start offset, step scale
     glm::vec4 cube{0};  // min corner relative to the centre, side
     glm::ivec4 mode{0}; // x: 1 = corner bricks
+    glm::vec4 sky{0};   // makeConeSkyConstants
 };
-static_assert(sizeof(GatherConstants) == 64, "must match svo_gather.comp");
+static_assert(sizeof(GatherConstants) == 80, "must match svo_gather.comp");
 
 } // namespace
 
@@ -51,9 +52,11 @@ void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree
                             const PixelSource& pixels, std::vector<glm::vec3>* out)
 {
     if (!mDispatch.isReadyFor(context)) {
+        const auto sky = mSkyPerCone;
         *this = OctreeGatherGpu();
+        mSkyPerCone = sky;
         mDispatch.create(context, getShaderDir() / "svo_gather.comp", kDispatchLabel, sizeof(GatherConstants),
-                         tree.getCones());
+                         tree.getCones(), 1, true);
     }
     mLastUploadBytes = 0;
     if (mUploadedStamp != tree.getStamp()) {
@@ -68,12 +71,19 @@ void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree
         mChildren.uploadSpan<std::uint32_t>(children);
         mGathered.uploadSpan<glm::vec4>(gathered);
         mLastUploadBytes += children.size() * sizeof(std::uint32_t) + gathered.size() * sizeof(glm::vec4);
+        // The emitters the pixels' cones meet; the bricks hold none (sampleBrickLevel).
+        static const std::vector<glm::vec3> kNone;
+        const auto& emission = tree.getSettings().cornerBricks ? kNone : tree.getEmission();
+        mEmits = !emission.empty();
+        mLastUploadBytes += uploadFaceEmission(mDispatch, mEmission, emission, "svo.emission");
         mUploadedStamp = tree.getStamp();
     }
     const glm::dvec3 anchor = tree.getOrigin() + glm::dvec3(0.5 * tree.getSide());
     const glm::ivec2 size = pixels.getSize();
     const int w = size.x, h = size.y;
     mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
+    if (mSkyPerCone)
+        mLastUploadBytes += mDispatch.setSkyPerCone(*mSkyPerCone);
 
     const OctreeSettings& s = tree.getSettings();
     GatherConstants constants;
@@ -82,7 +92,9 @@ void OctreeGatherGpu::trace(gpu::Context& context, const SparseVoxelOctree& tree
                        float(s.startOffset), float(s.stepScale)};
     constants.cube = glm::vec4(glm::vec3(tree.getOrigin() - anchor), float(tree.getSide()));
     constants.mode = glm::ivec4(s.cornerBricks ? 1 : 0, 0, 0, 0);
-    mLastGpuMs = mDispatch.run(mChildren, mGathered, gpu::PushConstants(constants), out);
+    constants.sky = makeConeSkyConstants(mSkyPerCone.has_value(), s.skyStart * tree.getLeafSize(), s.skyOpticalDepth,
+                                         mEmits);
+    mLastGpuMs = mDispatch.run(mChildren, mGathered, gpu::PushConstants(constants), out, {&mEmission});
 }
 
 } // namespace rtlab::voxelgi

@@ -176,13 +176,15 @@ namespace {
 
 // The Vulkan gather against the C++ one on the same tree and G-buffer (positions relative to the
 // cube's centre in the shader), with the tolerance stated in voxel_gi_gpu_parity.h.
-void compareGpu(glm::vec3 offset, bool cornerBricks = false)
+void compareGpu(glm::vec3 offset, bool cornerBricks = false, bool skyOpticalDepth = false)
 {
-    const scene::RenderScene s = makeOpenRoom(offset);
+    scene::RenderScene s = makeOpenRoom(offset);
+    addFloorEmitter(s, offset);
     const scene::Camera camera =
         lookAt(offset + glm::vec3(0.8f, 0.4f, 1.6f), offset + glm::vec3(-0.5f, -0.7f, -0.5f));
     const scene::GBuffer g = reference::castGBuffer(s, camera, 48, 32);
-    SparseVoxelOctree tree({.resolution = 32, .supersampling = 2, .cornerBricks = cornerBricks});
+    SparseVoxelOctree tree(
+        {.resolution = 32, .supersampling = 2, .skyOpticalDepth = skyOpticalDepth, .cornerBricks = cornerBricks});
     glm::dvec3 origin;
     double side = 0.0;
     SparseVoxelOctree::computeCube(glm::dvec3(s.boundsMin), glm::dvec3(s.boundsMax), 32, origin, side);
@@ -197,6 +199,18 @@ void compareGpu(glm::vec3 offset, bool cornerBricks = false)
     // A second call uploads only the pixels (the tree and its light are unchanged).
     gather.gatherCones(context, tree, g, gpuCones);
     EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
+    // The cones' sky and emitters, traced with the light: the same light, and the sky as the
+    // C++ march gives it.
+    ConeSkyOutput sky;
+    sky.skyPerCone = computeSkyPerCone(s.sky, tree.getCones());
+    std::vector<glm::vec3> cpuSky, gpuSky, gpuLight;
+    sky.out = &cpuSky;
+    tree.gatherCones(g, cpuCones, &sky);
+    gather.setConeSky(sky.skyPerCone);
+    gather.gatherCones(context, tree, g, gpuLight);
+    gather.readBackSky(gpuSky);
+    EXPECT_EQ(gpuLight, gpuCones);
+    expectGpuConesMatchCpu(cpuSky, gpuSky, g, tree.getCones().halfAngle);
 }
 
 } // namespace
@@ -204,7 +218,8 @@ void compareGpu(glm::vec3 offset, bool cornerBricks = false)
 TEST(SvoGpu, VulkanGatherMatchesTheCppGather)
 {
     compareGpu(glm::vec3(0.0f));
-    compareGpu(glm::vec3(0.0f), true); // corner bricks
+    compareGpu(glm::vec3(0.0f), true);        // corner bricks
+    compareGpu(glm::vec3(0.0f), false, true); // the sky in optical depth
 }
 
 TEST(SvoGpu, VulkanGatherMatchesFarFromTheOrigin)

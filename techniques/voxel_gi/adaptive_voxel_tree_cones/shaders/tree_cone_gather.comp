@@ -25,7 +25,12 @@ layout(std430, binding = 1) readonly buffer GatheredBuffer { vec4 gathered[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
 layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
-layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
+// [k]: cone k's direction; [16 + k]: the mean sky radiance over its solid angle (pc.sky.x == 1).
+layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[32]; };
+// [element * 6 + face]: the emitted radiance premultiplied by the occupancy (pc.sky.w == 1).
+layout(std430, binding = 6) readonly buffer EmissionBuffer { vec4 emitted[]; };
+// [pixel][cone]: the sky and emitters the cone sees past the voxels (pc.sky.x == 1).
+layout(std430, binding = 7) writeonly buffer SkyOutputBuffer { vec4 coneSky[]; };
 
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, depth (levels below the roots), max steps
@@ -33,6 +38,7 @@ layout(push_constant) uniform Constants {
     vec4 box;    // xyz: min corner relative to the centre
     ivec4 roots; // xyz: root cells per axis, w: the first node record's uint in topology[]
     ivec4 masks; // x: shared masks' record bits (0: inline), y: first base's uint, z: table's first
+    vec4 sky;    // x: 1 = trace the sky, y: sky start (world units), z: 1 = optical depth, w: 1 = emission
 } pc;
 
 #include "tree_find.glsl"
@@ -42,7 +48,13 @@ int findElement(int level, ivec3 c)
     return findTreeElement(level, c, pc.roots, pc.masks);
 }
 
-vec4 sampleLevel(int level, vec3 p, vec3 dir)
+float opticalDepthOf(float a)
+{
+    return -log(1.0 - clamp(a, 0.0, 0.9999));
+}
+
+vec4 sampleLevel(int level, vec3 p, vec3 dir, bool wantsDepth, bool wantsEmission, inout vec3 emission,
+                 inout float depth)
 {
     const float size = pc.march.x * exp2(float(2 * (pc.size.z - level)));
     const vec3 c = (p - pc.box.xyz) / size - 0.5;
@@ -63,9 +75,17 @@ vec4 sampleLevel(int level, vec3 p, vec3 dir)
         if (e < 0)
             continue;
         const uint base = uint(e) * 6u;
-        acc += w * (axisWeight.x * gathered[base + uint(faceSeen.x)] +
-                    axisWeight.y * gathered[base + uint(faceSeen.y)] +
-                    axisWeight.z * gathered[base + uint(faceSeen.z)]);
+        const vec4 gx = gathered[base + uint(faceSeen.x)], gy = gathered[base + uint(faceSeen.y)],
+                   gz = gathered[base + uint(faceSeen.z)];
+        acc += w * (axisWeight.x * gx + axisWeight.y * gy + axisWeight.z * gz);
+        // The voxels' optical depths with the same weights (cone_tracing.h ConeSample::depth).
+        if (wantsDepth)
+            depth += w * (axisWeight.x * opticalDepthOf(gx.a) + axisWeight.y * opticalDepthOf(gy.a) +
+                          axisWeight.z * opticalDepthOf(gz.a));
+        if (wantsEmission)
+            emission += w * (axisWeight.x * emitted[base + uint(faceSeen.x)].rgb +
+                             axisWeight.y * emitted[base + uint(faceSeen.y)].rgb +
+                             axisWeight.z * emitted[base + uint(faceSeen.z)].rgb);
     }
     return acc;
 }
@@ -77,6 +97,34 @@ bool insideBox(vec3 p)
     return all(greaterThanEqual(rel, vec3(0.0))) && all(lessThanEqual(rel, vec3(1.0)));
 }
 
+// The sample of cone_march.glsl: trilinear at the two levels around the footprint (4x apart),
+// linear between them.
+bool sampleCone(vec3 q, float diameter, vec3 dir, bool wantsDepth, bool wantsEmission, out vec4 s,
+                out vec3 emission, out float depth, out float voxelSize)
+{
+    emission = vec3(0.0);
+    depth = 0.0;
+    if (!insideBox(q))
+        return false; // left the lattice: no light from beyond
+    const float leaf = pc.march.x;
+    const int levels = pc.size.z;
+    const float m = min(float(levels), diameter > leaf ? 0.5 * log2(diameter / leaf) : 0.0);
+    const int m0 = int(floor(m));
+    const float frac = m - float(m0);
+    wantsEmission = wantsEmission && pc.sky.w == 1.0;
+    vec3 e0 = vec3(0.0), e1 = vec3(0.0);
+    float d0 = 0.0, d1 = 0.0;
+    s = (1.0 - frac) * sampleLevel(levels - m0, q, dir, wantsDepth, wantsEmission, e0, d0);
+    if (frac > 0.0 && m0 < levels)
+        s += frac * sampleLevel(levels - m0 - 1, q, dir, wantsDepth, wantsEmission, e1, d1);
+    emission = (1.0 - frac) * e0 + frac * e1;
+    depth = (1.0 - frac) * d0 + frac * d1;
+    voxelSize = leaf * exp2(2.0 * m);
+    return true;
+}
+
+#include <cone_march.glsl>
+
 void main()
 {
     // One cone per invocation (z: the cone), so that a warp holds neighbouring pixels' cones of
@@ -86,43 +134,30 @@ void main()
     if (pixel.x >= pc.size.x || pixel.y >= pc.size.y || k >= 16)
         return;
     const int index = pixel.y * pc.size.x + pixel.x;
+    const bool sky = pc.sky.x == 1.0;
     coneRadiance[index * 16 + k] = vec4(0.0);
+    if (sky)
+        coneSky[index * 16 + k] = vec4(0.0);
     const vec4 position = positions[index];
     const vec3 n = normals[index].xyz;
     if (position.w == 0.0 || dot(n, n) < 0.5 || !insideBox(position.xyz))
         return;
     const float leaf = pc.march.x;
-    const int depth = pc.size.z;
-    const vec3 origin = position.xyz + n * (0.5 * pc.march.z * leaf);
-    const float startDistance = pc.march.z * leaf;
     if (dot(cones[k].xyz, n) <= 0.0)
         return;
-    const vec3 dir = cones[k].xyz;
-    float occupied = 0.0;
-    vec3 light = vec3(0.0);
-    float t = startDistance;
-    for (int step = 0; step < pc.size.w; ++step) {
-        const vec3 q = origin + t * dir;
-        if (!insideBox(q))
-            break; // left the lattice: no indirect light from beyond
-        const float diameter = 2.0 * t * pc.march.y;
-        const float m = min(float(depth), diameter > leaf ? 0.5 * log2(diameter / leaf) : 0.0);
-        const int m0 = int(floor(m));
-        const float frac = m - float(m0);
-        vec4 s = (1.0 - frac) * sampleLevel(depth - m0, q, dir);
-        if (frac > 0.0 && m0 < depth)
-            s += frac * sampleLevel(depth - m0 - 1, q, dir);
-        const float voxelSize = leaf * exp2(2.0 * m);
-        const float dt = pc.march.w * voxelSize;
-        const float a = clamp(s.a, 0.0, 1.0);
-        if (a > 0.0) {
-            const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
-            light += ((1.0 - occupied) * corrected / a) * s.rgb;
-            occupied += (1.0 - occupied) * corrected;
-            if (occupied >= 0.99)
-                break;
-        }
-        t += dt;
-    }
-    coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+    // Start a leaf out, along the normal and along the cone (VoxelTreeCones::preparePixel).
+    ConeMarch m;
+    m.t0 = pc.march.z * leaf;
+    m.tanHalfAngle = pc.march.y;
+    m.stepScale = pc.march.w;
+    m.maxSteps = pc.size.w;
+    m.sky = sky;
+    m.opticalDepth = pc.sky.z == 1.0;
+    m.skyStart = pc.sky.y;
+    m.planeNormal = n;
+    m.planeHeight = 0.5 * pc.march.z * leaf;
+    const ConeTrace r = marchCone(position.xyz + n * (0.5 * pc.march.z * leaf), cones[k].xyz, m);
+    coneRadiance[index * 16 + k] = vec4(max(r.light, vec3(0.0)), 1.0);
+    if (sky)
+        coneSky[index * 16 + k] = vec4(getConeSkyRadiance(r, cones[16 + k].rgb), 1.0);
 }

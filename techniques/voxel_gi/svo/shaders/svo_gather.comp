@@ -18,18 +18,37 @@ layout(std430, binding = 1) readonly buffer GatheredBuffer { vec4 gathered[]; };
 layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }; // w: 1 = surface
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
 layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
-layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
+// [k]: cone k's direction; [16 + k]: the mean sky radiance over its solid angle (pc.sky.x == 1).
+layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[32]; };
+// [node * 6 + face]: the emitted radiance premultiplied by the occupancy (pc.sky.w == 1).
+layout(std430, binding = 6) readonly buffer EmissionBuffer { vec4 emitted[]; };
+// [pixel][cone]: the sky and emitters the cone sees past the voxels (pc.sky.x == 1).
+layout(std430, binding = 7) writeonly buffer SkyOutputBuffer { vec4 coneSky[]; };
 
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, depth (levels below the root), max steps
     vec4 march;  // leaf size, tan(half-angle), start offset (leaves), step scale
     vec4 cube;   // xyz: min corner relative to the centre, w: side
     ivec4 mode;  // x: 1 = corner bricks
+    vec4 sky;    // x: 1 = trace the sky, y: sky start (world units), z: 1 = optical depth, w: 1 = emission
 } pc;
 
 #include "svo_find.glsl"
 
-vec4 sampleLevel(int level, vec3 p, vec3 dir)
+float opticalDepthOf(float a)
+{
+    return -log(1.0 - clamp(a, 0.0, 0.9999));
+}
+
+// The optical depth of the three faces seen, with the axes' weights (cone_tracing.h
+// ConeSample::depth).
+float faceDepth(vec3 axisWeight, vec4 x, vec4 y, vec4 z)
+{
+    return axisWeight.x * opticalDepthOf(x.a) + axisWeight.y * opticalDepthOf(y.a) + axisWeight.z * opticalDepthOf(z.a);
+}
+
+vec4 sampleLevel(int level, vec3 p, vec3 dir, bool wantsDepth, bool wantsEmission, inout vec3 emission,
+                 inout float depth)
 {
     const float size = pc.cube.w / float(1 << level);
     const vec3 c = (p - pc.cube.xyz) / size - 0.5;
@@ -50,15 +69,22 @@ vec4 sampleLevel(int level, vec3 p, vec3 dir)
         if (node < 0)
             continue;
         const uint base = uint(node) * 6u;
-        acc += w * (axisWeight.x * gathered[base + uint(faceSeen.x)] +
-                    axisWeight.y * gathered[base + uint(faceSeen.y)] +
-                    axisWeight.z * gathered[base + uint(faceSeen.z)]);
+        const vec4 gx = gathered[base + uint(faceSeen.x)], gy = gathered[base + uint(faceSeen.y)],
+                   gz = gathered[base + uint(faceSeen.z)];
+        acc += w * (axisWeight.x * gx + axisWeight.y * gy + axisWeight.z * gz);
+        if (wantsDepth)
+            depth += w * faceDepth(axisWeight, gx, gy, gz);
+        if (wantsEmission)
+            emission += w * (axisWeight.x * emitted[base + uint(faceSeen.x)].rgb +
+                             axisWeight.y * emitted[base + uint(faceSeen.y)].rgb +
+                             axisWeight.z * emitted[base + uint(faceSeen.z)].rgb);
     }
     return acc;
 }
 
 // Corner bricks: one descent to the node of `level` holding p, its brick blended trilinearly.
-vec4 sampleBrickLevel(int level, vec3 p, vec3 dir)
+// Emitters are not bricked (SparseVoxelOctree::sampleBrickLevel reads none either).
+vec4 sampleBrickLevel(int level, vec3 p, vec3 dir, bool wantsDepth, inout float depth)
 {
     const int cells = 1 << level;
     const vec3 q = (p - pc.cube.xyz) / pc.cube.w * float(cells);
@@ -75,16 +101,20 @@ vec4 sampleBrickLevel(int level, vec3 p, vec3 dir)
         const vec3 w3 = mix(vec3(1.0) - t, t, vec3(d));
         const float w = w3.x * w3.y * w3.z;
         const uint base = uint(node) * 48u + uint(corner);
-        acc += w * (axisWeight.x * gathered[base + 8u * uint(faceSeen.x)] +
-                    axisWeight.y * gathered[base + 8u * uint(faceSeen.y)] +
-                    axisWeight.z * gathered[base + 8u * uint(faceSeen.z)]);
+        const vec4 gx = gathered[base + 8u * uint(faceSeen.x)], gy = gathered[base + 8u * uint(faceSeen.y)],
+                   gz = gathered[base + 8u * uint(faceSeen.z)];
+        acc += w * (axisWeight.x * gx + axisWeight.y * gy + axisWeight.z * gz);
+        if (wantsDepth)
+            depth += w * faceDepth(axisWeight, gx, gy, gz);
     }
     return acc;
 }
 
-vec4 sampleAt(int level, vec3 p, vec3 dir)
+vec4 sampleAt(int level, vec3 p, vec3 dir, bool wantsDepth, bool wantsEmission, inout vec3 emission,
+              inout float depth)
 {
-    return pc.mode.x == 1 ? sampleBrickLevel(level, p, dir) : sampleLevel(level, p, dir);
+    return pc.mode.x == 1 ? sampleBrickLevel(level, p, dir, wantsDepth, depth)
+                          : sampleLevel(level, p, dir, wantsDepth, wantsEmission, emission, depth);
 }
 
 bool insideCube(vec3 p)
@@ -92,6 +122,34 @@ bool insideCube(vec3 p)
     const vec3 rel = (p - pc.cube.xyz) / pc.cube.w;
     return all(greaterThanEqual(rel, vec3(0.0))) && all(lessThanEqual(rel, vec3(1.0)));
 }
+
+// The quadrilinear sample of cone_march.glsl: the level whose voxels are as wide as the
+// footprint and the next coarser one, blended linearly.
+bool sampleCone(vec3 q, float diameter, vec3 dir, bool wantsDepth, bool wantsEmission, out vec4 s,
+                out vec3 emission, out float depth, out float voxelSize)
+{
+    emission = vec3(0.0);
+    depth = 0.0;
+    if (!insideCube(q))
+        return false; // left the cube: no light from beyond
+    const float leaf = pc.march.x;
+    const int levels = pc.size.z;
+    const float m = min(float(levels), diameter > leaf ? log2(diameter / leaf) : 0.0);
+    const int m0 = int(floor(m));
+    const float frac = m - float(m0);
+    wantsEmission = wantsEmission && pc.sky.w == 1.0;
+    vec3 e0 = vec3(0.0), e1 = vec3(0.0);
+    float d0 = 0.0, d1 = 0.0;
+    s = (1.0 - frac) * sampleAt(levels - m0, q, dir, wantsDepth, wantsEmission, e0, d0);
+    if (frac > 0.0 && m0 < levels)
+        s += frac * sampleAt(levels - m0 - 1, q, dir, wantsDepth, wantsEmission, e1, d1);
+    emission = (1.0 - frac) * e0 + frac * e1;
+    depth = (1.0 - frac) * d0 + frac * d1;
+    voxelSize = leaf * exp2(m);
+    return true;
+}
+
+#include <cone_march.glsl>
 
 void main()
 {
@@ -102,43 +160,30 @@ void main()
     if (pixel.x >= pc.size.x || pixel.y >= pc.size.y || k >= 16)
         return;
     const int index = pixel.y * pc.size.x + pixel.x;
+    const bool sky = pc.sky.x == 1.0;
     coneRadiance[index * 16 + k] = vec4(0.0);
+    if (sky)
+        coneSky[index * 16 + k] = vec4(0.0);
     const vec4 position = positions[index];
     const vec3 n = normals[index].xyz;
     if (position.w == 0.0 || dot(n, n) < 0.5 || !insideCube(position.xyz))
         return;
     const float leaf = pc.march.x;
-    const int depth = pc.size.z;
-    const vec3 origin = position.xyz + n * (0.5 * pc.march.z * leaf);
-    const float startDistance = pc.march.z * leaf;
     if (dot(cones[k].xyz, n) <= 0.0)
         return;
-    const vec3 dir = cones[k].xyz;
-    float occupied = 0.0;
-    vec3 light = vec3(0.0);
-    float t = startDistance;
-    for (int step = 0; step < pc.size.w; ++step) {
-        const vec3 q = origin + t * dir;
-        if (!insideCube(q))
-            break; // left the cube: no indirect light from beyond
-        const float diameter = 2.0 * t * pc.march.y;
-        const float m = min(float(depth), diameter > leaf ? log2(diameter / leaf) : 0.0);
-        const int m0 = int(floor(m));
-        const float frac = m - float(m0);
-        vec4 s = (1.0 - frac) * sampleAt(depth - m0, q, dir);
-        if (frac > 0.0 && m0 < depth)
-            s += frac * sampleAt(depth - m0 - 1, q, dir);
-        const float voxelSize = leaf * exp2(m);
-        const float dt = pc.march.w * voxelSize;
-        const float a = clamp(s.a, 0.0, 1.0);
-        if (a > 0.0) {
-            const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
-            light += ((1.0 - occupied) * corrected / a) * s.rgb;
-            occupied += (1.0 - occupied) * corrected;
-            if (occupied >= 0.99)
-                break;
-        }
-        t += dt;
-    }
-    coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+    // Start a leaf out, along the normal and along the cone (SparseVoxelOctree::preparePixel).
+    ConeMarch m;
+    m.t0 = pc.march.z * leaf;
+    m.tanHalfAngle = pc.march.y;
+    m.stepScale = pc.march.w;
+    m.maxSteps = pc.size.w;
+    m.sky = sky;
+    m.opticalDepth = pc.sky.z == 1.0;
+    m.skyStart = pc.sky.y;
+    m.planeNormal = n;
+    m.planeHeight = 0.5 * pc.march.z * leaf;
+    const ConeTrace r = marchCone(position.xyz + n * (0.5 * pc.march.z * leaf), cones[k].xyz, m);
+    coneRadiance[index * 16 + k] = vec4(max(r.light, vec3(0.0)), 1.0);
+    if (sky)
+        coneSky[index * 16 + k] = vec4(getConeSkyRadiance(r, cones[16 + k].rgb), 1.0);
 }
