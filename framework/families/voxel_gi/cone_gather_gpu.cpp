@@ -71,9 +71,9 @@ std::size_t PixelConeDispatch::setSkyPerCone(const std::array<glm::vec3, kConeCo
     return entries.size() * sizeof(glm::vec4);
 }
 
-void PixelConeDispatch::readBackSky(std::vector<glm::vec3>& out) const
+void PixelConeDispatch::readBackSky(std::vector<glm::vec3>& out, bool points) const
 {
-    const Starts& starts = mOnDevice ? mDevicePixels : mPixels;
+    const Starts& starts = points ? mPoints : mOnDevice ? mDevicePixels : mPixels;
     if (mSkyBinding == 0 || !starts.skyOutput.isValid())
         throw Error("cone gather: the pipeline '" + mLabel + "' traced no cones' sky to read back");
     const std::vector<glm::vec4> e = starts.skyOutput.downloadVector<glm::vec4>(starts.count * kConeCount);

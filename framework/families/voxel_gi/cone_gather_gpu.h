@@ -58,8 +58,9 @@ public:
     //! The cones' sky of the last run over pixels of a `coneSky` pipeline whose shader traced it,
     //! [pixel * 16 + cone] as vec4.
     const gpu::Buffer& getSkyOutput() const { return (mOnDevice ? mDevicePixels : mPixels).skyOutput; }
-    //! That buffer on the CPU (one row of 16 per pixel).
-    void readBackSky(std::vector<glm::vec3>& out) const;
+    //! That buffer on the CPU (one row of 16 per pixel), or with `points` the sky of the last
+    //! run over the uploaded points.
+    void readBackSky(std::vector<glm::vec3>& out, bool points = false) const;
     //! Uploads the pixels' positions relative to `anchor` and their normals; returns the bytes.
     std::size_t uploadPixels(const scene::GBuffer& gbuffer, const glm::dvec3& anchor);
     //! uploadPixels for a CPU source; for a GPU one, the reduction is recorded before the next

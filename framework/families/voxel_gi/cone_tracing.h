@@ -144,6 +144,15 @@ struct ConeResult {
 //! of it the blend weighs (Max, "Optical models for direct volume rendering", IEEE TVCG 1995:
 //! transmittance is the exponential of the integrated extinction, which is what a linear filter
 //! may interpolate). The light keeps the occupancy, as the GPU gathers composite it.
+//! Whether a sample at `t` along a cone lies at or past the sky's start distance. The samples
+//! lie on sums of half-voxel steps and the usual start is a whole number of voxels, so a sample
+//! falls on it: the test takes 1e-4 of it as margin, so that t summed in float (the Vulkan
+//! gathers) or in double decides alike (cone_march.glsl).
+inline bool isPastSkyStart(double t, double skyStartDistance)
+{
+    return t >= skyStartDistance * (1.0 - 1e-4);
+}
+
 template <class Sampler>
 ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm::dvec3& dir, int cone,
                      const ConeMarchSettings& s)
@@ -161,7 +170,8 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
             break;
         const double diameter = 2.0 * t * s.tanHalfAngle;
         const glm::dvec3 p = origin + t * dir;
-        sample.wantsDepth = s.sky && s.skyOpticalDepth && t >= s.skyStartDistance;
+        const bool pastSkyStart = isPastSkyStart(t, s.skyStartDistance);
+        sample.wantsDepth = s.sky && s.skyOpticalDepth && pastSkyStart;
         if (!sampler.sample(p, diameter, cone, dir, sample)) {
             r.escaped = !lightDone;
             r.skyEscaped = true;
@@ -190,7 +200,7 @@ ConeResult marchCone(const Sampler& sampler, const glm::dvec3& origin, const glm
                 occupied += (1.0 - occupied) * corrected;
                 lightDone = occupied >= s.maxOpacity;
             }
-            if (s.sky && t >= s.skyStartDistance) {
+            if (s.sky && pastSkyStart) {
                 // The sky through the part of the sample the surface the cone leaves does not
                 // fill. Voxels of size v hold the box average of the occupancy, and a trilinear
                 // sample averages them again: the solid half-space below a plane (the surface,

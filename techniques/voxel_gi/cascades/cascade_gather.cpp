@@ -217,9 +217,9 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
         const std::size_t before = level.far.size();
         level.far.resize(std::size_t(slot) * kConeCount, glm::vec3(0.0f));
         // The sky beside the light while every far cone of the level has one; far cones traced
-        // on Vulkan, or for a gather that wants no sky, keep none, and the level's sky stays
-        // empty until its far cones are dropped.
-        if (!tracer && mTraceSky && level.farSky.size() == before)
+        // for a gather that wants no sky (or by a tracer that gives none) keep none, and the
+        // level's sky stays empty until its far cones are dropped.
+        if (mTraceSky && level.farSky.size() == before)
             level.farSky.resize(level.far.size(), glm::vec3(0.0f));
         else
             level.farSky.clear();
@@ -227,18 +227,25 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
     const GatheredSampler sampler{this, true};
     const auto farStart = std::chrono::steady_clock::now();
     if (tracer && !toTrace.empty()) {
-        std::vector<glm::vec3> traced;
-        tracer(toTrace, traced);
+        std::vector<glm::vec3> traced, tracedSky;
+        tracer(toTrace, traced, mTraceSky ? &tracedSky : nullptr);
         if (traced.size() != toTrace.size() * kConeCount)
             throw Error("cascades: the far-cone tracer gave " + std::to_string(traced.size()) +
                         " cones for " + std::to_string(toTrace.size() * kConeCount));
+        const bool withSky = tracedSky.size() == traced.size();
         for (std::size_t k = 0; k < toTrace.size(); ++k) {
             const auto [i, vox] = toTrace[k];
             Level& level = mLevels[std::size_t(i)];
-            for (int c = 0; c < kConeCount; ++c)
-                level.far[std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c)] =
-                    traced[k * kConeCount + std::size_t(c)];
+            for (int c = 0; c < kConeCount; ++c) {
+                const std::size_t at = std::size_t(level.farSlot[vox]) * kConeCount + std::size_t(c);
+                level.far[at] = traced[k * kConeCount + std::size_t(c)];
+                if (withSky && !level.farSky.empty())
+                    level.farSky[at] = tracedSky[k * kConeCount + std::size_t(c)];
+            }
         }
+        if (!withSky)
+            for (Level& level : mLevels)
+                level.farSky.clear();
     }
     tbb::parallel_for(std::size_t(0), tracer ? std::size_t(0) : toTrace.size(), [&](std::size_t k) {
         const auto [i, vox] = toTrace[k];
@@ -267,6 +274,20 @@ void CascadeVolume::prepareFarCones(const scene::GBuffer& gbuffer, const FarCone
         mCounters.farVoxelsCached += level.far.size() / kConeCount;
 }
 
+void CascadeVolume::setConeSky(const std::array<glm::vec3, kConeCount>* skyPerCone)
+{
+    mTraceSky = skyPerCone != nullptr;
+    if (skyPerCone != nullptr && *skyPerCone != mFarSkyPerCone) {
+        // Another sky: the far cones' sky is stale, so all far cones are traced again.
+        mFarSkyPerCone = *skyPerCone;
+        for (Level& level : mLevels) {
+            level.farSlot.assign(level.region.getVoxelCount(), ~0u);
+            level.far.clear();
+            level.farSky.clear();
+        }
+    }
+}
+
 CascadeVolume::StartLevels CascadeVolume::getStartLevels(double start) const
 {
     StartLevels s;
@@ -282,16 +303,7 @@ void CascadeVolume::gatherConesSplit(const scene::GBuffer& gbuffer, std::vector<
                                      const ConeSkyOutput* sky)
 {
     std::vector<glm::vec3>* skyOut = sky != nullptr ? sky->out : nullptr;
-    mTraceSky = skyOut != nullptr;
-    if (skyOut != nullptr && sky->skyPerCone != mFarSkyPerCone) {
-        // Another sky: the far cones' sky is stale, so all far cones are traced again.
-        mFarSkyPerCone = sky->skyPerCone;
-        for (Level& level : mLevels) {
-            level.farSlot.assign(level.region.getVoxelCount(), ~0u);
-            level.far.clear();
-            level.farSky.clear();
-        }
-    }
+    setConeSky(skyOut != nullptr ? &sky->skyPerCone : nullptr);
     prepareFarCones(gbuffer);
     const int W = gbuffer.width, H = gbuffer.height;
     const GatheredSampler sampler{this, true};

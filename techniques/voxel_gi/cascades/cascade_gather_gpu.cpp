@@ -18,8 +18,9 @@ struct GatherConstants {
     glm::ivec4 flags{0}; // visibility given, max steps
     glm::ivec4 anchorCell{0}; // the anchor in level-0 voxels
     glm::vec4 noise{0.0f};    // x: level noise (of a level's radius)
+    glm::vec4 sky{0.0f};      // makeConeSkyConstants (the sky start in voxels)
 };
-static_assert(sizeof(GatherConstants) == 80, "must match cascade_gather.comp");
+static_assert(sizeof(GatherConstants) == 96, "must match cascade_gather.comp");
 
 } // namespace
 
@@ -60,10 +61,15 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
         throw Error("cascades: the Vulkan gather reads the pre-combined direction buffers "
                     "(precombine: true)");
     if (!mDispatch.isReadyFor(context)) {
+        const auto sky = mSkyPerCone;
         *this = CascadeGatherGpu();
+        mSkyPerCone = sky;
         mDispatch.create(context, getShaderDir() / "cascade_gather.comp", kDispatchLabel,
-                         sizeof(GatherConstants), volume.getCones(), 3);
+                         sizeof(GatherConstants), volume.getCones(), 5, true);
         mFarListPlaceholder = mDispatch.makeBuffer(64, "cascades.far_list_placeholder");
+        mFaces = mDispatch.makeBuffer(16, "cascades.faces");
+        mFarSky = mDispatch.makeBuffer(16, "cascades.far_sky");
+        mResidentFarSky = mDispatch.makeBuffer(16, "cascades.far_sky_resident");
     }
     const int n = volume.getLevelCount();
     const int R = settings.resolution;
@@ -89,6 +95,33 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
             mLastUploadBytes += levelBytes;
         }
     }
+    if (mSkyPerCone) {
+        // The faces the sky's march reads (occupancy, emission), per level as the light.
+        mLastUploadBytes += mDispatch.setSkyPerCone(*mSkyPerCone);
+        const std::size_t faceBytes = levelVoxels * kFaceCount * sizeof(glm::vec4);
+        if (mFaces.getSize() < faceBytes * std::size_t(n)) {
+            mFaces = mDispatch.makeBuffer(faceBytes * std::size_t(n), "cascades.faces");
+            mUploadedFaceStamps.assign(std::size_t(n), 0);
+        }
+        mUploadedFaceStamps.resize(std::size_t(n), 0);
+        mEmits = false;
+        for (int i = 0; i < n; ++i) {
+            const auto& level = volume.getLevel(i);
+            if (levels[std::size_t(i)].centre.w < 0.0f)
+                continue;
+            mEmits = mEmits || level.emits;
+            const std::uint64_t stamp = std::max(level.voxelStamp, level.lightStamp);
+            if (mUploadedFaceStamps[std::size_t(i)] == stamp)
+                continue;
+            const auto& emission = level.light[kEmission];
+            std::vector<glm::vec4> faces(levelVoxels * kFaceCount);
+            for (std::size_t f = 0; f < faces.size() && f < level.alpha.size(); ++f)
+                faces[f] = glm::vec4(f < emission.size() ? emission[f] : glm::vec3(0.0f), level.alpha[f]);
+            mFaces.upload(faces.data(), faceBytes, faceBytes * std::size_t(i));
+            mUploadedFaceStamps[std::size_t(i)] = stamp;
+            mLastUploadBytes += faceBytes;
+        }
+    }
     if (!mLevels.isValid() || mLevels.getSize() < levels.size() * sizeof(GpuCascadeLevel))
         mLevels =
             mDispatch.makeBuffer(levels.size() * sizeof(GpuCascadeLevel), "cascades.levels", true);
@@ -98,7 +131,8 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
 
 namespace {
 
-GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anchor, glm::ivec2 size, bool far)
+GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anchor, glm::ivec2 size, bool far,
+                              bool sky, bool emits)
 {
     const CascadeSettings& settings = volume.getSettings();
     GatherConstants constants;
@@ -111,6 +145,7 @@ GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anc
     const glm::dvec3 anchorCells = glm::round(anchor / settings.voxelSize);
     constants.anchorCell = glm::ivec4(glm::ivec3(anchorCells), 0);
     constants.noise = {float(settings.levelNoise), float(settings.farStart), 0.0f, 0.0f};
+    constants.sky = makeConeSkyConstants(sky, settings.skyStart, settings.skyOpticalDepth, emits);
     return constants;
 }
 
@@ -153,6 +188,17 @@ const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& con
         mResidentFarList = mDispatch.makeBuffer(32 + mResidentFarVoxels * sizeof(std::uint32_t), "cascades.far_list");
         mResidentFarInputs.assign(std::size_t(n), {});
     }
+    // The far cones' sky, when traced: kept with the far cones, all of them dropped when the sky
+    // changes or is wanted where they were traced without it.
+    if (mSkyPerCone) {
+        if (mResidentFarSky.getSize() < mResidentFarVoxels * kConeCount * sizeof(glm::vec4))
+            mResidentFarSky =
+                mDispatch.makeBuffer(mResidentFarVoxels * kConeCount * sizeof(glm::vec4), "cascades.far_sky_resident");
+        if (mResidentFarSkyOf != mSkyPerCone) {
+            mResidentFarInputs.assign(std::size_t(n), {});
+            mResidentFarSkyOf = mSkyPerCone;
+        }
+    }
     // The far cones of level i sample levels getFarDependency(i) and coarser: drop them when one
     // of those changed since (CascadeVolume::invalidateFarCones), or on first use.
     std::vector<std::uint64_t> stamps(static_cast<std::size_t>(n));
@@ -170,7 +216,8 @@ const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& con
     }
     mLastFarLevelsDropped = clear.size() - 1;
     const glm::ivec2 size = pixels.getSize();
-    GatherConstants gather = makeConstants(volume, anchor, size, false);
+    mLastTracedSky = mSkyPerCone.has_value();
+    GatherConstants gather = makeConstants(volume, anchor, size, false, mLastTracedSky, mEmits);
     gather.flags.w = 1; // resident far cones
     const auto mode = [&](int z) {
         GatherConstants c = gather;
@@ -188,8 +235,9 @@ const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& con
         {mode(5), {1, 1, 1}},
         {mode(3), {}, &mResidentFarList, 4},
         {mode(4), {}, &mResidentFarList, 16}};
-    mLastGpuMs = mDispatch.runWithSteps(mLevels, mCombined, gpu::PushConstants(gather),
-                                        {&mResidentFarState, &mResidentFarCones, &mResidentFarList}, clear, steps);
+    mLastGpuMs = mDispatch.runWithSteps(
+        mLevels, mCombined, gpu::PushConstants(gather),
+        {&mResidentFarState, &mResidentFarCones, &mResidentFarList, &mFaces, &mResidentFarSky}, clear, steps);
     return mDispatch;
 }
 
@@ -200,14 +248,18 @@ void CascadeGatherGpu::trace(gpu::Context& context, const CascadeVolume& volume,
     const glm::dvec3 anchor = prepare(context, volume);
     mLastUploadBytes += mDispatch.preparePixels(pixels, anchor);
     uploadFarCones(volume);
-    mLastGpuMs = mDispatch.run(mLevels, mCombined,
-                               gpu::PushConstants(makeConstants(volume, anchor, pixels.getSize(), false)),
-                               out, {&mFarSlots, &mFarCones, &mFarListPlaceholder});
+    // The sky where the far cones hold theirs too (CascadeVolume::prepareFarCones keeps it while
+    // every far cone was traced with it).
+    mLastTracedSky = mSkyPerCone.has_value() && (volume.getSettings().farStart <= 0.0 || mFarSkyUploaded);
+    mLastGpuMs = mDispatch.run(
+        mLevels, mCombined,
+        gpu::PushConstants(makeConstants(volume, anchor, pixels.getSize(), false, mLastTracedSky, mEmits)),
+        out, {&mFarSlots, &mFarCones, &mFarListPlaceholder, &mFaces, &mFarSky});
 }
 
 void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume& volume,
                                      const std::vector<std::pair<int, std::uint32_t>>& centres,
-                                     std::vector<glm::vec3>& out)
+                                     std::vector<glm::vec3>& out, std::vector<glm::vec3>* sky)
 {
     mLastUploadBytes = 0;
     const glm::dvec3 anchor = prepare(context, volume);
@@ -223,10 +275,18 @@ void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume&
         mFarSlots = mDispatch.makeBuffer(16, "cascades.far_slots");
         mFarCones = mDispatch.makeBuffer(16, "cascades.far_cones");
     }
+    const bool traceSky = sky != nullptr && mSkyPerCone.has_value();
     mLastGpuMs = mDispatch.run(
         mLevels, mCombined,
-        gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true)), &out,
-        {&mFarSlots, &mFarCones, &mFarListPlaceholder}, true);
+        gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true, traceSky, mEmits)), &out,
+        {&mFarSlots, &mFarCones, &mFarListPlaceholder, &mFaces, &mFarSky}, true);
+    if (sky != nullptr) {
+        sky->clear();
+        if (traceSky) {
+            mDispatch.readBackSky(*sky, true);
+            sky->resize(out.size());
+        }
+    }
 }
 
 void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)
@@ -243,8 +303,9 @@ void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)
         }
         return;
     }
-    // Everything again when any level's far cones changed (new slots or invalidated).
-    std::vector<std::pair<std::uint64_t, std::size_t>> state(static_cast<std::size_t>(n));
+    // Everything again when any level's far cones changed (new slots or invalidated), or their
+    // sky came or went.
+    std::vector<std::pair<std::uint64_t, std::size_t>> state(static_cast<std::size_t>(n) + 1);
     for (int i = 0; i < n; ++i) {
         const auto& level = volume.getLevel(i);
         if (level.voxelized && level.farSlot.size() != levelVoxels)
@@ -252,10 +313,15 @@ void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)
                         "CascadeVolume::prepareFarCones first");
         state[std::size_t(i)] = {level.farStamp, level.far.size()};
     }
+    bool farSky = mSkyPerCone.has_value();
+    for (int i = 0; i < n; ++i)
+        farSky = farSky && volume.getLevel(i).farSky.size() == volume.getLevel(i).far.size();
+    state[std::size_t(n)] = {farSky ? 1 : 0, 0};
+    mFarSkyUploaded = farSky;
     if (state == mUploadedFar && mFarSlots.isValid())
         return;
     std::vector<std::uint32_t> slots(levelVoxels * std::size_t(n), ~0u);
-    std::vector<glm::vec4> cones;
+    std::vector<glm::vec4> cones, sky;
     for (int i = 0; i < n; ++i) {
         const auto& level = volume.getLevel(i);
         const std::uint32_t base = std::uint32_t(cones.size() / kConeCount);
@@ -264,6 +330,9 @@ void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)
                 slots[std::size_t(i) * levelVoxels + v] = base + level.farSlot[v];
         for (const glm::vec3& c : level.far)
             cones.emplace_back(c, 0.0f);
+        if (farSky)
+            for (const glm::vec3& c : level.farSky)
+                sky.emplace_back(c, 0.0f);
     }
     const std::size_t slotBytes = slots.size() * sizeof(std::uint32_t);
     const std::size_t coneBytes = std::max<std::size_t>(cones.size(), 1) * sizeof(glm::vec4);
@@ -274,7 +343,12 @@ void CascadeGatherGpu::uploadFarCones(const CascadeVolume& volume)
     mFarSlots.uploadSpan<std::uint32_t>(slots);
     if (!cones.empty())
         mFarCones.uploadSpan<glm::vec4>(cones);
-    mLastUploadBytes += slotBytes + cones.size() * sizeof(glm::vec4);
+    if (!sky.empty()) {
+        if (mFarSky.getSize() < coneBytes)
+            mFarSky = mDispatch.makeBuffer(coneBytes, "cascades.far_sky");
+        mFarSky.uploadSpan<glm::vec4>(sky);
+    }
+    mLastUploadBytes += slotBytes + (cones.size() + sky.size()) * sizeof(glm::vec4);
     mUploadedFar = std::move(state);
 }
 

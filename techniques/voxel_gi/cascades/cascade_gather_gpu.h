@@ -2,6 +2,9 @@
 // The pixel gather of the cascades on Vulkan (shaders/cascade_gather.comp): the levels'
 // pre-combined direction buffers live in one storage buffer, re-uploaded per level only when the
 // level was re-voxelized or re-lit; positions go up relative to the coarsest level's centre.
+// Asked for the cones' sky, the same dispatches also trace the sky and emitters each cone sees
+// past the voxels (the far cones' too), from the levels' faces (occupancy and emission, uploaded
+// the same way, only while the sky is traced).
 
 #include "cascade_volume.h"
 
@@ -50,9 +53,19 @@ public:
     const PixelConeDispatch& gatherConesResident(gpu::Context& context, const CascadeVolume& volume,
                                                  const PixelSource& pixels);
     //! CascadeVolume::FarConeTracer on Vulkan: the 16 far cones of each voxel centre, through
-    //! the same pre-combined buffers (uploaded when they changed), [centre * 16 + cone].
+    //! the same pre-combined buffers (uploaded when they changed), [centre * 16 + cone]; with
+    //! `sky` (and setConeSky) their sky and emitters too.
     void traceFarCones(gpu::Context& context, const CascadeVolume& volume,
-                       const std::vector<std::pair<int, std::uint32_t>>& centres, std::vector<glm::vec3>& out);
+                       const std::vector<std::pair<int, std::uint32_t>>& centres, std::vector<glm::vec3>& out,
+                       std::vector<glm::vec3>* sky = nullptr);
+    //! Whether the following gathers also trace the sky and emitters each cone sees past the
+    //! voxels (the sky per cone, computeSkyPerCone), or not (nullopt).
+    void setConeSky(const std::optional<std::array<glm::vec3, kConeCount>>& skyPerCone) { mSkyPerCone = skyPerCone; }
+    //! Whether the last gather over pixels traced the cones' sky (asked for it, and with split
+    //! cones every far cone traced with it).
+    bool tracedSky() const { return mLastTracedSky; }
+    //! The cones' sky of the last gather over pixels, which traced it, [pixel * 16 + cone].
+    void readBackSky(std::vector<glm::vec3>& out) const { mDispatch.readBackSky(out); }
     //! GPU time of the last dispatch, when the device has timestamps.
     std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
     //! Bytes uploaded by the last call (levels that changed, pixels).
@@ -73,6 +86,15 @@ private:
 
     PixelConeDispatch mDispatch;
     gpu::Buffer mLevels, mCombined;
+    // The cones' sky: the levels' faces (emission, occupancy) and what was uploaded of them; the
+    // far cones' sky (uploaded far cones, resident ones) and the sky the resident ones hold.
+    std::optional<std::array<glm::vec3, kConeCount>> mSkyPerCone;
+    gpu::Buffer mFaces, mFarSky, mResidentFarSky;
+    std::vector<std::uint64_t> mUploadedFaceStamps;
+    std::optional<std::array<glm::vec3, kConeCount>> mResidentFarSkyOf;
+    bool mEmits = false;
+    bool mFarSkyUploaded = false; //!< the uploaded far cones carry their sky
+    bool mLastTracedSky = false;
     gpu::Buffer mFarSlots, mFarCones; //!< split cones: slot per level voxel, radiance per slot
     std::vector<std::pair<std::uint64_t, std::size_t>> mUploadedFar; //!< per level: stamp, slots
     // The resident far cones: per level voxel a state (0 none, 1 wanted, 2 traced) and 16

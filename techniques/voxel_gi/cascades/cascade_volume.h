@@ -155,9 +155,15 @@ public:
     void gatherRays(const scene::GBuffer& gbuffer, int rays, Image<glm::vec3>& out,
                     const scene::Sky* sky = nullptr) const;
     //! Far cones to trace: (level, voxel) of each centre; out gets the 16 cones' radiance of
-    //! each, [centre * 16 + cone] (on Vulkan: CascadeGatherGpu::traceFarCones).
+    //! each, [centre * 16 + cone] (on Vulkan: CascadeGatherGpu::traceFarCones), and `sky`, when
+    //! not null, their sky and emitters (computeConeSkyRadiance) the same way, or nothing (the
+    //! far cones then keep no sky).
     using FarConeTracer = std::function<void(const std::vector<std::pair<int, std::uint32_t>>& centres,
-                                             std::vector<glm::vec3>& out)>;
+                                             std::vector<glm::vec3>& out, std::vector<glm::vec3>* sky)>;
+    //! Whether the following far cones also carry the cones' sky (the sky per cone), or not
+    //! (null); another sky drops every far cone (their sky is stale). gatherCones with a
+    //! ConeSkyOutput calls it; a Vulkan gather calls it before prepareFarCones.
+    void setConeSky(const std::array<glm::vec3, kConeCount>* skyPerCone);
     //! With settings.farStart > 0: drops the far cones of levels whose sampled levels changed and
     //! traces those the pixels of `gbuffer` need that are not traced yet, in C++ or with
     //! `tracer` (gatherCones calls it; the Vulkan gather needs it called first).

@@ -339,22 +339,41 @@ public:
         irradiance = mCombineGpu.readBackResident();
     }
 
+    const gpu::Image* getGpuConeSky() const override
+    {
+        return mSkyOnGpu ? mSkyCombineGpu.getResidentOutput() : nullptr;
+    }
+
+    void readBackConeSky(Image<glm::vec3>& irradiance) override
+    {
+        if (!mSkyOnGpu)
+            throw Error("cascades: the last gather traced no cone sky on the GPU");
+        irradiance = mSkyCombineGpu.readBackResident();
+    }
+
     void gather(const plugin::VoxelGiInput& input, Image<glm::vec3>& irradiance) override
     {
+        mSky.cones.clear();
+        mSkyOnGpu = false;
+        mSkyWhyNot.clear();
+        // The cones' sky and emitters, traced with the light when the frame asks for them.
+        std::optional<std::array<glm::vec3, voxelgi::kConeCount>> skyPerCone;
+        if (input.coneSky && input.scene != nullptr)
+            skyPerCone = voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
         if (input.gpuGBuffer != nullptr) {
             // Resident: the pixels reduced on the device, their cones and the combine there.
             if (input.gpu == nullptr || !whyNotGatheredOnGpu(*input.gpu).empty())
                 throw Error("cascades: the G-buffer was given on the GPU to a gather that does not run there");
             mGatheredOnGpu = mCombinedOnGpu = mGatheredResident = true;
-            mSky.cones.clear();
-            mSkyWhyNot = "the Vulkan gather traces no cone sky yet (device: cpu does)";
+            mGpu.setConeSky(skyPerCone);
             voxelgi::gatherConesResident(
                 *input.gpu, mCombineGpu, *input.gpuGBuffer, mTraceStep, mVolume->getCones().halfAngle,
                 input.gpuConeVisibility, input.capsules,
                 [&](const voxelgi::PixelSource& pixels) -> const voxelgi::PixelConeDispatch& {
                     return mGpu.gatherConesResident(*input.gpu, *mVolume, pixels);
                 },
-                &mCombineMs, mCapsuleResolution);
+                &mCombineMs, mCapsuleResolution, skyPerCone ? &mSkyCombineGpu : nullptr);
+            mSkyOnGpu = skyPerCone.has_value();
             if (input.readBack)
                 readBackIrradiance(irradiance);
             return;
@@ -366,20 +385,32 @@ public:
         mGatheredResident = false;
         mGatheredOnGpu = voxelgi::shouldGatherOnGpu(input.gpu, mDevice) && mSettings.precombine;
         mCombinedOnGpu = voxelgi::shouldCombineOnGpu(input.gpu, mGatheredOnGpu, mCombineDevice);
-        // The Vulkan gather's cones: the far cones first with split cones (on Vulkan too).
+        if (mGatheredOnGpu) {
+            mGpu.setConeSky(skyPerCone);
+            mVolume->setConeSky(skyPerCone ? &*skyPerCone : nullptr);
+        }
+        // The Vulkan gather's cones: the far cones first with split cones (on Vulkan too, their
+        // sky with them).
         const auto prepareGpuCones = [&](const scene::GBuffer& reduced) {
             if (mSettings.farStart > 0.0)
                 mVolume->prepareFarCones(
                     reduced, [&](const std::vector<std::pair<int, std::uint32_t>>& centres,
-                                 std::vector<glm::vec3>& far) {
-                        mGpu.traceFarCones(*input.gpu, *mVolume, centres, far);
+                                 std::vector<glm::vec3>& far, std::vector<glm::vec3>* farSky) {
+                        mGpu.traceFarCones(*input.gpu, *mVolume, centres, far, farSky);
                     });
         };
-        mSky.cones.clear();
-        mSkyWhyNot = mGatheredOnGpu ? "the Vulkan gather traces no cone sky yet (device: cpu does)" : "";
+        // The Vulkan gather's cones' sky to the CPU, for combineConeSky (this path's round trip).
+        const auto readBackGpuSky = [&](std::vector<glm::vec3>& cones) {
+            if (!skyPerCone)
+                return;
+            if (mGpu.tracedSky())
+                mGpu.readBackSky(cones);
+            else
+                mSkyWhyNot = "the far cones were traced without the sky (it was not asked for when they were)";
+        };
         voxelgi::ConeSkyOutput sky;
-        if (input.coneSky && input.scene != nullptr)
-            sky.skyPerCone = voxelgi::computeSkyPerCone(input.scene->sky, mVolume->getCones());
+        if (skyPerCone)
+            sky.skyPerCone = *skyPerCone;
         if (mCombinedOnGpu) {
             // The combine on Vulkan (cone_combine_gpu.h): the cones of the Vulkan gather stay on
             // the device, those of the C++ gather go up.
@@ -392,13 +423,15 @@ public:
                         // combine of combineConeSky (float against double: within 1e-5).
                         std::vector<glm::vec3> cones;
                         sky.out = &mSky.cones;
-                        mVolume->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
+                        mVolume->gatherCones(reduced, cones, skyPerCone ? &sky : nullptr);
                         return mCombineGpu.uploadCones(*input.gpu, cones);
                     }
                     prepareGpuCones(reduced);
                     return mGpu.gatherConesOnDevice(*input.gpu, *mVolume, reduced);
                 },
                 &mCombineMs, mCapsuleResolution);
+            if (mGatheredOnGpu)
+                readBackGpuSky(mSky.cones);
             if (!mSky.cones.empty())
                 voxelgi::keepConeSky(mSky, *input.gbuffer, mTraceStep, mVolume->getCones().halfAngle,
                                      input.capsules, mCapsuleResolution);
@@ -412,9 +445,11 @@ public:
                 if (mGatheredOnGpu) {
                     prepareGpuCones(reduced);
                     mGpu.gatherCones(*input.gpu, *mVolume, reduced, cones);
+                    if (skyCones != nullptr)
+                        readBackGpuSky(*skyCones);
                 } else {
                     sky.out = skyCones;
-                    mVolume->gatherCones(reduced, cones, input.coneSky ? &sky : nullptr);
+                    mVolume->gatherCones(reduced, cones, skyPerCone ? &sky : nullptr);
                 }
             },
             &mCombineMs, mCapsuleResolution, &mSky);
@@ -425,7 +460,7 @@ public:
         if (!mSkyWhyNot.empty())
             return mSkyWhyNot;
         if (!mSky.isValid())
-            return "the last gather traced no cone sky (or its far cones were traced on Vulkan)";
+            return "the last gather traced no cone sky (its far cones were traced without it)";
         irradiance = voxelgi::combineConeSky(mSky, *input.gbuffer, mVolume->getCones().halfAngle,
                                              input.coneVisibility, input.capsules);
         return {};
@@ -518,6 +553,8 @@ private:
     std::optional<voxelgi::CascadeVolume> mVolume;
     voxelgi::CascadeGatherGpu mGpu;
     voxelgi::ConeCombineGpu mCombineGpu;
+    voxelgi::ConeCombineGpu mSkyCombineGpu; // the resident gather's cones' sky
+    bool mSkyOnGpu = false;                 // the last gather left its cones' sky there
     voxelgi::CascadeInjectGpu mInjectGpu;
     voxelgi::VoxelizerGpu mVoxelizer;
     bool mVoxelizeOnGpu = false;
@@ -528,7 +565,7 @@ private:
     bool mGatheredResident = false; // the last gather ran resident (far cones on the device)
     bool mInjectOnGpu = false;
     bool mInjectedOnGpu = false;
-    voxelgi::ConeSkyTrace mSky; // the last C++ gather's cone sky, for combineConeSky
+    voxelgi::ConeSkyTrace mSky; // the last gather's cones' sky on the CPU, for combineConeSky
     std::string mSkyWhyNot;     // why the last gather traced no cone sky, "" when it did
     bool mGatheredOnGpu = false;
     double mCombineMs = std::nan(""); // the gather beyond its cones: reduction and combine

@@ -99,7 +99,7 @@ bool insideBox(vec3 p)
 
 // The sample of cone_march.glsl: trilinear at the two levels around the footprint (4x apart),
 // linear between them.
-bool sampleCone(vec3 q, float diameter, vec3 dir, bool wantsDepth, bool wantsEmission, out vec4 s,
+bool sampleCone(vec3 q, float diameter, vec3 dir, int cone, bool wantsDepth, bool wantsEmission, out vec4 s,
                 out vec3 emission, out float depth, out float voxelSize)
 {
     emission = vec3(0.0);
@@ -148,6 +148,7 @@ void main()
     // Start a leaf out, along the normal and along the cone (VoxelTreeCones::preparePixel).
     ConeMarch m;
     m.t0 = pc.march.z * leaf;
+    m.tMax = 1e30;
     m.tanHalfAngle = pc.march.y;
     m.stepScale = pc.march.w;
     m.maxSteps = pc.size.w;
@@ -156,7 +157,7 @@ void main()
     m.skyStart = pc.sky.y;
     m.planeNormal = n;
     m.planeHeight = 0.5 * pc.march.z * leaf;
-    const ConeTrace r = marchCone(position.xyz + n * (0.5 * pc.march.z * leaf), cones[k].xyz, m);
+    const ConeTrace r = marchCone(position.xyz + n * (0.5 * pc.march.z * leaf), cones[k].xyz, k, m);
     coneRadiance[index * 16 + k] = vec4(max(r.light, vec3(0.0)), 1.0);
     if (sky)
         coneSky[index * 16 + k] = vec4(getConeSkyRadiance(r, cones[16 + k].rgb), 1.0);

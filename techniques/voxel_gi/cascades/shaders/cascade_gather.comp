@@ -17,7 +17,8 @@ layout(std430, binding = 2) readonly buffer PositionBuffer { vec4 positions[]; }
 // The pixels' normals; for far cones (flags.z = 1) w is the voxel size of the centre's level.
 layout(std430, binding = 3) readonly buffer NormalBuffer { vec4 normals[]; };
 layout(std430, binding = 4) writeonly buffer OutputBuffer { vec4 coneRadiance[]; }; // [pixel][cone]
-layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[16]; };
+// [k]: cone k's direction; [16 + k]: the mean sky radiance over its solid angle (pc.sky.x == 1).
+layout(std430, binding = 5) readonly buffer ConeBuffer { vec4 cones[32]; };
 // Split near/far cones (noise.y > 0): [level][voxel] the slot of the voxel centre's far cones
 // (~0u: not traced), and [slot][cone] their radiance (CascadeVolume::prepareFarCones). Resident
 // (flags.w = 1): [level][voxel] the state of the voxel's far cones (0 none, 1 wanted, 2 traced)
@@ -35,6 +36,13 @@ layout(std430, binding = 8) buffer FarListBuffer {
     uint farPad;
     uint farList[];       // [level * R^3 + voxel]
 };
+// The cones' sky (pc.sky.x == 1): per level voxel face, [(level * R^3 + voxel) * 6 + face], the
+// emitted radiance premultiplied by the occupancy (rgb) and the occupancy (a), for the emitters
+// and the optical depths the sky's march reads; the far cones' sky and emitters, laid out as
+// farCones; and the pixels' cones' sky, [pixel][cone].
+layout(std430, binding = 9) readonly buffer FaceBuffer { vec4 faces[]; };
+layout(std430, binding = 10) buffer FarSkyBuffer { vec4 farSky[]; };
+layout(std430, binding = 11) writeonly buffer SkyOutputBuffer { vec4 coneSky[]; };
 
 layout(push_constant) uniform Constants {
     ivec4 size;  // width, height, levels, resolution
@@ -43,6 +51,8 @@ layout(push_constant) uniform Constants {
                  // 5 count, 3 trace and 4 commit the resident far cones; w: 1 = resident far cones
     ivec4 anchorCell; // xyz: the anchor in level-0 voxels
     vec4 noise;       // x: level noise (of a level's radius), y: far start (level voxels; 0: off)
+    vec4 sky;         // x: 1 = trace the sky, y: sky start (voxels of the cone's start level),
+                      // z: 1 = optical depth, w: 1 = some voxel emits
 } pc;
 
 float selectLevel(vec3 p, float diameter)
@@ -73,7 +83,7 @@ vec4 sampleLevel(int level, vec3 p, int cone)
 
 // The far cones' radiance at p for cone `cone`, trilinear over level `level`'s voxel centres
 // (the lattice and clamping of sampleLevel).
-vec3 sampleFar(int level, vec3 p, int cone)
+vec3 sampleFar(int level, vec3 p, int cone, bool sky)
 {
     const int R = pc.size.w;
     ivec3 i0;
@@ -88,14 +98,13 @@ vec3 sampleFar(int level, vec3 p, int cone)
             continue;
         const ivec3 v = i0 + d;
         const uint voxel = base + uint(v.x + R * (v.y + R * v.z));
-        if (pc.flags.w == 1) {
-            if (farSlots[voxel] == 2u)
-                acc += w * farCones[voxel * 16u + uint(cone)].rgb;
-            continue;
-        }
-        const uint slot = farSlots[voxel];
-        if (slot != 0xffffffffu)
-            acc += w * farCones[slot * 16u + uint(cone)].rgb;
+        uint entry = 0xffffffffu;
+        if (pc.flags.w == 1)
+            entry = farSlots[voxel] == 2u ? voxel : 0xffffffffu;
+        else
+            entry = farSlots[voxel];
+        if (entry != 0xffffffffu)
+            acc += w * (sky ? farSky[entry * 16u + uint(cone)].rgb : farCones[entry * 16u + uint(cone)].rgb);
     }
     return acc;
 }
@@ -119,42 +128,85 @@ void markFar(int level, vec3 p)
     }
 }
 
-// One cone marched front to back from t0 until tMax: rgb the radiance, a the transmittance;
-// `escaped` when it left the cascade (voxelgi::marchCone).
-vec4 marchCone(vec3 origin, vec3 dir, int k, float t0, float tMax, out bool escaped)
+float opticalDepthOf(float a)
 {
-    float occupied = 0.0;
-    vec3 light = vec3(0.0);
-    float t = t0;
-    escaped = false;
-    for (int step = 0; step < pc.flags.y; ++step) {
-        if (t >= tMax)
-            break;
-        const float diameter = 2.0 * t * pc.march.y;
-        const vec3 q = origin + t * dir;
-        const float l = selectLevel(q, diameter);
-        if (l < 0.0) {
-            escaped = true; // left the cascade: no indirect light from beyond
-            break;
-        }
-        const int l0 = int(floor(l));
-        const float frac = l - float(l0);
-        vec4 s = (1.0 - frac) * sampleLevel(l0, q, k);
-        if (frac > 0.0 && l0 + 1 < pc.size.z)
-            s += frac * sampleLevel(l0 + 1, q, k);
-        const float voxelSize = pc.march.x * exp2(l);
-        const float dt = pc.march.w * voxelSize;
-        const float a = clamp(s.a, 0.0, 1.0);
-        if (a > 0.0) {
-            const float corrected = 1.0 - pow(1.0 - min(a, 0.999999), dt / voxelSize);
-            light += ((1.0 - occupied) * corrected / a) * s.rgb;
-            occupied += (1.0 - occupied) * corrected;
-            if (occupied >= 0.99)
-                break;
-        }
-        t += dt;
+    return -log(1.0 - clamp(a, 0.0, 0.9999));
+}
+
+// The faces seen along `dir` of level `level`'s trilinear neighbourhood of p: their emission and
+// optical depths, weighted as the pre-combined buffers blend them (CascadeVolume::sampleLevel).
+void sampleFaces(int level, vec3 p, vec3 dir, float weight, bool wantsDepth, bool wantsEmission,
+                 inout vec3 emission, inout float depth)
+{
+    const int R = pc.size.w;
+    ivec3 i0;
+    vec3 t;
+    getTrilinear(level, p, R, i0, t);
+    const uint base = uint(level) * uint(R) * uint(R) * uint(R);
+    const ivec3 faceSeen = ivec3(0, 2, 4) + ivec3(greaterThan(dir, vec3(0.0)));
+    const vec3 axisWeight = dir * dir;
+    for (int corner = 0; corner < 8; ++corner) {
+        ivec3 d;
+        const float w = weight * getCornerWeight(corner, t, d);
+        if (w == 0.0)
+            continue;
+        const ivec3 v = i0 + d;
+        const uint at = (base + uint(v.x + R * (v.y + R * v.z))) * 6u;
+        const vec4 fx = faces[at + uint(faceSeen.x)], fy = faces[at + uint(faceSeen.y)],
+                   fz = faces[at + uint(faceSeen.z)];
+        if (wantsDepth)
+            depth += w * (axisWeight.x * opticalDepthOf(fx.a) + axisWeight.y * opticalDepthOf(fy.a) +
+                          axisWeight.z * opticalDepthOf(fz.a));
+        if (wantsEmission)
+            emission += w * (axisWeight.x * fx.rgb + axisWeight.y * fy.rgb + axisWeight.z * fz.rgb);
     }
-    return vec4(light, 1.0 - occupied);
+}
+
+// The sample of cone_march.glsl: the level the footprint selects, blended with the next
+// coarser one, from the pre-combined buffers of cone `cone`.
+bool sampleCone(vec3 q, float diameter, vec3 dir, int cone, bool wantsDepth, bool wantsEmission, out vec4 s,
+                out vec3 emission, out float depth, out float voxelSize)
+{
+    emission = vec3(0.0);
+    depth = 0.0;
+    const float l = selectLevel(q, diameter);
+    if (l < 0.0)
+        return false; // left the cascade: no light from beyond
+    const int l0 = int(floor(l));
+    const float frac = l - float(l0);
+    const bool next = frac > 0.0 && l0 + 1 < pc.size.z;
+    s = (1.0 - frac) * sampleLevel(l0, q, cone);
+    if (next)
+        s += frac * sampleLevel(l0 + 1, q, cone);
+    wantsEmission = wantsEmission && pc.sky.w == 1.0;
+    if (wantsDepth || wantsEmission) {
+        sampleFaces(l0, q, dir, 1.0 - frac, wantsDepth, wantsEmission, emission, depth);
+        if (next)
+            sampleFaces(l0 + 1, q, dir, frac, wantsDepth, wantsEmission, emission, depth);
+    }
+    voxelSize = pc.march.x * exp2(l);
+    return true;
+}
+
+#include <cone_march.glsl>
+
+// A cone's march from t0 until tMax, with the sky when traced: from skyStart on, the part of
+// each sample below the surface of normal n the cone leaves (planeHeight below its origin) left
+// out (none where n is 0).
+ConeMarch makeMarch(float t0, float tMax, float skyStart, vec3 n, float planeHeight)
+{
+    ConeMarch m;
+    m.t0 = t0;
+    m.tMax = tMax;
+    m.tanHalfAngle = pc.march.y;
+    m.stepScale = pc.march.w;
+    m.maxSteps = pc.flags.y;
+    m.sky = pc.sky.x == 1.0;
+    m.opticalDepth = pc.sky.z == 1.0;
+    m.skyStart = skyStart;
+    m.planeNormal = n;
+    m.planeHeight = planeHeight;
+    return m;
 }
 
 void main()
@@ -194,10 +246,11 @@ void main()
         const int local = int(voxel) - level * levelVoxels;
         const vec3 cell = vec3(local % R, (local / R) % R, local / (R * R)) + 0.5;
         const float voxelSize = levels[level].origin.w;
-        bool escaped;
-        const vec3 light = marchCone(levels[level].origin.xyz + cell * voxelSize, cones[k].xyz, k,
-                                     pc.noise.y * voxelSize, 1e30, escaped).rgb;
-        farCones[voxel * 16u + uint(k)] = vec4(max(light, vec3(0.0)), 1.0);
+        const ConeTrace r = marchCone(levels[level].origin.xyz + cell * voxelSize, cones[k].xyz, k,
+                                      makeMarch(pc.noise.y * voxelSize, 1e30, pc.sky.y * voxelSize, vec3(0.0), 0.0));
+        farCones[voxel * 16u + uint(k)] = vec4(max(r.light, vec3(0.0)), 1.0);
+        if (pc.sky.x == 1.0)
+            farSky[voxel * 16u + uint(k)] = vec4(getConeSkyRadiance(r, cones[16 + k].rgb), 1.0);
         return;
     }
 
@@ -206,16 +259,21 @@ void main()
     const int index = pixel.y * pc.size.x + pixel.x;
     if (pc.flags.z != 2)
         coneRadiance[index * 16 + k] = vec4(0.0);
+    const bool sky = pc.sky.x == 1.0;
+    if (sky && pc.flags.z != 2)
+        coneSky[index * 16 + k] = vec4(0.0);
     if (pc.flags.z == 1) {
         // Far cones ("Split Cone Trace"): the 16 cones from a voxel centre, from far start voxels
         // of its level on (CascadeVolume::prepareFarCones).
         const vec4 centre = positions[index];
         if (centre.w == 0.0)
             return;
-        const float t0 = pc.noise.y * normals[index].w;
-        bool escaped;
-        const vec3 light = marchCone(centre.xyz, cones[k].xyz, k, t0, 1e30, escaped).rgb;
-        coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+        const float voxelSize = normals[index].w;
+        const ConeTrace r = marchCone(centre.xyz, cones[k].xyz, k,
+                                      makeMarch(pc.noise.y * voxelSize, 1e30, pc.sky.y * voxelSize, vec3(0.0), 0.0));
+        coneRadiance[index * 16 + k] = vec4(max(r.light, vec3(0.0)), 1.0);
+        if (sky)
+            coneSky[index * 16 + k] = vec4(getConeSkyRadiance(r, cones[16 + k].rgb), 1.0);
         return;
     }
     const vec4 position = positions[index];
@@ -252,27 +310,52 @@ void main()
     if (dot(cones[k].xyz, n) <= 0.0)
         return;
     const vec3 dir = cones[k].xyz;
-    bool escaped;
-    vec3 light;
-    if (farStart <= 0.0) {
-        light = marchCone(origin, dir, k, startDistance, 1e30, escaped).rgb;
-    } else {
-        const vec4 a = marchCone(origin, dir, k, startDistance, split0, escaped);
-        vec3 la = a.rgb;
-        if (!escaped)
-            la += a.a * sampleFar(l0, origin, k);
+    const vec3 skyOfCone = cones[16 + k].rgb;
+    const ConeMarch near =
+        makeMarch(startDistance, farStart > 0.0 ? split0 : 1e30, pc.sky.y * v, n, 0.5 * pc.march.z * v);
+    const ConeTrace a = marchCone(origin, dir, k, near);
+    vec3 light = a.light, skyLight = getConeSkyRadiance(a, skyOfCone);
+    if (farStart > 0.0) {
+        // The near part, then the far cones seen through it (CascadeVolume::gatherConesSplit);
+        // the sky the same way: the near part's emitters, then the sky where it left the
+        // cascade, else the far cones' sky and emitters, through the near part's sky
+        // transmittance.
+        vec3 la = a.light;
+        if (!a.escaped)
+            la += a.transmittance * sampleFar(l0, origin, k, false);
+        vec3 sa = vec3(0.0);
+        if (sky)
+            sa = a.emission + a.skyTransmittance * (a.skyEscaped ? skyOfCone : sampleFar(l0, origin, k, true));
         light = la;
+        skyLight = sa;
         if (two) {
-            vec3 lb = a.rgb;
-            if (!escaped) {
-                bool escapedB;
-                const vec4 b = marchCone(origin, dir, k, split0, 2.0 * split0, escapedB);
-                lb += a.a * b.rgb;
-                if (!escapedB)
-                    lb += a.a * b.a * sampleFar(l0 + 1, origin, k);
+            vec3 lb = a.light, sb = a.emission;
+            ConeTrace b;
+            b.light = b.emission = vec3(0.0);
+            b.transmittance = b.skyTransmittance = 1.0;
+            b.escaped = b.skyEscaped = false;
+            if (!a.escaped) {
+                ConeMarch second = near;
+                second.t0 = split0;
+                second.tMax = 2.0 * split0;
+                b = marchCone(origin, dir, k, second);
+                lb += a.transmittance * b.light;
+                if (!b.escaped)
+                    lb += a.transmittance * b.transmittance * sampleFar(l0 + 1, origin, k, false);
+            }
+            if (sky) {
+                if (a.skyEscaped)
+                    sb += a.skyTransmittance * skyOfCone;
+                else // then a.escaped is false too: b was marched
+                    sb += a.transmittance * b.emission +
+                          a.skyTransmittance * b.skyTransmittance *
+                              (b.skyEscaped ? skyOfCone : sampleFar(l0 + 1, origin, k, true));
             }
             light = la + frac * (lb - la);
+            skyLight = sa + frac * (sb - sa);
         }
     }
     coneRadiance[index * 16 + k] = vec4(max(light, vec3(0.0)), 1.0);
+    if (sky)
+        coneSky[index * 16 + k] = vec4(max(skyLight, vec3(0.0)), 1.0);
 }

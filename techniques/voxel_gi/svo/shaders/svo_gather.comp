@@ -125,7 +125,7 @@ bool insideCube(vec3 p)
 
 // The quadrilinear sample of cone_march.glsl: the level whose voxels are as wide as the
 // footprint and the next coarser one, blended linearly.
-bool sampleCone(vec3 q, float diameter, vec3 dir, bool wantsDepth, bool wantsEmission, out vec4 s,
+bool sampleCone(vec3 q, float diameter, vec3 dir, int cone, bool wantsDepth, bool wantsEmission, out vec4 s,
                 out vec3 emission, out float depth, out float voxelSize)
 {
     emission = vec3(0.0);
@@ -174,6 +174,7 @@ void main()
     // Start a leaf out, along the normal and along the cone (SparseVoxelOctree::preparePixel).
     ConeMarch m;
     m.t0 = pc.march.z * leaf;
+    m.tMax = 1e30;
     m.tanHalfAngle = pc.march.y;
     m.stepScale = pc.march.w;
     m.maxSteps = pc.size.w;
@@ -182,7 +183,7 @@ void main()
     m.skyStart = pc.sky.y;
     m.planeNormal = n;
     m.planeHeight = 0.5 * pc.march.z * leaf;
-    const ConeTrace r = marchCone(position.xyz + n * (0.5 * pc.march.z * leaf), cones[k].xyz, m);
+    const ConeTrace r = marchCone(position.xyz + n * (0.5 * pc.march.z * leaf), cones[k].xyz, k, m);
     coneRadiance[index * 16 + k] = vec4(max(r.light, vec3(0.0)), 1.0);
     if (sky)
         coneSky[index * 16 + k] = vec4(getConeSkyRadiance(r, cones[16 + k].rgb), 1.0);
