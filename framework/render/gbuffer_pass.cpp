@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/error.h"
+#include "render/capsule_mesh_gpu.h"
 #include "render/gbuffer_geometry.h"
 
 namespace rtlab::render {
@@ -99,6 +100,7 @@ struct GBufferPass::State {
     bool hasScene = false;
     //! What the buffers hold (setScene uploads only what changed from it).
     GBufferGeometry uploaded;
+    CapsuleMeshGpu capsules; //!< meshes the characters where they moved
     gpu::RenderTarget target;               //!< own target of draw(camera, width, height)
     const gpu::RenderTarget* last = nullptr; //!< the target of the last draw
     bool drawn = false;
@@ -129,8 +131,19 @@ void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
         geometry.vertices.size() * sizeof(GBufferVertex) <= s.vertices.getSize() &&
         geometry.indices.size() * sizeof(std::uint32_t) <= s.indices.getSize()) {
         s.hasScene = false;
+        // The characters' vertices are meshed on the device from their poses (the same bits):
+        // held as the new ones, they are left out of the span that goes up.
+        const bool meshCapsules =
+            canMeshCapsulesOnDevice(scene, s.uploaded.vertices.size(), geometry.vertices.size());
+        if (meshCapsules)
+            forEachCapsuleVertex(scene, [&](std::size_t v) {
+                s.uploaded.vertices[v].position = geometry.vertices[v].position;
+                s.uploaded.vertices[v].normal = geometry.vertices[v].normal;
+            });
         gpu::uploadChangedSpan<GBufferVertex>(s.vertices, s.uploaded.vertices, geometry.vertices);
         gpu::uploadChangedSpan<std::uint32_t>(s.indices, s.uploaded.indices, geometry.indices);
+        if (meshCapsules)
+            s.capsules.write(*s.context, scene.capsules, s.vertices, sizeof(GBufferVertex) / sizeof(float), true);
         s.indexCount = static_cast<std::uint32_t>(geometry.indices.size());
         s.vertexCount = geometry.vertices.size();
         s.uploaded = std::move(geometry);

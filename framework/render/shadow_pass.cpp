@@ -1,5 +1,7 @@
 #include "render/shadow_pass.h"
 
+#include "render/capsule_mesh_gpu.h"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -168,6 +170,7 @@ struct ShadowPass::State {
     std::uint32_t indexCount = 0;
     bool uploaded = false;
     std::vector<glm::vec3> uploadedPositions; // what the buffers hold, to skip equal uploads
+    CapsuleMeshGpu capsules;                  // meshes the characters where they moved
     std::vector<std::uint32_t> uploadedIndices;
     glm::vec3 boundsMin{0.0f};
     glm::vec3 boundsMax{0.0f};
@@ -210,8 +213,16 @@ struct ShadowPass::State {
                           scene.indices.size() * sizeof(std::uint32_t) <= indices.getSize();
         uploaded = false;
         if (fits) {
+            // The characters' vertices are meshed on the device from their poses (the same
+            // bits): held as the new ones, they are left out of the span that goes up.
+            const bool meshCapsules =
+                canMeshCapsulesOnDevice(scene, uploadedPositions.size(), scene.positions.size());
+            if (meshCapsules)
+                forEachCapsuleVertex(scene, [&](std::size_t v) { uploadedPositions[v] = scene.positions[v]; });
             gpu::uploadChangedSpan<glm::vec3>(vertices, uploadedPositions, scene.positions);
             gpu::uploadChangedSpan<std::uint32_t>(indices, uploadedIndices, scene.indices);
+            if (meshCapsules)
+                capsules.write(*context, scene.capsules, vertices, 3, false);
         } else {
             // Buffers cannot be empty: an empty scene keeps one unused vertex and triangle.
             // With room to be patched when the scene grows a little (gpu::getPatchCapacity).

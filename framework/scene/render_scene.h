@@ -6,6 +6,7 @@
 #include "scene/sky.h"
 
 #include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
 
 #include <cstdint>
 #include <string>
@@ -24,6 +25,19 @@ struct PointLight {
     glm::vec3 intensity{1.0f};  //!< radiant intensity (radiance units x area / steradian), isotropic
 };
 
+//! A capsule as Scene::appendCharacters meshed it into a RenderScene (scene.cpp appendCapsule):
+//! its ends, radius and frame, and where its vertices start, so that a renderer can mesh it again
+//! on the device from these few numbers (render/capsule_mesh_gpu.h) instead of uploading its
+//! vertices. Vertex i of the capsule (i < getCapsuleVertexCount()) is, with the template entry
+//! e of getCapsuleTemplate(): n = e.x * (e.y * t0 + e.z * t1) + e.w * up, at (i below half the
+//! vertices ? a : b) + radius * n.
+struct CapsuleMesh {
+    glm::vec3 a{0.0f}, b{0.0f};
+    float radius = 0.0f;
+    glm::vec3 t0{0.0f}, t1{0.0f}, up{0.0f};
+    std::uint32_t firstVertex = 0;
+};
+
 struct RenderScene {
     std::vector<glm::vec3> positions;           //!< world units
     std::vector<glm::vec3> normals;             //!< per vertex, unit length (shading normals)
@@ -34,6 +48,9 @@ struct RenderScene {
     Sky sky;
     glm::vec3 boundsMin{0.0f};  //!< of the triangles, world units
     glm::vec3 boundsMax{0.0f};
+    //! The characters' capsules among the triangles (Scene::appendCharacters), in order; their
+    //! vertices are the last ones of `positions`. Not part of the content hash: the triangles are.
+    std::vector<CapsuleMesh> capsules;
 
     std::size_t triangleCount() const { return indices.size() / 3; }
     //! Hash of everything above: the key of ground-truth caches.
@@ -41,5 +58,12 @@ struct RenderScene {
     //! Recomputes boundsMin/boundsMax from positions.
     void updateBounds();
 };
+
+//! The unit sphere's latitude rows and longitudes a capsule is meshed with (scene.cpp
+//! appendCapsule: 16 segments, 6 rings per half, the equator row once per half): per vertex
+//! (cos lat, cos lon, sin lon, sin lat), rows from the bottom pole to the top one.
+const std::vector<glm::vec4>& getCapsuleTemplate();
+//! Vertices per capsule: getCapsuleTemplate().size().
+std::size_t getCapsuleVertexCount();
 
 } // namespace rtlab::scene

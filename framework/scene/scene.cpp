@@ -13,6 +13,11 @@
 
 namespace rtlab::scene {
 
+namespace {
+constexpr int kCapsuleSegments = 16; // a capsule's longitudes
+constexpr int kCapsuleRings = 6;     // its latitude rows per half, pole to equator
+} // namespace
+
 const std::vector<SceneFeature>& FeatureSet::getAll()
 {
     static const std::vector<SceneFeature> all = {
@@ -100,12 +105,35 @@ Camera Scene::getCameraAt(int frame) const
     return cameraPath.empty() ? camera : cameraPath.evaluate(getFrameTime(frame));
 }
 
+const std::vector<glm::vec4>& getCapsuleTemplate()
+{
+    static const std::vector<glm::vec4> unit = [] {
+        std::vector<glm::vec4> v;
+        for (int half = 0; half < 2; ++half)
+            for (int r = 0; r <= kCapsuleRings; ++r) {
+                const float lat =
+                    -glm::half_pi<float>() + glm::half_pi<float>() * (float(r) / kCapsuleRings + half);
+                for (int s = 0; s <= kCapsuleSegments; ++s) {
+                    const float lon = glm::two_pi<float>() * float(s) / kCapsuleSegments;
+                    v.emplace_back(std::cos(lat), std::cos(lon), std::sin(lon), std::sin(lat));
+                }
+            }
+        return v;
+    }();
+    return unit;
+}
+
+std::size_t getCapsuleVertexCount()
+{
+    return getCapsuleTemplate().size();
+}
+
 namespace {
 
 // A capsule as a UV sphere split at its equator with a cylinder between the halves.
-void appendCapsule(RenderScene& out, const Capsule& c, std::uint32_t material, int segments = 16,
-                   int rings = 6)
+void appendCapsule(RenderScene& out, const Capsule& c, std::uint32_t material)
 {
+    const int segments = kCapsuleSegments, rings = kCapsuleRings;
     const glm::vec3 axis = c.b - c.a;
     const float length = glm::length(axis);
     const glm::vec3 up = length > 0.0f ? axis / length : glm::vec3(0, 1, 0);
@@ -113,30 +141,35 @@ void appendCapsule(RenderScene& out, const Capsule& c, std::uint32_t material, i
                                                               : glm::cross(up, glm::vec3(1, 0, 0)));
     const glm::vec3 t1 = glm::cross(up, t0);
     const auto base = std::uint32_t(out.positions.size());
+    out.capsules.push_back({c.a, c.b, c.radius, t0, t1, up, base});
     // Latitude rows from the bottom pole (-pi/2) to the top pole (+pi/2); the equator row is
     // duplicated so the lower half sits on c.a and the upper half on c.b.
-    int rows = 0;
-    for (int half = 0; half < 2; ++half)
-        for (int r = 0; r <= rings; ++r, ++rows) {
-            const float lat = -glm::half_pi<float>() + glm::half_pi<float>() * (float(r) / rings + half);
-            const glm::vec3 centre = half == 0 ? c.a : c.b;
-            for (int s = 0; s <= segments; ++s) {
-                const float lon = glm::two_pi<float>() * float(s) / segments;
-                const glm::vec3 n = std::cos(lat) * (std::cos(lon) * t0 + std::sin(lon) * t1) + std::sin(lat) * up;
-                out.positions.push_back(centre + c.radius * n);
-                out.normals.push_back(n);
-            }
-        }
+    const std::vector<glm::vec4>& unit = getCapsuleTemplate();
+    const int rows = 2 * (rings + 1);
+    for (std::size_t i = 0; i < unit.size(); ++i) {
+        const glm::vec4& e = unit[i];
+        const glm::vec3 centre = i < unit.size() / 2 ? c.a : c.b;
+        const glm::vec3 n = e.x * (e.y * t0 + e.z * t1) + e.w * up;
+        out.positions.push_back(centre + c.radius * n);
+        out.normals.push_back(n);
+    }
     for (int r = 0; r + 1 < rows; ++r)
         for (int s = 0; s < segments; ++s) {
             const std::uint32_t i0 = base + r * (segments + 1) + s, i1 = i0 + 1;
             const std::uint32_t j0 = i0 + (segments + 1), j1 = j0 + 1;
             // Counter-clockwise seen from outside (longitude increases counter-clockwise about up).
+            // The pole rows collapse to a point: their triangles are left out by where they lie
+            // (not by their area, which rounding makes 0 or not with the pose, so that every pose
+            // has the same triangles and a renderer can mesh it again: render/capsule_mesh_gpu.h).
+            // Elsewhere a triangle of no area (a capsule whose ends meet) is left out.
+            const bool bottomPole = r == 0, topPole = r + 2 == rows;
             for (const auto& tri : {std::array<std::uint32_t, 3>{i0, i1, j1}, std::array<std::uint32_t, 3>{i0, j1, j0}}) {
+                if ((bottomPole && tri[1] == i1) || (topPole && tri[1] == j1 && tri[2] == j0))
+                    continue;
                 const glm::vec3 e = glm::cross(out.positions[tri[1]] - out.positions[tri[0]],
                                                out.positions[tri[2]] - out.positions[tri[0]]);
                 if (glm::dot(e, e) <= 0.0f)
-                    continue;  // the pole rows collapse to a point
+                    continue;
                 out.indices.insert(out.indices.end(), tri.begin(), tri.end());
                 out.triangleMaterial.push_back(material);
             }

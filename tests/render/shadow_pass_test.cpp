@@ -11,6 +11,9 @@
 #include <vector>
 
 #include "core/error.h"
+#include "gpu/bus_counters.h"
+#include "render/gbuffer_geometry.h"
+#include "scene/scene.h"
 #include "lighting_test_support.h"
 
 namespace rtlab::render::test {
@@ -254,6 +257,65 @@ TEST_F(ShadowPassTest, RenderingTheFacesAChangeTouchesGivesTheFullRendering)
     EXPECT_THROW(getShadows().renderFaces(s2, wrongCount), Error);
     const std::uint8_t badBits[] = {0x40, 0x00};
     EXPECT_THROW(getShadows().renderFaces(s2, badBits), Error);
+}
+
+// The characters meshed on the device: a frame where only they moved sends their poses to the
+// G-buffer and shadow passes (80 bytes a capsule) instead of their vertices, and both passes
+// draw exactly what they draw from the uploaded vertices: the G-buffer's attachments and the
+// shadow faces bit for bit equal to passes given the moved scene whole.
+TEST_F(ShadowPassTest, CharactersMeshedOnTheDeviceDrawTheUploadedVerticesBits)
+{
+    SceneBuilder b;
+    const std::uint32_t wall = b.addMaterial(kAlbedo);
+    b.addBox({0.0f, 0.0f, -3.0f}, glm::vec3(2.0f, 2.0f, 0.1f), 0.0f, wall);
+    scene::RenderScene base = b.getScene();
+    base.materials.push_back({"skin", glm::vec3(0.8f, 0.6f, 0.5f), glm::vec3(0.0f)});
+    base.pointLights.push_back({{0.5f, 1.5f, 0.0f}, glm::vec3(1.0f)});
+    const auto posed = [&](float t) {
+        std::vector<scene::PosedCapsule> capsules;
+        for (int i = 0; i < 3; ++i) {
+            const glm::vec3 foot(-1.0f + float(i) + 0.3f * t, -0.8f, -1.5f - 0.2f * t * float(i));
+            capsules.push_back({{foot, foot + glm::vec3(0.1f * t, 0.9f, 0.05f), 0.2f + 0.01f * float(i)},
+                                std::uint32_t(base.materials.size() - 1), "walker"});
+        }
+        scene::RenderScene s = base;
+        scene::Scene().appendCharacters(s, capsules);
+        return s;
+    };
+    const scene::RenderScene before = posed(0.0f), after = posed(1.0f);
+    ASSERT_EQ(after.capsules.size(), 3u);
+    ASSERT_EQ(before.positions.size(), after.positions.size());
+    const scene::Camera camera = makeCamera({0.0f, 0.5f, 2.0f}, {0.0f, 0.0f, -2.0f});
+    // Patched: the walls stay, the capsules are meshed from their poses.
+    getPass().setScene(before);
+    getShadows().render(before);
+    const gpu::BusCounters start = gpu::getBusCounters();
+    getPass().setScene(after);
+    const std::uint64_t gbufferBytes = (gpu::getBusCounters() - start).uploadBytes;
+    getShadows().render(after);
+    // The poses (3 x 80 bytes) and, once per context, the template (238 x 16 bytes): no vertex.
+    EXPECT_LE(gbufferBytes, 3u * 80u + scene::getCapsuleVertexCount() * 16u);
+    getPass().draw(camera, 64, 48);
+    const scene::GBuffer patched = getPass().readBack();
+    // Whole: fresh passes given the moved scene's vertices.
+    GBufferPass whole(getContext());
+    whole.setScene(after, false);
+    whole.draw(camera, 64, 48);
+    const scene::GBuffer uploaded = whole.readBack();
+    ASSERT_EQ(patched.position.pixels.size(), uploaded.position.pixels.size());
+    std::size_t characterPixels = 0;
+    for (std::size_t i = 0; i < patched.position.pixels.size(); ++i) {
+        EXPECT_EQ(std::memcmp(&patched.position.pixels[i], &uploaded.position.pixels[i], sizeof(glm::vec3)), 0) << i;
+        EXPECT_EQ(std::memcmp(&patched.normal.pixels[i], &uploaded.normal.pixels[i], sizeof(glm::vec3)), 0) << i;
+        characterPixels += patched.materialId.pixels[i] == base.materials.size() - 1 ? 1 : 0;
+    }
+    EXPECT_GT(characterPixels, 100u);
+    ShadowPassOptions options;
+    options.compiler = getCompiler().getOptions();
+    ShadowPass fresh(getContext(), options);
+    fresh.render(after);
+    for (int face = 0; face < kCubeFaceCount; ++face)
+        EXPECT_EQ(getShadows().readBackFace(0, face).pixels, fresh.readBackFace(0, face).pixels) << "face " << face;
 }
 
 } // namespace
