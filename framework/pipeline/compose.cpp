@@ -24,19 +24,6 @@ namespace {
 
 constexpr std::array<const char*, render::kCubeFaceCount> kFaceNames = {"+x", "-x", "+y",
                                                                         "-y", "+z", "-z"};
-// The bounds of the positions, as render::ShadowPass computes them for its planes.
-std::pair<glm::vec3, glm::vec3> computeBounds(const std::vector<glm::vec3>& positions)
-{
-    if (positions.empty())
-        return {glm::vec3(0.0f), glm::vec3(0.0f)};
-    glm::vec3 lo(std::numeric_limits<float>::max()), hi(std::numeric_limits<float>::lowest());
-    for (const glm::vec3& p : positions) {
-        lo = glm::min(lo, p);
-        hi = glm::max(hi, p);
-    }
-    return {lo, hi};
-}
-
 using Box = std::pair<glm::vec3, glm::vec3>;
 
 // The box a capsule's triangles lie in (scene.cpp appendCapsule: points on the capsule's
@@ -304,7 +291,10 @@ void Compose::addPasses(FrameGraph& graph)
                 mShadows->useAtlas(ctx.write(atlas));
             }
             const std::size_t lightCount = g.pointLights.size();
-            const auto [boundsMin, boundsMax] = computeBounds(g.positions);
+            // The assembled geometry's bounds (kept as its vertices: RenderScene::updateBounds,
+            // extended over the characters), what the shadow planes follow.
+            const glm::vec3 boundsMin = g.positions.empty() ? glm::vec3(0.0f) : g.boundsMin;
+            const glm::vec3 boundsMax = g.positions.empty() ? glm::vec3(0.0f) : g.boundsMax;
             std::vector<scene::Capsule> capsules;
             if (const auto* posed = ctx.tryRead(capsulesRes))
                 for (const auto& c : *posed)

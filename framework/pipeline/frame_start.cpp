@@ -179,6 +179,7 @@ void FrameStart::addPasses(FrameGraph& graph)
                       }
                       scene::RenderScene& g = ctx.write(geometryRes);
                       g = mStaticGeometry;
+                      g.staticKey = mStaticKey;
                       const auto& characters = posed ? *posed : kNoCapsules;
                       mScene.appendCharacters(g, characters);
                       if (g.indices.empty())

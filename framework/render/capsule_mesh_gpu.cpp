@@ -30,6 +30,19 @@ bool canMeshCapsulesOnDevice(const scene::RenderScene& scene, std::size_t heldVe
     return true;
 }
 
+bool onlyCharactersMoved(const scene::RenderScene& next, const std::string& heldStaticKey, std::size_t heldVertices,
+                         std::size_t heldIndices, const std::vector<scene::CapsuleMesh>& heldCapsules)
+{
+    if (next.staticKey.empty() || next.staticKey != heldStaticKey || next.positions.size() != heldVertices ||
+        next.indices.size() != heldIndices || next.capsules.size() != heldCapsules.size() || next.capsules.empty())
+        return false;
+    for (std::size_t i = 0; i < next.capsules.size(); ++i)
+        if (next.capsules[i].firstVertex != heldCapsules[i].firstVertex ||
+            next.capsules[i].material != heldCapsules[i].material)
+            return false;
+    return true;
+}
+
 std::size_t CapsuleMeshGpu::write(gpu::Context& context, const std::vector<scene::CapsuleMesh>& capsules,
                                   gpu::Buffer& vertices, std::uint32_t floatsPerVertex, bool normals)
 {

@@ -20,6 +20,12 @@ namespace rtlab::render {
 //! (so the capsules' vertices are where the held ones were), and some capsules.
 bool canMeshCapsulesOnDevice(const scene::RenderScene& scene, std::size_t heldVertices, std::size_t nextVertices);
 
+//! Whether `next` differs from `held` (what a pass uploaded last) only by where its characters
+//! are: the same static part (RenderScene::staticKey, known), vertex and index counts, and
+//! capsules (their first vertices and materials). Then only the capsules' vertices changed.
+bool onlyCharactersMoved(const scene::RenderScene& next, const std::string& heldStaticKey, std::size_t heldVertices,
+                         std::size_t heldIndices, const std::vector<scene::CapsuleMesh>& heldCapsules);
+
 //! Calls `visit(v)` for every vertex index v of the scene's capsules.
 template <class Visit>
 void forEachCapsuleVertex(const scene::RenderScene& scene, const Visit& visit)

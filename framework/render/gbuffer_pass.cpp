@@ -101,6 +101,18 @@ struct GBufferPass::State {
     //! What the buffers hold (setScene uploads only what changed from it).
     GBufferGeometry uploaded;
     CapsuleMeshGpu capsules; //!< meshes the characters where they moved
+    // The scene the buffers hold: its static part's key, counts and capsules
+    // (onlyCharactersMoved).
+    std::string staticKey;
+    std::size_t scenePositions = 0, sceneIndices = 0;
+    std::vector<scene::CapsuleMesh> sceneCapsules;
+    void remember(const scene::RenderScene& scene)
+    {
+        staticKey = scene.staticKey;
+        scenePositions = scene.positions.size();
+        sceneIndices = scene.indices.size();
+        sceneCapsules = scene.capsules;
+    }
     gpu::RenderTarget target;               //!< own target of draw(camera, width, height)
     const gpu::RenderTarget* last = nullptr; //!< the target of the last draw
     bool drawn = false;
@@ -123,8 +135,21 @@ GBufferPass& GBufferPass::operator=(GBufferPass&&) noexcept = default;
 
 void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
 {
-    GBufferGeometry geometry = buildGBufferGeometry(scene);
     State& s = *mState;
+    // Only the characters moved: their vertices are meshed on the device from their poses, and
+    // nothing else is rebuilt, compared or uploaded (what is held keeps their new positions, as
+    // the vertex buffer will).
+    if (patch && s.hasScene &&
+        onlyCharactersMoved(scene, s.staticKey, s.scenePositions, s.sceneIndices, s.sceneCapsules)) {
+        forEachCapsuleVertex(scene, [&](std::size_t v) {
+            s.uploaded.vertices[v].position = scene.positions[v];
+            s.uploaded.vertices[v].normal = scene.normals[v];
+        });
+        s.capsules.write(*s.context, scene.capsules, s.vertices, sizeof(GBufferVertex) / sizeof(float), true);
+        s.sceneCapsules = scene.capsules;
+        return;
+    }
+    GBufferGeometry geometry = buildGBufferGeometry(scene);
     // A scene that fits the buffers (a character moved, a light did, a dig changed a model's
     // mesh by a little): only the span of vertices and indices that differs goes over the bus.
     if (patch && s.hasScene && !geometry.vertices.empty() && !geometry.indices.empty() &&
@@ -147,6 +172,7 @@ void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
         s.indexCount = static_cast<std::uint32_t>(geometry.indices.size());
         s.vertexCount = geometry.vertices.size();
         s.uploaded = std::move(geometry);
+        s.remember(scene);
         s.hasScene = true;
         return;
     }
@@ -168,6 +194,7 @@ void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
     s.indexCount = static_cast<std::uint32_t>(geometry.indices.size());
     s.vertexCount = geometry.vertices.size();
     s.uploaded = std::move(geometry);
+    s.remember(scene);
     s.hasScene = true;
 }
 

@@ -172,6 +172,11 @@ struct ShadowPass::State {
     std::vector<glm::vec3> uploadedPositions; // what the buffers hold, to skip equal uploads
     CapsuleMeshGpu capsules;                  // meshes the characters where they moved
     std::vector<std::uint32_t> uploadedIndices;
+    // The static part of what the buffers hold (onlyCharactersMoved) and its bounds (of the
+    // vertices before the characters').
+    std::string staticKey;
+    std::vector<scene::CapsuleMesh> uploadedCapsules;
+    glm::vec3 staticMin{std::numeric_limits<float>::max()}, staticMax{std::numeric_limits<float>::lowest()};
     glm::vec3 boundsMin{0.0f};
     glm::vec3 boundsMax{0.0f};
     std::vector<ShadowLightState> lights;
@@ -202,6 +207,23 @@ struct ShadowPass::State {
 
     void uploadGeometry(const scene::RenderScene& scene)
     {
+        // Only the characters moved: their vertices are meshed on the device from their poses;
+        // nothing else is compared or uploaded, and the bounds are the static part's and theirs.
+        if (uploaded && onlyCharactersMoved(scene, staticKey, uploadedPositions.size(), uploadedIndices.size(),
+                                            uploadedCapsules)) {
+            if (scene.capsules == uploadedCapsules)
+                return; // not even they moved
+            boundsMin = staticMin;
+            boundsMax = staticMax;
+            forEachCapsuleVertex(scene, [&](std::size_t v) {
+                uploadedPositions[v] = scene.positions[v];
+                boundsMin = glm::min(boundsMin, scene.positions[v]);
+                boundsMax = glm::max(boundsMax, scene.positions[v]);
+            });
+            capsules.write(*context, scene.capsules, vertices, 3, false);
+            uploadedCapsules = scene.capsules;
+            return;
+        }
         if (uploaded && scene.positions == uploadedPositions && scene.indices == uploadedIndices)
             return;
         validateRenderScene(scene);
@@ -242,14 +264,23 @@ struct ShadowPass::State {
         indexCount = static_cast<std::uint32_t>(scene.indices.size());
         uploadedPositions = scene.positions;
         uploadedIndices = scene.indices;
-        boundsMin = glm::vec3(std::numeric_limits<float>::max());
-        boundsMax = glm::vec3(std::numeric_limits<float>::lowest());
-        for (const glm::vec3& p : scene.positions) {
+        staticMin = boundsMin = glm::vec3(std::numeric_limits<float>::max());
+        staticMax = boundsMax = glm::vec3(std::numeric_limits<float>::lowest());
+        const std::size_t firstCharacter =
+            scene.capsules.empty() ? scene.positions.size() : std::size_t(scene.capsules.front().firstVertex);
+        for (std::size_t i = 0; i < scene.positions.size(); ++i) {
+            const glm::vec3& p = scene.positions[i];
+            if (i == firstCharacter) {
+                staticMin = boundsMin;
+                staticMax = boundsMax;
+            }
             boundsMin = glm::min(boundsMin, p);
             boundsMax = glm::max(boundsMax, p);
         }
         if (scene.positions.empty())
             boundsMin = boundsMax = glm::vec3(0.0f);
+        staticKey = scene.staticKey;
+        uploadedCapsules = scene.capsules;
         uploaded = true;
     }
 };
@@ -259,6 +290,7 @@ void ShadowPass::forgetGeometry()
     mState->uploaded = false;
     mState->uploadedPositions.clear();
     mState->uploadedIndices.clear();
+    mState->staticKey.clear();
 }
 
 ShadowPass::ShadowPass(gpu::Context& context, ShadowPassOptions options)

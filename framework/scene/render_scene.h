@@ -36,6 +36,9 @@ struct CapsuleMesh {
     float radius = 0.0f;
     glm::vec3 t0{0.0f}, t1{0.0f}, up{0.0f};
     std::uint32_t firstVertex = 0;
+    std::uint32_t material = 0;
+
+    bool operator==(const CapsuleMesh&) const = default;
 };
 
 struct RenderScene {
@@ -51,6 +54,10 @@ struct RenderScene {
     //! The characters' capsules among the triangles (Scene::appendCharacters), in order; their
     //! vertices are the last ones of `positions`. Not part of the content hash: the triangles are.
     std::vector<CapsuleMesh> capsules;
+    //! The content hash of the triangles before the characters' (FrameStart's
+    //! assemble_geometry keeps it), or empty: a pass that keeps what it uploaded of the static
+    //! part compares this instead of the triangles. Not part of the content hash.
+    std::string staticKey;
 
     std::size_t triangleCount() const { return indices.size() / 3; }
     //! Hash of everything above: the key of ground-truth caches.

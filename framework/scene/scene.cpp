@@ -141,7 +141,7 @@ void appendCapsule(RenderScene& out, const Capsule& c, std::uint32_t material)
                                                               : glm::cross(up, glm::vec3(1, 0, 0)));
     const glm::vec3 t1 = glm::cross(up, t0);
     const auto base = std::uint32_t(out.positions.size());
-    out.capsules.push_back({c.a, c.b, c.radius, t0, t1, up, base});
+    out.capsules.push_back({c.a, c.b, c.radius, t0, t1, up, base, material});
     // Latitude rows from the bottom pole (-pi/2) to the top pole (+pi/2); the equator row is
     // duplicated so the lower half sits on c.a and the upper half on c.b.
     const std::vector<glm::vec4>& unit = getCapsuleTemplate();

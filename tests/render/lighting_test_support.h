@@ -78,6 +78,9 @@ private:
     std::optional<LightingPass> mLighting;
 };
 
-class ShadowPassTest : public LightingPassTest {};
+class ShadowPassTest : public LightingPassTest {
+public:
+    gpu::Context& getContextForTest() { return getContext(); }
+};
 
 } // namespace rtlab::render::test
