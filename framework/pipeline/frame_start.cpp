@@ -160,7 +160,8 @@ void FrameStart::addPasses(FrameGraph& graph)
     graph.addPass({.name = "assemble_geometry",
                    .reads = {sceneRes},
                    .optionalReads = {sdfMeshes, capsules},
-                   .writes = {geometryRes, geometryKeyRes}},
+                   .writes = {geometryRes, geometryKeyRes},
+                   .persistent = {geometryRes.name}},
                   [this, sdfMeshes, capsules, geometryRes, geometryKeyRes](PassContext& ctx) {
                       static const std::vector<scene::SdfMesh> kNoMeshes;
                       static const std::vector<scene::PosedCapsule> kNoCapsules;
@@ -177,9 +178,24 @@ void FrameStart::addPasses(FrameGraph& graph)
                           mStaticKey = mStaticGeometry.computeContentHash();
                           mStaticVersion = mSdfMeshVersion;
                       }
+                      // The last frame's geometry (kept across frames) when its static part is
+                      // this one: its characters cut off, back to the static part, without
+                      // copying the static part again.
                       scene::RenderScene& g = ctx.write(geometryRes);
-                      g = mStaticGeometry;
-                      g.staticKey = mStaticKey;
+                      const scene::RenderScene& st = mStaticGeometry;
+                      if (ctx.mayReuse() && g.staticKey == mStaticKey && g.positions.size() >= st.positions.size() &&
+                          g.indices.size() >= st.indices.size() && g.materials.size() == st.materials.size()) {
+                          g.positions.resize(st.positions.size());
+                          g.normals.resize(st.normals.size());
+                          g.indices.resize(st.indices.size());
+                          g.triangleMaterial.resize(st.triangleMaterial.size());
+                          g.capsules.clear();
+                          g.boundsMin = st.boundsMin;
+                          g.boundsMax = st.boundsMax;
+                      } else {
+                          g = st;
+                          g.staticKey = mStaticKey;
+                      }
                       const auto& characters = posed ? *posed : kNoCapsules;
                       mScene.appendCharacters(g, characters);
                       if (g.indices.empty())
