@@ -227,9 +227,10 @@ Image<glm::vec3> ConeCombineGpu::combine(gpu::Context& context, const gpu::Buffe
     return out;
 }
 
-void ConeCombineGpu::runCombine(gpu::Context& context, const gpu::ComputePipeline& pipeline,
-                                const std::vector<gpu::Binding>& bindings, const CombineConstants& given,
-                                CapsuleResolution capsuleResolution)
+ConeCombineGpu::Recorder ConeCombineGpu::makeRecorder(const gpu::ComputePipeline& pipeline,
+                                                      const std::vector<gpu::Binding>& bindings,
+                                                      const CombineConstants& given,
+                                                      CapsuleResolution capsuleResolution)
 {
     // The capsules at the traced pixels: a first dispatch over the reduced pixels multiplies the
     // cone radiances in place, then the combine runs without capsules.
@@ -240,7 +241,7 @@ void ConeCombineGpu::runCombine(gpu::Context& context, const gpu::ComputePipelin
     if (traced)
         constants.flags.y = 0;
     const int w = constants.size.x, h = constants.size.y, lw = constants.size.z, lh = constants.size.w;
-    const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
+    return [&pipeline, bindings, constants, tracedConstants, traced, w, h, lw, lh](gpu::CommandList& cmd) {
         if (traced)
             cmd.dispatch(pipeline, bindings, gpu::PushConstants(tracedConstants),
                          gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(lw), 8),
@@ -250,13 +251,29 @@ void ConeCombineGpu::runCombine(gpu::Context& context, const gpu::ComputePipelin
                      gpu::GroupCount{gpu::computeGroupCount(std::uint64_t(w), 8),
                                      gpu::computeGroupCount(std::uint64_t(h), 8), 1},
                      kDispatchLabel);
-    });
-    mLastGpuMs = result.sumGpuMs(kDispatchLabel);
+    };
+}
+
+void ConeCombineGpu::runCombine(gpu::Context& context, const gpu::ComputePipeline& pipeline,
+                                const std::vector<gpu::Binding>& bindings, const CombineConstants& given,
+                                CapsuleResolution capsuleResolution)
+{
+    const Recorder record = makeRecorder(pipeline, bindings, given, capsuleResolution);
+    mLastGpuMs = context.run(record).sumGpuMs(kDispatchLabel);
 }
 
 const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
                                                   int factor, const ResidentCombineInputs& in,
                                                   const gpu::Buffer* cones)
+{
+    const Recorder record = prepareResident(context, dispatch, factor, in, cones);
+    mLastGpuMs = context.run(record).sumGpuMs(kDispatchLabel);
+    return mOutputImage;
+}
+
+ConeCombineGpu::Recorder ConeCombineGpu::prepareResident(gpu::Context& context, const PixelConeDispatch& dispatch,
+                                                         int factor, const ResidentCombineInputs& in,
+                                                         const gpu::Buffer* cones)
 {
     if (in.gbuffer == nullptr || in.gbuffer->positionDepth == nullptr || in.gbuffer->normal == nullptr)
         throw Error("cone combine: the resident combine needs the G-buffer's GPU images");
@@ -304,8 +321,7 @@ const gpu::Image& ConeCombineGpu::combineResident(gpu::Context& context, const P
         gpu::Binding::storageImage(10, vis(1)),
         gpu::Binding::storageImage(11, vis(2)),
         gpu::Binding::storageImage(12, vis(3))};
-    runCombine(context, mResidentPipeline, bindings, constants, in.capsuleResolution);
-    return mOutputImage;
+    return makeRecorder(mResidentPipeline, bindings, constants, in.capsuleResolution);
 }
 
 Image<glm::vec3> ConeCombineGpu::readBackResident() const
@@ -400,9 +416,18 @@ const gpu::Image& gatherConesResident(
     in.capsules = capsules;
     in.coneHalfAngle = coneHalfAngle;
     in.capsuleResolution = capsuleResolution;
-    const gpu::Image& out = combiner.combineResident(context, dispatch, traceStep, in);
+    // The light's combine and the sky's in one submission.
+    const ConeCombineGpu::Recorder light = combiner.prepareResident(context, dispatch, traceStep, in);
+    ConeCombineGpu::Recorder sky;
     if (skyCombiner != nullptr)
-        skyCombiner->combineResident(context, dispatch, traceStep, in, &dispatch.getSkyOutput());
+        sky = skyCombiner->prepareResident(context, dispatch, traceStep, in, &dispatch.getSkyOutput());
+    const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
+        light(cmd);
+        if (sky)
+            sky(cmd);
+    });
+    combiner.setLastGpuMs(result.sumGpuMs(ConeCombineGpu::kDispatchLabel));
+    const gpu::Image& out = *combiner.getResidentOutput();
     if (combineMs != nullptr)
         *combineMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tracedAt).count();
     return out;

@@ -53,6 +53,15 @@ public:
     const gpu::Image& combineResident(gpu::Context& context, const PixelConeDispatch& dispatch,
                                       int factor, const ResidentCombineInputs& in,
                                       const gpu::Buffer* cones = nullptr);
+    //! Records a resident combine: combineResident without its submission. The checks, the
+    //! output image and the capsules' upload happen here; the returned recorder adds the
+    //! dispatches to a command list (gatherConesResident records the light's and the sky's in
+    //! one submission), valid while this object and the bound resources are.
+    using Recorder = std::function<void(gpu::CommandList&)>;
+    Recorder prepareResident(gpu::Context& context, const PixelConeDispatch& dispatch, int factor,
+                             const ResidentCombineInputs& in, const gpu::Buffer* cones = nullptr);
+    //! Sets getLastGpuMs() for dispatches recorded with prepareResident.
+    void setLastGpuMs(std::optional<double> ms) { mLastGpuMs = ms; }
     //! The image of the last combineResident on the CPU. Throws rtlab::Error before one.
     Image<glm::vec3> readBackResident() const;
     //! The image of the last combineResident, or null.
@@ -79,7 +88,10 @@ private:
     // The capsules relative to `anchor` as the shader reads them, uploaded; returns their count.
     int uploadCapsules(const std::vector<scene::PosedCapsule>* capsules, const glm::dvec3& anchor);
     // The combine's dispatches with `pipeline` (either variant): with the capsules at the traced
-    // pixels a first one over the reduced pixels, then the full-resolution one.
+    // pixels a first one over the reduced pixels, then the full-resolution one; recorded
+    // (makeRecorder) or run in their own submission (runCombine).
+    static Recorder makeRecorder(const gpu::ComputePipeline& pipeline, const std::vector<gpu::Binding>& bindings,
+                                 const CombineConstants& constants, CapsuleResolution capsuleResolution);
     void runCombine(gpu::Context& context, const gpu::ComputePipeline& pipeline,
                     const std::vector<gpu::Binding>& bindings, const CombineConstants& constants,
                     CapsuleResolution capsuleResolution);
@@ -101,7 +113,8 @@ private:
 //! PixelConeDispatch, runs its cones without reading back and returns the dispatch; the combine
 //! then reads them there and writes the irradiance into `combiner`'s image, which is returned.
 //! `combineMs`, when given, receives the combine's wall time. With `skyCombiner` the dispatch's
-//! cones' sky (PixelConeDispatch::getSkyOutput) is combined the same way into its image.
+//! cones' sky (PixelConeDispatch::getSkyOutput) is combined the same way into its image, in the
+//! same submission (`combiner`'s getLastGpuMs then counts both).
 const gpu::Image& gatherConesResident(
     gpu::Context& context, ConeCombineGpu& combiner, const plugin::VoxelGiGpuGBuffer& gbuffer,
     int traceStep, double coneHalfAngle, const std::array<const gpu::Image*, 4>& visibility,
