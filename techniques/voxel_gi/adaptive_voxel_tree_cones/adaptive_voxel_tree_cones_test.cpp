@@ -264,18 +264,8 @@ void compareGpu(glm::vec3 offset, int resolution, int depth, NodeMasks masks = N
     // A second call uploads only the pixels (the tree and its light are unchanged).
     gather.gatherCones(context, tree, g, gpuCones);
     EXPECT_EQ(gather.getLastUploadBytes(), 2 * g.position.pixels.size() * sizeof(glm::vec4));
-    // The cones' sky and emitters, traced with the light: the same light, and the sky as the
-    // C++ march gives it.
-    ConeSkyOutput sky;
-    sky.skyPerCone = computeSkyPerCone(s.sky, tree.getCones());
-    std::vector<glm::vec3> cpuSky, gpuSky, gpuLight;
-    sky.out = &cpuSky;
-    tree.gatherCones(g, cpuCones, &sky);
-    gather.setConeSky(sky.skyPerCone);
-    gather.gatherCones(context, tree, g, gpuLight);
-    gather.readBackSky(gpuSky);
-    EXPECT_EQ(gpuLight, gpuCones);
-    expectGpuConesMatchCpu(cpuSky, gpuSky, g, tree.getCones().halfAngle);
+    // The cones' sky and emitters, traced with the light.
+    expectGpuConeSkyMatchesCpu(tree, gather, context, g, s.sky, gpuCones);
 }
 
 } // namespace
