@@ -300,8 +300,9 @@ TEST(VoxelGiDriver, TheResidentSparseGatherLightsTheFrameWithItsConesSky)
 }
 
 // svo as a technique that claims a resident gather and then leaves no image on the GPU (`mode:
-// none`) or one the lighting pass cannot bind (`mode: small`, a 1x1 R32Float image): the frame
-// stops with an error that names the technique and what it left, never a stale image.
+// none`) or one the lighting pass cannot bind (`mode: small`, a 1x1 R32Float image; `small_sky`,
+// the right irradiance image and such a cone sky): the frame stops with an error that names the
+// technique and what it left, never a stale image.
 class ResidentButWrong final : public plugin::VoxelGiTechnique {
 public:
     static plugin::TechniqueInfo describe() { return {.summary = "test double: a resident gather gone wrong"}; }
@@ -315,7 +316,7 @@ public:
     static config::ParamSchema declareParams()
     {
         config::ParamSchema s = inner().schema;
-        s.addEnum("mode", "none", {"none", "small"}, "what the resident gather leaves on the GPU");
+        s.addEnum("mode", "none", {"none", "small", "small_sky"}, "what the resident gather leaves on the GPU");
         return s;
     }
     explicit ResidentButWrong(const config::ParamSet& p)
@@ -339,14 +340,28 @@ public:
         if (mMode == "small" && input.gpu != nullptr)
             mImage = input.gpu->createImage({gpu::ImageDimension::Image2D, gpu::Format::R32Float, 1, 1, 1,
                                              gpu::ImageUsage::StorageAndSampled, "test.small"});
+        // A right irradiance image and a cone sky the lighting pass cannot bind.
+        if (mMode == "small_sky" && input.gpu != nullptr && input.gpuGBuffer != nullptr) {
+            mImage = input.gpu->createImage({gpu::ImageDimension::Image2D, gpu::Format::RGBA32Float,
+                                             std::uint32_t(input.gpuGBuffer->width),
+                                             std::uint32_t(input.gpuGBuffer->height), 1,
+                                             gpu::ImageUsage::StorageAndSampled, "test.irradiance"});
+            mSky = input.gpu->createImage({gpu::ImageDimension::Image2D, gpu::Format::R32Float, 1, 1, 1,
+                                           gpu::ImageUsage::StorageAndSampled, "test.small_sky"});
+        }
     }
     const gpu::Image* getGpuIrradiance() const override { return mImage.isValid() ? &mImage : nullptr; }
+    const gpu::Image* getGpuConeSky() const override { return mSky.isValid() ? &mSky : nullptr; }
+    void readBackIrradiance(Image<glm::vec3>& irradiance) override
+    {
+        irradiance = Image<glm::vec3>(int(mImage.getDesc().width), int(mImage.getDesc().height), glm::vec3(0.0f));
+    }
 
 private:
     std::string mMode;
     std::unique_ptr<plugin::Technique> mInner;
     plugin::VoxelGiTechnique& mTechnique;
-    gpu::Image mImage;
+    gpu::Image mImage, mSky;
 };
 
 TEST(VoxelGiDriver, AResidentGatherThatLeavesNoUsableImageStopsTheFrameWithAClearError)
@@ -356,7 +371,7 @@ TEST(VoxelGiDriver, AResidentGatherThatLeavesNoUsableImageStopsTheFrameWithAClea
     const auto dir = std::filesystem::temp_directory_path() / "rtlab_voxel_gi_driver_wrong";
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
-    for (const std::string mode : {"none", "small"}) {
+    for (const std::string mode : {"none", "small", "small_sky"}) {
         const auto e = experiment::parseExperiment(R"(base:
   scene: cornell_box
   resolution: [24, 16]
@@ -376,9 +391,10 @@ TEST(VoxelGiDriver, AResidentGatherThatLeavesNoUsableImageStopsTheFrameWithAClea
         EXPECT_EQ(rows[0].at("status"), "failed");
         const std::string& error = rows[0].at("error");
         EXPECT_NE(error.find("technique 'resident_but_wrong'"), std::string::npos) << error;
-        EXPECT_NE(error.find(mode == "none" ? "left no irradiance there" : "left a 1x1 R32_SFLOAT irradiance image"),
-                  std::string::npos)
-            << error;
+        const char* expected = mode == "none"    ? "left no irradiance there"
+                               : mode == "small" ? "left a 1x1 R32_SFLOAT irradiance image"
+                                                 : "left a 1x1 R32_SFLOAT cone sky image";
+        EXPECT_NE(error.find(expected), std::string::npos) << error;
     }
 }
 
