@@ -104,14 +104,19 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
             mUploadedFaceStamps.assign(std::size_t(n), 0);
         }
         mUploadedFaceStamps.resize(std::size_t(n), 0);
-        mEmits = false;
+        // A level's faces go up where the sky's march reads them: its occupancy for the optical
+        // depth, its emission where it emits (in occupancy, a level that does not emit needs
+        // none: the pre-combined buffers hold the rest).
+        const bool opticalDepth = volume.getSettings().skyOpticalDepth;
+        mEmittingLevels = 0;
         for (int i = 0; i < n; ++i) {
             const auto& level = volume.getLevel(i);
             if (levels[std::size_t(i)].centre.w < 0.0f)
                 continue;
-            mEmits = mEmits || level.emits;
+            if (level.emits)
+                mEmittingLevels |= 1u << i;
             const std::uint64_t stamp = std::max(level.voxelStamp, level.lightStamp);
-            if (mUploadedFaceStamps[std::size_t(i)] == stamp)
+            if (!(opticalDepth || level.emits) || mUploadedFaceStamps[std::size_t(i)] == stamp)
                 continue;
             const auto& emission = level.light[kEmission];
             std::vector<glm::vec4> faces(levelVoxels * kFaceCount);
@@ -132,7 +137,7 @@ glm::dvec3 CascadeGatherGpu::prepare(gpu::Context& context, const CascadeVolume&
 namespace {
 
 GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anchor, glm::ivec2 size, bool far,
-                              bool sky, bool emits)
+                              bool sky, std::uint32_t emittingLevels)
 {
     const CascadeSettings& settings = volume.getSettings();
     GatherConstants constants;
@@ -145,7 +150,8 @@ GatherConstants makeConstants(const CascadeVolume& volume, const glm::dvec3& anc
     const glm::dvec3 anchorCells = glm::round(anchor / settings.voxelSize);
     constants.anchorCell = glm::ivec4(glm::ivec3(anchorCells), 0);
     constants.noise = {float(settings.levelNoise), float(settings.farStart), 0.0f, 0.0f};
-    constants.sky = makeConeSkyConstants(sky, settings.skyStart, settings.skyOpticalDepth, emits);
+    constants.sky = makeConeSkyConstants(sky, settings.skyStart, settings.skyOpticalDepth, false);
+    constants.sky.w = sky ? float(emittingLevels) : 0.0f; // a bit per level that emits (levels < 24)
     return constants;
 }
 
@@ -217,7 +223,7 @@ const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& con
     mLastFarLevelsDropped = clear.size() - 1;
     const glm::ivec2 size = pixels.getSize();
     mLastTracedSky = mSkyPerCone.has_value();
-    GatherConstants gather = makeConstants(volume, anchor, size, false, mLastTracedSky, mEmits);
+    GatherConstants gather = makeConstants(volume, anchor, size, false, mLastTracedSky, mEmittingLevels);
     gather.flags.w = 1; // resident far cones
     const auto mode = [&](int z) {
         GatherConstants c = gather;
@@ -253,7 +259,7 @@ void CascadeGatherGpu::trace(gpu::Context& context, const CascadeVolume& volume,
     mLastTracedSky = mSkyPerCone.has_value() && (volume.getSettings().farStart <= 0.0 || mFarSkyUploaded);
     mLastGpuMs = mDispatch.run(
         mLevels, mCombined,
-        gpu::PushConstants(makeConstants(volume, anchor, pixels.getSize(), false, mLastTracedSky, mEmits)),
+        gpu::PushConstants(makeConstants(volume, anchor, pixels.getSize(), false, mLastTracedSky, mEmittingLevels)),
         out, {&mFarSlots, &mFarCones, &mFarListPlaceholder, &mFaces, &mFarSky});
 }
 
@@ -278,7 +284,7 @@ void CascadeGatherGpu::traceFarCones(gpu::Context& context, const CascadeVolume&
     const bool traceSky = sky != nullptr && mSkyPerCone.has_value();
     mLastGpuMs = mDispatch.run(
         mLevels, mCombined,
-        gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true, traceSky, mEmits)), &out,
+        gpu::PushConstants(makeConstants(volume, anchor, mDispatch.getPointsSize(), true, traceSky, mEmittingLevels)), &out,
         {&mFarSlots, &mFarCones, &mFarListPlaceholder, &mFaces, &mFarSky}, true);
     if (sky != nullptr) {
         sky->clear();

@@ -92,7 +92,7 @@ private:
     gpu::Buffer mFaces, mFarSky, mResidentFarSky;
     std::vector<std::uint64_t> mUploadedFaceStamps;
     std::optional<std::array<glm::vec3, kConeCount>> mResidentFarSkyOf;
-    bool mEmits = false;
+    std::uint32_t mEmittingLevels = 0; //!< bit i: level i emits (its faces are bound)
     bool mFarSkyUploaded = false; //!< the uploaded far cones carry their sky
     bool mLastTracedSky = false;
     gpu::Buffer mFarSlots, mFarCones; //!< split cones: slot per level voxel, radiance per slot

@@ -52,7 +52,7 @@ layout(push_constant) uniform Constants {
     ivec4 anchorCell; // xyz: the anchor in level-0 voxels
     vec4 noise;       // x: level noise (of a level's radius), y: far start (level voxels; 0: off)
     vec4 sky;         // x: 1 = trace the sky, y: sky start (voxels of the cone's start level),
-                      // z: 1 = optical depth, w: 1 = some voxel emits
+                      // z: 1 = optical depth, w: a bit per level that emits (as a float)
 } pc;
 
 float selectLevel(vec3 p, float diameter)
@@ -178,12 +178,16 @@ bool sampleCone(vec3 q, float diameter, vec3 dir, int cone, bool wantsDepth, boo
     s = (1.0 - frac) * sampleLevel(l0, q, cone);
     if (next)
         s += frac * sampleLevel(l0 + 1, q, cone);
-    wantsEmission = wantsEmission && pc.sky.w == 1.0;
-    if (wantsDepth || wantsEmission) {
-        sampleFaces(l0, q, dir, 1.0 - frac, wantsDepth, wantsEmission, emission, depth);
-        if (next)
-            sampleFaces(l0 + 1, q, dir, frac, wantsDepth, wantsEmission, emission, depth);
-    }
+    // A level's faces are bound where they are read: in optical depth every level's, else
+    // those of the levels that emit (CascadeVolume::sampleLevel reads a level's emission only
+    // where it emits).
+    const uint emitting = uint(pc.sky.w);
+    const bool emits0 = wantsEmission && ((emitting >> uint(l0)) & 1u) != 0u;
+    const bool emits1 = wantsEmission && next && ((emitting >> uint(l0 + 1)) & 1u) != 0u;
+    if (wantsDepth || emits0)
+        sampleFaces(l0, q, dir, 1.0 - frac, wantsDepth, emits0, emission, depth);
+    if (next && (wantsDepth || emits1))
+        sampleFaces(l0 + 1, q, dir, frac, wantsDepth, emits1, emission, depth);
     voxelSize = pc.march.x * exp2(l);
     return true;
 }
