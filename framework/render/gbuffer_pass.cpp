@@ -141,6 +141,8 @@ void GBufferPass::setScene(const scene::RenderScene& scene, bool patch)
     // the vertex buffer will).
     if (patch && s.hasScene &&
         onlyCharactersMoved(scene, s.staticKey, s.scenePositions, s.sceneIndices, s.sceneCapsules)) {
+        if (scene.capsules == s.sceneCapsules)
+            return; // not even they moved
         forEachCapsuleVertex(scene, [&](std::size_t v) {
             s.uploaded.vertices[v].position = scene.positions[v];
             s.uploaded.vertices[v].normal = scene.normals[v];
