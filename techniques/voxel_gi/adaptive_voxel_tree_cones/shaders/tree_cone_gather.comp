@@ -8,7 +8,9 @@
 // popcount of the mask bits below the child's (Silvennoinen & Timonen, SIGGRAPH 2015, "Adaptive
 // Voxel Tree"), the 64-bit popcount as two 32-bit bitCounts. The same algorithm as
 // VoxelTreeCones::gatherCones (voxel_tree_cones.cpp, cone_tracing.h marchCone), in float.
-// Positions are relative to the lattice's centre (precision far from the origin).
+// Positions are relative to the lattice's centre (precision far from the origin). Asked for the
+// cones' sky (pc.sky.x), the same march (<cone_march.glsl>) also gives each cone's sky and
+// emitters past the voxels, the Tomorrow Children's "Sky Light".
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 

@@ -6,7 +6,9 @@
 // Positions are relative to an anchor (the coarsest level's centre), so that coordinates far from
 // the origin keep their precision. The Tomorrow Children, GDC 2015 (seed
 // shared/seeds/000_3da000e866ebc485.txt, "Need to light pixels", "Cascade selection",
-// "Pre-Combine Anisotropic Voxels").
+// "Pre-Combine Anisotropic Voxels"). Asked for the cones' sky (pc.sky.x), the same march
+// (<cone_march.glsl>) also gives each cone's sky and emitters past the voxels ("Sky Light"), the
+// far cones' too.
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 

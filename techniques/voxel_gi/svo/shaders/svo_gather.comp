@@ -7,6 +7,8 @@
 // SparseVoxelOctree::gatherCones (sparse_voxel_octree.cpp, cone_tracing.h marchCone), in float.
 // Crassin et al., "Interactive Indirect Illumination Using Voxel Cone Tracing", Pacific Graphics
 // 2011, section 4. Positions are relative to the cube's centre (precision far from the origin).
+// Asked for the cones' sky (pc.sky.x), the same march (<cone_march.glsl>) also gives each cone's
+// sky and emitters past the voxels, the Tomorrow Children's "Sky Light".
 
 layout(local_size_x = 8, local_size_y = 8, local_size_z = 1) in;
 
