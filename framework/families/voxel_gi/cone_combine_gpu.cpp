@@ -408,6 +408,7 @@ const gpu::Image& gatherConesResident(
     PixelSource source;
     source.gpu = &gbuffer;
     source.factor = traceStep;
+    source.deferSubmission = true; // recorded with the combine below: one submission
     const PixelConeDispatch& dispatch = traceCones(source);
     const auto tracedAt = std::chrono::steady_clock::now();
     ResidentCombineInputs in;
@@ -416,16 +417,21 @@ const gpu::Image& gatherConesResident(
     in.capsules = capsules;
     in.coneHalfAngle = coneHalfAngle;
     in.capsuleResolution = capsuleResolution;
-    // The light's combine and the sky's in one submission.
+    // The reduction and the cones (as the technique recorded them), the light's combine and the
+    // sky's in one submission.
     const ConeCombineGpu::Recorder light = combiner.prepareResident(context, dispatch, traceStep, in);
     ConeCombineGpu::Recorder sky;
     if (skyCombiner != nullptr)
         sky = skyCombiner->prepareResident(context, dispatch, traceStep, in, &dispatch.getSkyOutput());
     const gpu::RunResult result = context.run([&](gpu::CommandList& cmd) {
+        if (dispatch.getRecorded())
+            dispatch.getRecorded()(cmd);
         light(cmd);
         if (sky)
             sky(cmd);
     });
+    if (dispatch.getRecorded())
+        dispatch.setDeferredGpuMs(result.sumGpuMs(dispatch.getLabel()));
     combiner.setLastGpuMs(result.sumGpuMs(ConeCombineGpu::kDispatchLabel));
     const gpu::Image& out = *combiner.getResidentOutput();
     if (combineMs != nullptr)

@@ -112,9 +112,11 @@ private:
 //! `source` (the G-buffer's GPU images, reduced by `traceStep` on the device) in its
 //! PixelConeDispatch, runs its cones without reading back and returns the dispatch; the combine
 //! then reads them there and writes the irradiance into `combiner`'s image, which is returned.
-//! `combineMs`, when given, receives the combine's wall time. With `skyCombiner` the dispatch's
-//! cones' sky (PixelConeDispatch::getSkyOutput) is combined the same way into its image, in the
-//! same submission (`combiner`'s getLastGpuMs then counts both).
+//! The technique's dispatches are recorded (PixelSource::deferSubmission) and submitted with the
+//! combine: the whole gather is one submission. `combineMs`, when given, receives its wall time
+//! from the cones' recording on. With `skyCombiner` the dispatch's cones' sky
+//! (PixelConeDispatch::getSkyOutput) is combined the same way into its image, in the same
+//! submission (`combiner`'s getLastGpuMs then counts both).
 const gpu::Image& gatherConesResident(
     gpu::Context& context, ConeCombineGpu& combiner, const plugin::VoxelGiGpuGBuffer& gbuffer,
     int traceStep, double coneHalfAngle, const std::array<const gpu::Image*, 4>& visibility,

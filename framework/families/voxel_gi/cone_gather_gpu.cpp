@@ -108,6 +108,9 @@ void PixelConeDispatch::reserve(Starts& starts, std::size_t entries, const char*
 
 std::size_t PixelConeDispatch::preparePixels(const PixelSource& source, const glm::dvec3& anchor)
 {
+    mRecorded = {};
+    mDeferredGpuMs.reset();
+    mDefer = source.gpu != nullptr && source.deferSubmission;
     if (source.gpu == nullptr) {
         if (source.gbuffer == nullptr)
             throw Error("cone gather: no pixels given (neither a G-buffer nor its GPU images)");
@@ -238,12 +241,18 @@ std::optional<double> PixelConeDispatch::runWithSteps(gpu::Buffer& first, gpu::B
                                                       const std::vector<Step>& before)
 {
     const Starts& starts = mOnDevice ? mDevicePixels : mPixels;
+    // Everything the recording reads, held by value (it may run after this call returns).
     const std::vector<gpu::Binding> bindings = bindStarts(starts, first, second, extra);
-    const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
-        if (mOnDevice)
+    const std::vector<std::byte> bytes(constants.getData(), constants.getData() + constants.getSize());
+    std::vector<std::pair<gpu::Buffer*, Clear>> clears;
+    for (const Clear& c : clear)
+        clears.emplace_back(extra.at(c.extra), c);
+    const bool reduce = mOnDevice;
+    const auto record = [this, &starts, bindings, bytes, clears, before, reduce](gpu::CommandList& cmd) {
+        if (reduce)
             recordReduce(cmd);
-        for (const Clear& c : clear)
-            cmd.fillBuffer(*extra.at(c.extra), 0u, c.offset, c.size);
+        for (const auto& [buffer, c] : clears)
+            cmd.fillBuffer(*buffer, 0u, c.offset, c.size);
         for (const Step& step : before) {
             const gpu::PushConstants stepConstants(step.constants.data(), step.constants.size());
             if (step.indirect != nullptr)
@@ -252,21 +261,30 @@ std::optional<double> PixelConeDispatch::runWithSteps(gpu::Buffer& first, gpu::B
             else
                 cmd.dispatch(mPipeline, bindings, stepConstants, step.groups, mLabel.c_str());
         }
-        recordCones(cmd, bindings, constants, starts);
-    });
-    return result.sumGpuMs(mLabel);
+        recordCones(cmd, bindings, gpu::PushConstants(bytes.data(), bytes.size()), starts);
+    };
+    if (mDefer) {
+        mRecorded = record;
+        return std::nullopt;
+    }
+    return mContext->run(record).sumGpuMs(mLabel);
 }
 
 void PixelConeDispatch::runWithoutCones()
 {
     Starts& starts = mOnDevice ? mDevicePixels : mPixels;
-    mContext->run([&](gpu::CommandList& cmd) {
-        if (mOnDevice)
+    const bool reduce = mOnDevice;
+    const auto record = [this, &starts, reduce](gpu::CommandList& cmd) {
+        if (reduce)
             recordReduce(cmd);
         cmd.fillBuffer(starts.output, 0u);
         if (starts.skyOutput.isValid())
             cmd.fillBuffer(starts.skyOutput, 0u);
-    });
+    };
+    if (mDefer)
+        mRecorded = record;
+    else
+        mContext->run(record);
 }
 
 void PixelConeDispatch::recordReduce(gpu::CommandList& cmd)
@@ -291,6 +309,15 @@ std::optional<double> PixelConeDispatch::run(gpu::Buffer& first, gpu::Buffer& se
     Starts& starts = points ? mPoints : mOnDevice ? mDevicePixels : mPixels;
     const bool reduce = !points && mOnDevice;
     const std::vector<gpu::Binding> bindings = bindStarts(starts, first, second, extra);
+    if (mDefer && !points && out == nullptr) {
+        const std::vector<std::byte> bytes(constants.getData(), constants.getData() + constants.getSize());
+        mRecorded = [this, &starts, bindings, bytes, reduce](gpu::CommandList& cmd) {
+            if (reduce)
+                recordReduce(cmd);
+            recordCones(cmd, bindings, gpu::PushConstants(bytes.data(), bytes.size()), starts);
+        };
+        return std::nullopt;
+    }
     const gpu::RunResult result = mContext->run([&](gpu::CommandList& cmd) {
         if (reduce)
             recordReduce(cmd);

@@ -18,6 +18,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +36,10 @@ struct PixelSource {
     const scene::GBuffer* gbuffer = nullptr;
     const plugin::VoxelGiGpuGBuffer* gpu = nullptr;
     int factor = 1;
+    //! With `gpu`: the dispatch records the reduction and the cones (getRecorded) instead of
+    //! submitting them, for a caller that submits them with what reads them (the resident
+    //! gather's combine: one submission for the whole gather).
+    bool deferSubmission = false;
     //! The traced pixels' grid: the G-buffer's size, or the reduced size for `gpu`.
     glm::ivec2 getSize() const;
 };
@@ -114,6 +119,15 @@ public:
     //! For a structure with nothing to trace: the prepared pixels' reduction (if on the device)
     //! and zero radiances in getOutput().
     void runWithoutCones();
+    //! What the last run recorded instead of submitting (PixelSource::deferSubmission), to be
+    //! recorded into the caller's command list; empty when it submitted. Valid while the bound
+    //! buffers are, until the next preparePixels.
+    const std::function<void(gpu::CommandList&)>& getRecorded() const { return mRecorded; }
+    //! The GPU time of the deferred dispatches, as the caller's submission measured it
+    //! (setDeferredGpuMs); nullopt otherwise.
+    std::optional<double> getDeferredGpuMs() const { return mDeferredGpuMs; }
+    void setDeferredGpuMs(std::optional<double> ms) const { mDeferredGpuMs = ms; }
+    const std::string& getLabel() const { return mLabel; }
     //! The cone radiances of the last run over pixels, [pixel * 16 + cone] as vec4.
     const gpu::Buffer& getOutput() const { return mOnDevice ? mDevicePixels.output : mPixels.output; }
     //! A storage buffer of at least `bytes` (16 at least) named `name`; `hostVisible` for data
@@ -139,6 +153,9 @@ private:
     // Uploaded pixels, uploaded points, pixels reduced on the device (device-local buffers).
     Starts mPixels, mPoints, mDevicePixels;
     bool mOnDevice = false; //!< the last pixels prepared were reduced on the device
+    bool mDefer = false;    //!< the next run records into mRecorded (PixelSource::deferSubmission)
+    std::function<void(gpu::CommandList&)> mRecorded;
+    mutable std::optional<double> mDeferredGpuMs;
     // The reduction recorded before the next run() (mOnDevice).
     gpu::ComputePipeline mReduce;
     std::vector<std::byte> mReduceConstants;

@@ -40,7 +40,7 @@ public:
     //! The cones' sky of the last gather, which traced it, [pixel * 16 + cone] (zero for an
     //! empty tree).
     void readBackSky(std::vector<glm::vec3>& out) const;
-    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs ? mLastGpuMs : mDispatch.getDeferredGpuMs(); }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/adaptive_voxel_tree_cones/shaders when set, else the
     //! source folder.

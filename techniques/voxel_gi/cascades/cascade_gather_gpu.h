@@ -67,7 +67,7 @@ public:
     //! The cones' sky of the last gather over pixels, which traced it, [pixel * 16 + cone].
     void readBackSky(std::vector<glm::vec3>& out) const { mDispatch.readBackSky(out); }
     //! GPU time of the last dispatch, when the device has timestamps.
-    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs ? mLastGpuMs : mDispatch.getDeferredGpuMs(); }
     //! Bytes uploaded by the last call (levels that changed, pixels).
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! Levels whose resident far cones the last resident gather dropped (their inputs changed).

@@ -35,7 +35,7 @@ public:
     void setConeSky(const std::optional<std::array<glm::vec3, kConeCount>>& skyPerCone) { mSkyPerCone = skyPerCone; }
     //! The cones' sky of the last gather, which traced it, [pixel * 16 + cone].
     void readBackSky(std::vector<glm::vec3>& out) const { mDispatch.readBackSky(out); }
-    std::optional<double> getLastGpuMs() const { return mLastGpuMs; }
+    std::optional<double> getLastGpuMs() const { return mLastGpuMs ? mLastGpuMs : mDispatch.getDeferredGpuMs(); }
     std::size_t getLastUploadBytes() const { return mLastUploadBytes; }
     //! $RTLAB_SOURCE_DIR/techniques/voxel_gi/svo/shaders when set, else the source folder.
     static std::filesystem::path getShaderDir();
