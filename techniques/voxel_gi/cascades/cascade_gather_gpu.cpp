@@ -204,6 +204,8 @@ const PixelConeDispatch& CascadeGatherGpu::gatherConesResident(gpu::Context& con
             mResidentFarInputs.assign(std::size_t(n), {});
             mResidentFarSkyOf = mSkyPerCone;
         }
+    } else {
+        mResidentFarSkyOf.reset(); // far cones traced from now on carry no sky
     }
     // The far cones of level i sample levels getFarDependency(i) and coarser: drop them when one
     // of those changed since (CascadeVolume::invalidateFarCones), or on first use.
